@@ -1,0 +1,277 @@
+#include "automaton/automaton.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+namespace hybrid {
+namespace {
+
+[[noreturn]] void Fail(std::string_view api, const std::string& message) {
+  throw std::invalid_argument(std::string(api) + ": " + message);
+}
+
+template <class T, class Key>
+bool SortedUnique(const std::vector<T>& items, Key key) {
+  for (size_t i = 1; i < items.size(); ++i) {
+    if (!(key(items[i - 1]) < key(items[i]))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Automaton::Automaton(std::string name) : name_(std::move(name)) {
+  if (name_.empty()) Fail("Automaton", "empty name");
+}
+
+void Automaton::CheckSlots(const Expression& e, std::string_view context, bool allow_inputs,
+                           bool allow_state) const {
+  for (int slot : e.Slots()) {
+    if (slot >= symbols_.size()) {
+      Fail(context, "expression '" + e.ToString() + "' reads undeclared slot " +
+                        std::to_string(slot));
+    }
+    const Symbol& s = symbols_[slot];
+    const bool ok = s.kind == SymbolKind::kParameter ||
+                    (s.kind == SymbolKind::kInput && allow_inputs) ||
+                    ((s.kind == SymbolKind::kVariable || s.kind == SymbolKind::kDiscrete) &&
+                     allow_state);
+    if (!ok) {
+      Fail(context, std::string(KindName(s.kind)) + " '" + s.name + "' is not allowed here");
+    }
+  }
+}
+
+double Automaton::EvaluateConstant(const Expression& e, std::string_view context) const {
+  CheckSlots(e, context, false, false);
+  const double v = e.Evaluate(ParameterEnvironment());
+  if (!std::isfinite(v)) Fail(context, "'" + e.ToString() + "' is not finite");
+  return v;
+}
+
+int Automaton::AddVariable(std::string name, std::string unit, std::optional<Range> domain) {
+  if (domain) {
+    const double lo = EvaluateConstant(domain->lo, "Automaton::AddVariable: domain of " + name);
+    const double hi = EvaluateConstant(domain->hi, "Automaton::AddVariable: domain of " + name);
+    if (lo > hi) Fail("Automaton::AddVariable", "empty domain for '" + name + "'");
+  }
+  int slot;
+  try {
+    slot = symbols_.Add({std::move(name), SymbolKind::kVariable, std::move(unit)});
+  } catch (const std::invalid_argument& e) {
+    Fail("Automaton::AddVariable", e.what());
+  }
+  variables_.push_back({slot, std::move(domain)});
+  return slot;
+}
+
+int Automaton::AddDiscreteVariable(std::string name) {
+  if (!modes_.empty()) {
+    Fail("Automaton::AddDiscreteVariable", "'" + name + "' declared after the first mode");
+  }
+  int slot;
+  try {
+    slot = symbols_.Add({std::move(name), SymbolKind::kDiscrete, ""});
+  } catch (const std::invalid_argument& e) {
+    Fail("Automaton::AddDiscreteVariable", e.what());
+  }
+  discrete_.push_back(slot);
+  return slot;
+}
+
+int Automaton::AddInput(std::string name, Range bounds, std::string unit) {
+  const double lo = EvaluateConstant(bounds.lo, "Automaton::AddInput: bounds of " + name);
+  const double hi = EvaluateConstant(bounds.hi, "Automaton::AddInput: bounds of " + name);
+  if (lo > hi) Fail("Automaton::AddInput", "empty bounds for '" + name + "'");
+  int slot;
+  try {
+    slot = symbols_.Add({std::move(name), SymbolKind::kInput, std::move(unit)});
+  } catch (const std::invalid_argument& e) {
+    Fail("Automaton::AddInput", e.what());
+  }
+  inputs_.push_back({slot, std::move(bounds)});
+  return slot;
+}
+
+int Automaton::AddParameter(std::string name, Expression value, std::string unit) {
+  EvaluateConstant(value, "Automaton::AddParameter: value of " + name);
+  int slot;
+  try {
+    slot = symbols_.Add({std::move(name), SymbolKind::kParameter, std::move(unit)});
+  } catch (const std::invalid_argument& e) {
+    Fail("Automaton::AddParameter", e.what());
+  }
+  parameters_.emplace_back(slot, std::move(value));
+  return slot;
+}
+
+ModeId Automaton::AddMode(Mode mode) {
+  constexpr std::string_view kApi = "Automaton::AddMode";
+  if (mode.name.empty()) Fail(kApi, "empty mode name");
+  if (FindMode(mode.name)) Fail(kApi, "duplicate mode '" + mode.name + "'");
+  if (!SortedUnique(mode.flows, [](const auto& f) { return f.first; })) {
+    Fail(kApi, "flows of mode '" + mode.name + "' are not sorted by slot or repeat a variable");
+  }
+  for (const auto& [slot, rhs] : mode.flows) {
+    if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kVariable) {
+      Fail(kApi, "mode '" + mode.name + "' has a flow for something that is not a continuous "
+                 "variable (slot " + std::to_string(slot) + ")");
+    }
+    CheckSlots(rhs, std::string(kApi) + ": flow of '" + symbols_[slot].name + "' in mode '" +
+                        mode.name + "'", true, true);
+  }
+  for (const Comparison& c : mode.invariant.comparisons) {
+    CheckSlots(c.Residual(), std::string(kApi) + ": invariant of mode '" + mode.name + "'", true,
+               true);
+  }
+  if (!SortedUnique(mode.discrete_values, [](const auto& d) { return d.first; })) {
+    Fail(kApi, "discrete values of mode '" + mode.name + "' are not sorted or repeat a variable");
+  }
+  for (const auto& [slot, value] : mode.discrete_values) {
+    if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kDiscrete) {
+      Fail(kApi, "mode '" + mode.name + "' sets a value for something that is not a discrete "
+                 "variable (slot " + std::to_string(slot) + ")");
+    }
+  }
+  if (mode.discrete_values.size() != discrete_.size()) {
+    for (int d : discrete_) {
+      if (!mode.DiscreteValueOf(d)) {
+        Fail(kApi, "mode '" + mode.name + "' does not set discrete variable '" +
+                       symbols_[d].name + "'");
+      }
+    }
+  }
+  modes_.push_back(std::move(mode));
+  return ModeId(num_modes() - 1);
+}
+
+std::optional<ModeId> Automaton::FindMode(std::string_view name) const {
+  for (int i = 0; i < num_modes(); ++i) {
+    if (modes_[i].name == name) return ModeId(i);
+  }
+  return std::nullopt;
+}
+
+TransitionId Automaton::AddTransition(Transition t) {
+  constexpr std::string_view kApi = "Automaton::AddTransition";
+  if (t.name.empty()) Fail(kApi, "empty transition name");
+  for (const Transition& other : transitions_) {
+    if (other.name == t.name) Fail(kApi, "duplicate transition '" + t.name + "'");
+  }
+  if (!t.source.is_valid() || t.source.value() >= num_modes()) {
+    Fail(kApi, "transition '" + t.name + "' has an unknown source mode");
+  }
+  if (!t.target.is_valid() || t.target.value() >= num_modes()) {
+    Fail(kApi, "transition '" + t.name + "' has an unknown target mode");
+  }
+  for (const Comparison& c : t.guard.comparisons) {
+    CheckSlots(c.Residual(), std::string(kApi) + ": guard of '" + t.name + "'", true, true);
+  }
+  if (!SortedUnique(t.resets, [](const Reset& r) { return r.slot; })) {
+    Fail(kApi, "transition '" + t.name + "' resets a variable twice");
+  }
+  for (const Reset& r : t.resets) {
+    if (r.slot < 0 || r.slot >= symbols_.size() ||
+        symbols_[r.slot].kind != SymbolKind::kVariable) {
+      Fail(kApi, "transition '" + t.name + "' resets something that is not a continuous variable");
+    }
+    CheckSlots(r.value, std::string(kApi) + ": reset of '" + symbols_[r.slot].name + "' in '" +
+                            t.name + "'", true, true);
+  }
+  transitions_.push_back(std::move(t));
+  return TransitionId(num_transitions() - 1);
+}
+
+void Automaton::AddInitialState(InitialState state) {
+  constexpr std::string_view kApi = "Automaton::AddInitialState";
+  if (!state.mode.is_valid() || state.mode.value() >= num_modes()) Fail(kApi, "unknown mode");
+  const std::string& mode_name = modes_[state.mode.value()].name;
+  if (!SortedUnique(state.values, [](const InitialValue& v) { return v.slot; })) {
+    Fail(kApi, "initial state in '" + mode_name + "' gives a variable twice");
+  }
+  for (const InitialValue& v : state.values) {
+    if (v.slot < 0 || v.slot >= symbols_.size() ||
+        symbols_[v.slot].kind != SymbolKind::kVariable) {
+      Fail(kApi, "initial state in '" + mode_name + "' sets something that is not a continuous "
+                 "variable");
+    }
+    const std::string context =
+        std::string(kApi) + ": initial value of '" + symbols_[v.slot].name + "'";
+    const double lo = EvaluateConstant(v.range.lo, context);
+    const double hi = EvaluateConstant(v.range.hi, context);
+    if (lo > hi) Fail(kApi, "empty initial range for '" + symbols_[v.slot].name + "'");
+  }
+  for (const VariableInfo& var : variables_) {
+    const bool given = std::any_of(state.values.begin(), state.values.end(),
+                                   [&](const InitialValue& v) { return v.slot == var.slot; });
+    if (!given) {
+      Fail(kApi, "initial state in '" + mode_name + "' gives no value for '" +
+                     symbols_[var.slot].name + "'");
+    }
+  }
+  initial_states_.push_back(std::move(state));
+}
+
+void Automaton::AddProperty(Property property) {
+  constexpr std::string_view kApi = "Automaton::AddProperty";
+  if (property.name.empty()) Fail(kApi, "empty property name");
+  for (const Property& p : properties_) {
+    if (p.name == property.name) Fail(kApi, "duplicate property '" + property.name + "'");
+  }
+  const std::string context = std::string(kApi) + ": property '" + property.name + "'";
+  property.predicate.ForEachComparison(
+      [&](const Comparison& c) { CheckSlots(c.Residual(), context, false, true); });
+  property.predicate.ForEachMode([&](const std::string& m) {
+    if (!FindMode(m)) Fail(context, "unknown mode '" + m + "'");
+  });
+  if (property.horizon && !(*property.horizon > 0.0 && std::isfinite(*property.horizon))) {
+    Fail(context, "horizon must be positive and finite");
+  }
+  properties_.push_back(std::move(property));
+}
+
+void Automaton::SetScenario(Scenario scenario) {
+  constexpr std::string_view kApi = "Automaton::SetScenario";
+  if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {
+    Fail(kApi, "'until' must be positive and finite");
+  }
+  std::set<int> seen;
+  for (const InputSignal& s : scenario.inputs) {
+    if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
+      Fail(kApi, "signal for something that is not an input");
+    }
+    const std::string& name = symbols_[s.slot].name;
+    if (!seen.insert(s.slot).second) Fail(kApi, "input '" + name + "' driven twice");
+    if (s.points.empty()) Fail(kApi, "signal for '" + name + "' has no points");
+    for (size_t i = 0; i < s.points.size(); ++i) {
+      if (!std::isfinite(s.points[i].first) || !std::isfinite(s.points[i].second)) {
+        Fail(kApi, "signal for '" + name + "' has a non-finite point");
+      }
+      if (i > 0 && !(s.points[i - 1].first < s.points[i].first)) {
+        Fail(kApi, "signal for '" + name + "': times must increase strictly");
+      }
+    }
+    const auto& bounds = std::find_if(inputs_.begin(), inputs_.end(),
+                                      [&](const InputInfo& in) { return in.slot == s.slot; })
+                             ->bounds;
+    const double lo = EvaluateConstant(bounds.lo, kApi);
+    const double hi = EvaluateConstant(bounds.hi, kApi);
+    for (const auto& [t, v] : s.points) {
+      if (v < lo || v > hi) {
+        Fail(kApi, "signal for '" + name + "' takes value " + FormatNumber(v) +
+                       " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+      }
+    }
+  }
+  scenario_ = std::move(scenario);
+}
+
+std::vector<double> Automaton::ParameterEnvironment() const {
+  std::vector<double> env(symbols_.size(), 0.0);
+  for (const auto& [slot, value] : parameters_) env[slot] = value.Evaluate(env);
+  return env;
+}
+
+}  // namespace hybrid

@@ -1,0 +1,134 @@
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "automaton/expression.h"
+#include "automaton/id.h"
+#include "automaton/mode.h"
+#include "automaton/property.h"
+#include "automaton/scenario.h"
+#include "automaton/symbol_table.h"
+#include "automaton/transition.h"
+
+namespace hybrid {
+
+/// A closed interval given by two expressions over parameters (e.g. `[-1, 1]`, `[0, theta1_max]`).
+struct Range {
+  Expression lo;
+  Expression hi;
+  friend bool operator==(const Range&, const Range&) = default;
+};
+
+/// Initial value of one continuous variable: a point (`x = e`) or a box side (`x in [lo, hi]`).
+struct InitialValue {
+  int slot = -1;
+  Range range;  ///< lo == hi (the same expression) for a point
+  bool is_point = true;
+  friend bool operator==(const InitialValue&, const InitialValue&) = default;
+};
+
+/// An initial mode with initial values for every continuous variable, sorted by slot.
+struct InitialState {
+  ModeId mode;
+  std::vector<InitialValue> values;
+  friend bool operator==(const InitialState&, const InitialState&) = default;
+};
+
+/// Declared domain of a continuous variable.
+struct VariableInfo {
+  int slot = -1;
+  std::optional<Range> domain;
+  friend bool operator==(const VariableInfo&, const VariableInfo&) = default;
+};
+
+/// Bounds of an input.
+struct InputInfo {
+  int slot = -1;
+  Range bounds;
+  friend bool operator==(const InputInfo&, const InputInfo&) = default;
+};
+
+/// A hybrid automaton: symbols, modes, transitions, initial states, properties and a default
+/// scenario. The model IR every solver consumes.
+///
+/// Built incrementally; each Add* validates its argument against what is already declared and
+/// throws std::invalid_argument naming the method and the offending name (duplicate names,
+/// expressions reading undeclared slots, flows of non-variables, unknown modes, parameters that
+/// read anything but earlier parameters, discrete valuations that are incomplete, ...). So a model
+/// is valid by construction, and names must be declared before use.
+///
+/// Environment layout: every expression of the automaton reads a flat array indexed by slot
+/// (SymbolTable); ParameterEnvironment() gives one with the parameters filled in.
+class Automaton {
+ public:
+  /// `name` must be non-empty.
+  explicit Automaton(std::string name);
+
+  const std::string& name() const { return name_; }
+  const SymbolTable& symbols() const { return symbols_; }
+
+  int AddVariable(std::string name, std::string unit = "", std::optional<Range> domain = {});
+  int AddDiscreteVariable(std::string name);
+  int AddInput(std::string name, Range bounds, std::string unit = "");
+  /// `value` may read only parameters declared earlier; it must evaluate to a finite number.
+  int AddParameter(std::string name, Expression value, std::string unit = "");
+  /// Flows must be sorted by slot and name continuous variables; every discrete variable must
+  /// get a value; the mode name must be new.
+  ModeId AddMode(Mode mode);
+  /// Source and target must exist; resets must assign continuous variables; the name must be new.
+  TransitionId AddTransition(Transition transition);
+  /// Every continuous variable must get exactly one value; bounds read parameters only.
+  void AddInitialState(InitialState state);
+  /// Comparisons may read variables, discrete variables and parameters, not inputs; `in` atoms
+  /// must name modes of this automaton; the property name must be new.
+  void AddProperty(Property property);
+  /// Inputs must exist, each at most once; points strictly increasing in time; until > 0.
+  void SetScenario(Scenario scenario);
+
+  int num_modes() const { return static_cast<int>(modes_.size()); }
+  int num_transitions() const { return static_cast<int>(transitions_.size()); }
+  const Mode& mode(ModeId id) const { return modes_.at(id.value()); }
+  const Transition& transition(TransitionId id) const { return transitions_.at(id.value()); }
+  std::span<const Mode> modes() const { return modes_; }
+  std::span<const Transition> transitions() const { return transitions_; }
+  std::optional<ModeId> FindMode(std::string_view name) const;
+  std::span<const VariableInfo> variables() const { return variables_; }
+  std::span<const InputInfo> inputs() const { return inputs_; }
+  /// Slots of the parameters in declaration order, with their defining expressions.
+  std::span<const std::pair<int, Expression>> parameters() const { return parameters_; }
+  std::span<const int> discrete_variables() const { return discrete_; }
+  std::span<const InitialState> initial_states() const { return initial_states_; }
+  std::span<const Property> properties() const { return properties_; }
+  const std::optional<Scenario>& scenario() const { return scenario_; }
+
+  /// An environment (one entry per slot) with every parameter evaluated in declaration order and
+  /// every other slot 0.
+  std::vector<double> ParameterEnvironment() const;
+  /// The value of a constant expression over parameters (throws std::invalid_argument, naming
+  /// `context`, if it reads a non-parameter or is not finite).
+  double EvaluateConstant(const Expression& e, std::string_view context) const;
+
+  friend bool operator==(const Automaton&, const Automaton&) = default;
+
+ private:
+  void CheckSlots(const Expression& e, std::string_view context, bool allow_inputs,
+                  bool allow_state) const;
+
+  std::string name_;
+  SymbolTable symbols_;
+  std::vector<VariableInfo> variables_;
+  std::vector<int> discrete_;
+  std::vector<InputInfo> inputs_;
+  std::vector<std::pair<int, Expression>> parameters_;
+  std::vector<Mode> modes_;
+  std::vector<Transition> transitions_;
+  std::vector<InitialState> initial_states_;
+  std::vector<Property> properties_;
+  std::optional<Scenario> scenario_;
+};
+
+}  // namespace hybrid

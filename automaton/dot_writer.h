@@ -1,0 +1,23 @@
+#pragma once
+
+#include <string>
+
+#include "automaton/system.h"
+
+namespace hybrid {
+
+/// How WriteDot draws a composed system.
+struct DotOptions {
+  /// false: one cluster per component, each with its own modes and transitions.
+  /// true: the product automaton (System::Product), one node per reachable tuple of modes.
+  bool product = false;
+};
+
+/// A Graphviz `digraph` of `system`. Nodes are modes, labelled with the mode name, each flow
+/// (`x' = f`) and the invariant; edges are transitions, labelled with the name, the synchronising
+/// label in brackets, the guard and the resets; lazy transitions are dashed. A point node marks
+/// each initial mode, its edge labelled with the initial values. All text is escaped for DOT
+/// strings, so any model renders. Throws what System::Product throws when `product` is set.
+std::string WriteDot(const System& system, const DotOptions& options = {});
+
+}  // namespace hybrid

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "automaton/constraint.h"
+
+namespace hybrid {
+
+/// A Boolean state predicate, the body of a property: comparisons over variables (continuous and
+/// discrete), `in MODE` atoms, `true`/`false`, combined with `not`, `and`, `or`.
+/// Immutable and cheap to copy (the tree is shared).
+class Predicate {
+ public:
+  enum class Kind { kTrue, kFalse, kComparison, kInMode, kNot, kAnd, kOr };
+
+  /// `true`.
+  Predicate();
+  static Predicate True();
+  static Predicate False();
+  static Predicate Compare(Comparison c);
+  /// Holds exactly when the current mode is named `mode` (for a composed system, a qualified
+  /// component mode such as `A.c000_l000`).
+  static Predicate InMode(std::string mode);
+  static Predicate Not(Predicate p);
+  static Predicate And(Predicate a, Predicate b);
+  static Predicate Or(Predicate a, Predicate b);
+
+  Kind kind() const;
+  /// Precondition kind() == kComparison.
+  const Comparison& comparison() const;
+  /// Precondition kind() == kInMode.
+  const std::string& mode() const;
+  /// Operands of kNot (one), kAnd and kOr (two).
+  std::span<const Predicate> operands() const;
+
+  /// Truth value at `env` when the current mode(s) are `modes` (names, as in InMode); comparisons
+  /// use Comparison::Holds with tolerance `tol`.
+  bool Evaluate(std::span<const double> env, std::span<const std::string> modes,
+                double tol = 0.0) const;
+  /// Calls `f` on every comparison.
+  void ForEachComparison(const std::function<void(const Comparison&)>& f) const;
+  /// Calls `f` on every mode name of an `in` atom.
+  void ForEachMode(const std::function<void(const std::string&)>& f) const;
+
+  /// Fully parenthesised where needed: `not` binds tighter than `and`, `and` tighter than `or`.
+  std::string ToString() const;
+  friend bool operator==(const Predicate& a, const Predicate& b);
+
+ private:
+  struct Node;
+  explicit Predicate(std::shared_ptr<const Node> node);
+  std::shared_ptr<const Node> node_;
+};
+
+}  // namespace hybrid

@@ -1,0 +1,159 @@
+#include "automaton/printer.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace hybrid {
+namespace {
+
+std::string UnitSuffix(const Symbol& s) { return s.unit.empty() ? "" : " [" + s.unit + "]"; }
+
+std::string RangeText(const Range& r) {
+  return "[" + r.lo.ToString() + ", " + r.hi.ToString() + "]";
+}
+
+void PrintScenario(const Scenario& scenario, const SymbolTable& symbols, const std::string& indent,
+                   std::ostream& out) {
+  out << indent << "scenario {\n" << indent << "  until " << FormatNumber(scenario.until) << ";\n";
+  for (const InputSignal& s : scenario.inputs) {
+    out << indent << "  " << symbols[s.slot].name << " = ";
+    if (s.shape == InputSignal::Shape::kStep && s.points.size() == 1 && s.points[0].first == 0.0 &&
+        !std::signbit(s.points[0].first)) {
+      out << FormatNumber(s.points[0].second);
+    } else {
+      out << (s.shape == InputSignal::Shape::kStep ? "step(" : "linear(");
+      for (size_t i = 0; i < s.points.size(); ++i) {
+        out << (i > 0 ? ", " : "") << FormatNumber(s.points[i].first) << ": "
+            << FormatNumber(s.points[i].second);
+      }
+      out << ")";
+    }
+    out << ";\n";
+  }
+  out << indent << "}\n";
+}
+
+void PrintProperty(const Property& p, const std::string& indent, std::ostream& out) {
+  out << indent << "property " << p.name << ": " << KindKeyword(p.kind) << " "
+      << p.predicate.ToString();
+  if (p.horizon) out << " within " << FormatNumber(*p.horizon);
+  out << ";\n";
+}
+
+}  // namespace
+
+std::string PrintAutomaton(const Automaton& a) {
+  std::ostringstream out;
+  const SymbolTable& symbols = a.symbols();
+  out << "automaton " << a.name() << " {\n";
+  size_t var = 0, input = 0, param = 0;
+  for (int s = 0; s < symbols.size(); ++s) {
+    const Symbol& sym = symbols[s];
+    switch (sym.kind) {
+      case SymbolKind::kVariable: {
+        const VariableInfo& info = a.variables()[var++];
+        out << "  var " << sym.name << UnitSuffix(sym);
+        if (info.domain) out << " in " << RangeText(*info.domain);
+        out << ";\n";
+        break;
+      }
+      case SymbolKind::kDiscrete: out << "  discrete " << sym.name << ";\n"; break;
+      case SymbolKind::kInput:
+        out << "  input " << sym.name << UnitSuffix(sym) << " in "
+            << RangeText(a.inputs()[input++].bounds) << ";\n";
+        break;
+      case SymbolKind::kParameter:
+        out << "  param " << sym.name << UnitSuffix(sym) << " = "
+            << a.parameters()[param++].second.ToString() << ";\n";
+        break;
+    }
+  }
+  for (const Mode& m : a.modes()) {
+    out << "\n  mode " << m.name;
+    if (!m.discrete_values.empty()) {
+      out << " (";
+      for (size_t i = 0; i < m.discrete_values.size(); ++i) {
+        out << (i > 0 ? ", " : "") << symbols[m.discrete_values[i].first].name << " = "
+            << m.discrete_values[i].second;
+      }
+      out << ")";
+    }
+    out << " {\n";
+    for (const auto& [slot, rhs] : m.flows) {
+      out << "    " << symbols[slot].name << "' = " << rhs.ToString() << ";\n";
+    }
+    if (!m.invariant.empty()) out << "    inv " << m.invariant.ToString() << ";\n";
+    out << "  }\n";
+  }
+  for (const Transition& t : a.transitions()) {
+    out << "\n  transition " << t.name << ": " << a.mode(t.source).name << " -> "
+        << a.mode(t.target).name << " {\n";
+    if (!t.guard.empty()) out << "    guard " << t.guard.ToString() << ";\n";
+    if (!t.resets.empty()) {
+      out << "    reset ";
+      for (size_t i = 0; i < t.resets.size(); ++i) {
+        out << (i > 0 ? ", " : "") << symbols[t.resets[i].slot].name
+            << " := " << t.resets[i].value.ToString();
+      }
+      out << ";\n";
+    }
+    if (!t.label.empty()) out << "    label " << t.label << ";\n";
+    if (t.urgency == Urgency::kLazy) out << "    lazy;\n";
+    out << "  }\n";
+  }
+  for (const InitialState& init : a.initial_states()) {
+    out << "\n  init " << a.mode(init.mode).name << " {";
+    for (const InitialValue& v : init.values) {
+      out << " " << symbols[v.slot].name;
+      if (v.is_point) {
+        out << " = " << v.range.lo.ToString() << ";";
+      } else {
+        out << " in " << RangeText(v.range) << ";";
+      }
+    }
+    out << " }\n";
+  }
+  if (a.scenario()) {
+    out << "\n";
+    PrintScenario(*a.scenario(), symbols, "  ", out);
+  }
+  if (!a.properties().empty()) out << "\n";
+  for (const Property& p : a.properties()) PrintProperty(p, "  ", out);
+  out << "}\n";
+  return out.str();
+}
+
+std::string PrintSystem(const System& system) {
+  const auto components = system.components();
+  if (components.size() == 1 && components[0].instance.empty() &&
+      components[0].source.name() == system.name() && system.shared().empty()) {
+    return PrintAutomaton(components[0].source);
+  }
+  std::ostringstream out;
+  std::set<std::string> printed;
+  for (const Component& c : components) {
+    if (printed.insert(c.source.name()).second) out << PrintAutomaton(c.source) << "\n";
+  }
+  out << "system " << system.name() << " {\n";
+  if (!system.shared().empty()) {
+    out << "  share ";
+    bool first = true;
+    for (const std::string& s : system.shared()) {
+      out << (first ? "" : ", ") << s;
+      first = false;
+    }
+    out << ";\n";
+  }
+  for (const Component& c : components) {
+    out << "  instance ";
+    if (!c.instance.empty()) out << c.instance << " = ";
+    out << c.source.name() << ";\n";
+  }
+  if (system.scenario()) PrintScenario(*system.scenario(), system.symbols(), "  ", out);
+  for (const Property& p : system.properties()) PrintProperty(p, "  ", out);
+  out << "}\n";
+  return out.str();
+}
+
+}  // namespace hybrid

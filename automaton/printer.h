@@ -1,0 +1,22 @@
+#pragma once
+
+#include <string>
+
+#include "automaton/automaton.h"
+#include "automaton/system.h"
+
+namespace hybrid {
+
+/// Writes `automaton` in the model language. Parsing the result (ParseAutomaton) gives an
+/// automaton equal to `automaton` (operator==): declarations come in slot order, expressions with
+/// the fewest parentheses that keep their tree, numbers in shortest round-trip form.
+/// Precondition: every name is an identifier of the language (true for parsed automata; not for
+/// System::Product results or renamed components, whose names contain '.').
+std::string PrintAutomaton(const Automaton& automaton);
+
+/// Writes `system`: each distinct automaton it instantiates (as declared, before renaming), then
+/// the `system` block. For a system made by System::Of, writes the automaton alone. Parsing the
+/// result (ParseModel) gives an equal System.
+std::string PrintSystem(const System& system);
+
+}  // namespace hybrid

@@ -1,0 +1,429 @@
+#include "automaton/system.h"
+
+#include <algorithm>
+#include <deque>
+#include <map>
+#include <stdexcept>
+
+namespace hybrid {
+namespace {
+
+[[noreturn]] void Fail(std::string_view api, const std::string& message) {
+  throw std::invalid_argument(std::string(api) + ": " + message);
+}
+
+// Rewrites every symbol of `e` through `slot_map` (old slot -> new slot) with new names.
+Expression Remap(const Expression& e, const std::vector<int>& slot_map, const SymbolTable& names) {
+  return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
+    const int s = slot_map.at(slot);
+    return Expression::Symbol(names[s].name, s);
+  });
+}
+
+Comparison Remap(const Comparison& c, const std::vector<int>& m, const SymbolTable& n) {
+  return {Remap(c.lhs, m, n), c.relation, Remap(c.rhs, m, n)};
+}
+
+Constraint Remap(const Constraint& c, const std::vector<int>& m, const SymbolTable& n) {
+  Constraint out;
+  for (const Comparison& x : c.comparisons) out.comparisons.push_back(Remap(x, m, n));
+  return out;
+}
+
+Predicate Remap(const Predicate& p, const std::vector<int>& m, const SymbolTable& n,
+                const std::function<std::string(const std::string&)>& mode_name) {
+  switch (p.kind()) {
+    case Predicate::Kind::kComparison: return Predicate::Compare(Remap(p.comparison(), m, n));
+    case Predicate::Kind::kInMode: return Predicate::InMode(mode_name(p.mode()));
+    case Predicate::Kind::kNot: return Predicate::Not(Remap(p.operands()[0], m, n, mode_name));
+    case Predicate::Kind::kAnd:
+      return Predicate::And(Remap(p.operands()[0], m, n, mode_name),
+                            Remap(p.operands()[1], m, n, mode_name));
+    case Predicate::Kind::kOr:
+      return Predicate::Or(Remap(p.operands()[0], m, n, mode_name),
+                           Remap(p.operands()[1], m, n, mode_name));
+    default: return p;
+  }
+}
+
+// Copies `a` into a new automaton whose symbols are renamed by `rename`; slots are preserved.
+Automaton Renamed(const Automaton& a, const std::function<std::string(const std::string&)>& rename,
+                  const std::function<std::string(const std::string&)>& rename_label) {
+  Automaton out(a.name());
+  const SymbolTable& old = a.symbols();
+  SymbolTable names;
+  for (int s = 0; s < old.size(); ++s) names.Add({rename(old[s].name), old[s].kind, old[s].unit});
+  std::vector<int> identity(old.size());
+  for (int s = 0; s < old.size(); ++s) identity[s] = s;
+  auto expr = [&](const Expression& e) { return Remap(e, identity, names); };
+  auto range = [&](const Range& r) { return Range{expr(r.lo), expr(r.hi)}; };
+  size_t next_var = 0, next_input = 0, next_param = 0;
+  for (int s = 0; s < old.size(); ++s) {
+    const Symbol& sym = names[s];
+    switch (sym.kind) {
+      case SymbolKind::kVariable: {
+        const auto& info = a.variables()[next_var++];
+        std::optional<Range> domain;
+        if (info.domain) domain = range(*info.domain);
+        out.AddVariable(sym.name, sym.unit, domain);
+        break;
+      }
+      case SymbolKind::kDiscrete: out.AddDiscreteVariable(sym.name); break;
+      case SymbolKind::kInput:
+        out.AddInput(sym.name, range(a.inputs()[next_input++].bounds), sym.unit);
+        break;
+      case SymbolKind::kParameter:
+        out.AddParameter(sym.name, expr(a.parameters()[next_param++].second), sym.unit);
+        break;
+    }
+  }
+  for (const Mode& m : a.modes()) {
+    Mode copy = m;
+    for (auto& [slot, rhs] : copy.flows) rhs = expr(rhs);
+    copy.invariant = Remap(m.invariant, identity, names);
+    out.AddMode(std::move(copy));
+  }
+  for (const Transition& t : a.transitions()) {
+    Transition copy = t;
+    copy.guard = Remap(t.guard, identity, names);
+    for (Reset& r : copy.resets) r.value = expr(r.value);
+    if (!copy.label.empty()) copy.label = rename_label(copy.label);
+    out.AddTransition(std::move(copy));
+  }
+  for (const InitialState& init : a.initial_states()) {
+    InitialState copy = init;
+    for (InitialValue& v : copy.values) v.range = range(v.range);
+    out.AddInitialState(std::move(copy));
+  }
+  auto same_mode = [](const std::string& m) { return m; };
+  for (const Property& p : a.properties()) {
+    Property copy = p;
+    copy.predicate = Remap(p.predicate, identity, names, same_mode);
+    out.AddProperty(std::move(copy));
+  }
+  if (a.scenario()) out.SetScenario(*a.scenario());
+  return out;
+}
+
+}  // namespace
+
+System::System(std::string name) : name_(std::move(name)) {
+  if (name_.empty()) Fail("System", "empty name");
+}
+
+System System::Of(const Automaton& automaton) {
+  System s(automaton.name());
+  s.AddComponent("", automaton);
+  const Component& c = s.components_.front();
+  auto same = [](const std::string& m) { return m; };
+  for (const Property& p : automaton.properties()) {
+    Property copy = p;
+    copy.predicate = Remap(p.predicate, c.global_slot, s.symbols_, same);
+    s.properties_.push_back(std::move(copy));
+  }
+  if (automaton.scenario()) s.scenario_ = automaton.scenario();  // slots coincide
+  return s;
+}
+
+void System::Share(std::string name) { shared_.insert(std::move(name)); }
+
+void System::AddComponent(std::string instance, const Automaton& automaton) {
+  constexpr std::string_view kApi = "System::AddComponent";
+  for (const Component& c : components_) {
+    if (c.instance == instance) {
+      Fail(kApi, instance.empty() ? "two unqualified components"
+                                  : "duplicate instance '" + instance + "'");
+    }
+  }
+  auto rename = [&](const std::string& n) {
+    return instance.empty() || shared_.count(n) ? n : instance + "." + n;
+  };
+  Component c{instance, Renamed(automaton, rename, rename), {}, automaton};
+  const SymbolTable& local = c.automaton.symbols();
+  for (int s = 0; s < local.size(); ++s) {
+    if (auto g = symbols_.Find(local[s].name)) {
+      if (symbols_[*g].kind != local[s].kind) {
+        Fail(kApi, "'" + local[s].name + "' is a " + std::string(KindName(local[s].kind)) +
+                       " in '" + automaton.name() + "' but a " +
+                       std::string(KindName(symbols_[*g].kind)) + " elsewhere");
+      }
+      c.global_slot.push_back(*g);
+    } else {
+      c.global_slot.push_back(symbols_.Add(local[s]));
+    }
+  }
+  // At most one component may define the flow of a shared variable.
+  for (int s = 0; s < local.size(); ++s) {
+    if (local[s].kind != SymbolKind::kVariable) continue;
+    auto has_flow = [s](const Automaton& a) {
+      return std::any_of(a.modes().begin(), a.modes().end(),
+                         [s](const Mode& m) { return m.FlowOf(s).has_value(); });
+    };
+    if (!has_flow(c.automaton)) continue;
+    for (const Component& other : components_) {
+      auto it = std::find(other.global_slot.begin(), other.global_slot.end(), c.global_slot[s]);
+      if (it == other.global_slot.end()) continue;
+      const int other_slot = static_cast<int>(it - other.global_slot.begin());
+      auto other_has_flow = [other_slot](const Automaton& a) {
+        return std::any_of(a.modes().begin(), a.modes().end(),
+                           [other_slot](const Mode& m) { return m.FlowOf(other_slot).has_value(); });
+      };
+      if (other_has_flow(other.automaton)) {
+        Fail(kApi, "shared variable '" + local[s].name + "' has flows in two components");
+      }
+    }
+  }
+  components_.push_back(std::move(c));
+}
+
+std::optional<std::pair<int, ModeId>> System::FindMode(std::string_view qualified) const {
+  for (int i = 0; i < static_cast<int>(components_.size()); ++i) {
+    const Component& c = components_[i];
+    std::string_view local = qualified;
+    if (!c.instance.empty()) {
+      if (!qualified.starts_with(c.instance + ".")) continue;
+      local = qualified.substr(c.instance.size() + 1);
+    }
+    if (auto m = c.automaton.FindMode(local)) return std::make_pair(i, *m);
+  }
+  return std::nullopt;
+}
+
+std::string System::QualifiedModeName(int c, ModeId m) const {
+  const Component& comp = components_.at(c);
+  const std::string& local = comp.automaton.mode(m).name;
+  return comp.instance.empty() ? local : comp.instance + "." + local;
+}
+
+void System::AddProperty(Property property) {
+  const std::string context = "System::AddProperty: property '" + property.name + "'";
+  for (const Property& p : properties_) {
+    if (p.name == property.name) Fail("System::AddProperty", "duplicate property '" + p.name + "'");
+  }
+  property.predicate.ForEachComparison([&](const Comparison& c) {
+    for (int slot : c.Residual().Slots()) {
+      if (slot >= symbols_.size()) Fail(context, "reads an undeclared slot");
+      if (symbols_[slot].kind == SymbolKind::kInput) {
+        Fail(context, "input '" + symbols_[slot].name + "' is not allowed here");
+      }
+    }
+  });
+  property.predicate.ForEachMode([&](const std::string& m) {
+    if (!FindMode(m)) Fail(context, "unknown mode '" + m + "'");
+  });
+  properties_.push_back(std::move(property));
+}
+
+void System::SetScenario(Scenario scenario) {
+  for (const InputSignal& s : scenario.inputs) {
+    if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
+      Fail("System::SetScenario", "signal for something that is not an input");
+    }
+  }
+  if (!(scenario.until > 0.0)) Fail("System::SetScenario", "'until' must be positive");
+  scenario_ = std::move(scenario);
+}
+
+Automaton System::Product(int max_modes) const {
+  constexpr std::string_view kApi = "System::Product";
+  const int n = static_cast<int>(components_.size());
+  if (n == 0) Fail(kApi, "system has no components");
+  Automaton out(name_);
+  // Declare the global symbols in slot order so that slots coincide.
+  std::vector<int> identity(symbols_.size());
+  for (int s = 0; s < symbols_.size(); ++s) identity[s] = s;
+  auto global = [&](const Component& c, const Expression& e) {
+    return Remap(e, c.global_slot, symbols_);
+  };
+  for (int s = 0; s < symbols_.size(); ++s) {
+    const Symbol& sym = symbols_[s];
+    // Find the component that declared the symbol first, for its domain/bounds/value.
+    for (const Component& c : components_) {
+      auto it = std::find(c.global_slot.begin(), c.global_slot.end(), s);
+      if (it == c.global_slot.end()) continue;
+      const int local = static_cast<int>(it - c.global_slot.begin());
+      const Automaton& a = c.automaton;
+      switch (sym.kind) {
+        case SymbolKind::kVariable: {
+          std::optional<Range> domain;
+          for (const VariableInfo& v : a.variables()) {
+            if (v.slot == local && v.domain) {
+              domain = Range{global(c, v.domain->lo), global(c, v.domain->hi)};
+            }
+          }
+          out.AddVariable(sym.name, sym.unit, domain);
+          break;
+        }
+        case SymbolKind::kDiscrete: out.AddDiscreteVariable(sym.name); break;
+        case SymbolKind::kInput:
+          for (const InputInfo& in : a.inputs()) {
+            if (in.slot == local) {
+              out.AddInput(sym.name, {global(c, in.bounds.lo), global(c, in.bounds.hi)}, sym.unit);
+            }
+          }
+          break;
+        case SymbolKind::kParameter:
+          for (const auto& [slot, value] : a.parameters()) {
+            if (slot == local) out.AddParameter(sym.name, global(c, value), sym.unit);
+          }
+          break;
+      }
+      break;
+    }
+  }
+
+  // Labels used by each component (for synchronisation).
+  std::vector<std::set<std::string>> alphabet(n);
+  for (int i = 0; i < n; ++i) {
+    for (const Transition& t : components_[i].automaton.transitions()) {
+      if (!t.label.empty()) alphabet[i].insert(t.label);
+    }
+  }
+
+  using Tuple = std::vector<int>;
+  std::map<Tuple, ModeId> index;
+  std::deque<Tuple> queue;
+  auto mode_of = [&](const Tuple& tuple) -> ModeId {
+    if (auto it = index.find(tuple); it != index.end()) return it->second;
+    if (static_cast<int>(index.size()) >= max_modes) {
+      Fail(kApi, "more than " + std::to_string(max_modes) + " product modes");
+    }
+    Mode m;
+    for (int i = 0; i < n; ++i) {
+      const Component& c = components_[i];
+      const Mode& local = c.automaton.mode(ModeId(tuple[i]));
+      m.name += (i > 0 ? "__" : "") + local.name;
+      for (const auto& [slot, rhs] : local.flows) {
+        m.flows.emplace_back(c.global_slot[slot], global(c, rhs));
+      }
+      for (const Comparison& x : local.invariant.comparisons) {
+        m.invariant.comparisons.push_back(Remap(x, c.global_slot, symbols_));
+      }
+      for (const auto& [slot, value] : local.discrete_values) {
+        m.discrete_values.emplace_back(c.global_slot[slot], value);
+      }
+    }
+    std::sort(m.flows.begin(), m.flows.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::sort(m.discrete_values.begin(), m.discrete_values.end());
+    m.discrete_values.erase(std::unique(m.discrete_values.begin(), m.discrete_values.end()),
+                            m.discrete_values.end());
+    const ModeId id = out.AddMode(std::move(m));
+    index.emplace(tuple, id);
+    queue.push_back(tuple);
+    return id;
+  };
+
+  // Initial tuples: the cartesian product of the components' initial states.
+  std::vector<std::pair<Tuple, std::vector<InitialValue>>> inits = {{{}, {}}};
+  for (const Component& c : components_) {
+    std::vector<std::pair<Tuple, std::vector<InitialValue>>> next;
+    for (const auto& [tuple, values] : inits) {
+      for (const InitialState& s : c.automaton.initial_states()) {
+        auto t = tuple;
+        t.push_back(s.mode.value());
+        auto v = values;
+        for (const InitialValue& iv : s.values) {
+          const int g = c.global_slot[iv.slot];
+          if (std::none_of(v.begin(), v.end(), [g](const InitialValue& x) { return x.slot == g; })) {
+            v.push_back({g, {global(c, iv.range.lo), global(c, iv.range.hi)}, iv.is_point});
+          }
+        }
+        next.emplace_back(std::move(t), std::move(v));
+      }
+    }
+    inits = std::move(next);
+  }
+  for (auto& [tuple, values] : inits) {
+    std::sort(values.begin(), values.end(),
+              [](const InitialValue& a, const InitialValue& b) { return a.slot < b.slot; });
+    out.AddInitialState({mode_of(tuple), std::move(values)});
+  }
+
+  int transition_count = 0;
+  while (!queue.empty()) {
+    const Tuple tuple = queue.front();
+    queue.pop_front();
+    const ModeId source = index.at(tuple);
+    for (int i = 0; i < n; ++i) {
+      for (const Transition& t : components_[i].automaton.transitions()) {
+        if (t.source.value() != tuple[i]) continue;
+        // Partners: every other component whose alphabet has the label.
+        std::vector<std::vector<const Transition*>> choices(n);
+        bool blocked = false;
+        bool leader = true;  // a synchronised step is generated once, from its first participant
+        for (int j = 0; j < n && !blocked; ++j) {
+          if (j == i || t.label.empty() || !alphabet[j].count(t.label)) continue;
+          if (j < i) leader = false;
+          for (const Transition& u : components_[j].automaton.transitions()) {
+            if (u.source.value() == tuple[j] && u.label == t.label) choices[j].push_back(&u);
+          }
+          blocked = choices[j].empty();
+        }
+        if (blocked || !leader) continue;
+        choices[i] = {&t};
+        // Enumerate combinations.
+        std::vector<std::vector<std::pair<int, const Transition*>>> combos = {{}};
+        for (int j = 0; j < n; ++j) {
+          if (choices[j].empty()) continue;
+          std::vector<std::vector<std::pair<int, const Transition*>>> next;
+          for (const auto& combo : combos) {
+            for (const Transition* u : choices[j]) {
+              auto c = combo;
+              c.emplace_back(j, u);
+              next.push_back(std::move(c));
+            }
+          }
+          combos = std::move(next);
+        }
+        for (const auto& combo : combos) {
+          Tuple target = tuple;
+          Transition joint;
+          joint.source = source;
+          joint.label = t.label;
+          joint.urgency = Urgency::kLazy;
+          std::string name;
+          for (const auto& [j, u] : combo) {
+            const Component& c = components_[j];
+            target[j] = u->target.value();
+            name += (name.empty() ? "" : "__") +
+                    (c.instance.empty() ? u->name : c.instance + "." + u->name);
+            for (const Comparison& x : u->guard.comparisons) {
+              joint.guard.comparisons.push_back(Remap(x, c.global_slot, symbols_));
+            }
+            for (const Reset& r : u->resets) {
+              const int g = c.global_slot[r.slot];
+              if (std::any_of(joint.resets.begin(), joint.resets.end(),
+                              [g](const Reset& x) { return x.slot == g; })) {
+                Fail(kApi, "synchronised transitions reset '" + symbols_[g].name + "' twice");
+              }
+              joint.resets.push_back({g, global(c, r.value)});
+            }
+            if (u->urgency == Urgency::kUrgent) joint.urgency = Urgency::kUrgent;
+          }
+          std::sort(joint.resets.begin(), joint.resets.end(),
+                    [](const Reset& a, const Reset& b) { return a.slot < b.slot; });
+          joint.name = "t" + std::to_string(transition_count++) + "_" + name;
+          for (char& ch : joint.name) {
+            if (ch == '.') ch = '_';
+          }
+          joint.target = mode_of(target);
+          out.AddTransition(std::move(joint));
+        }
+      }
+    }
+  }
+  for (const Property& p : properties_) {
+    Property copy = p;
+    // Product modes are tuples; an `in A.m` atom holds in every product mode containing A.m.
+    // It cannot be expressed as one product mode name, so product properties keep only
+    // comparisons; properties with `in` atoms are checked on the System, not the product.
+    bool has_mode_atom = false;
+    p.predicate.ForEachMode([&](const std::string&) { has_mode_atom = true; });
+    if (!has_mode_atom) out.AddProperty(std::move(copy));
+  }
+  if (scenario_) out.SetScenario(*scenario_);
+  return out;
+}
+
+}  // namespace hybrid

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <set>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "automaton/automaton.h"
+
+namespace hybrid {
+
+/// One automaton inside a System.
+struct Component {
+  /// Instance name, or empty for a component whose names are not qualified.
+  std::string instance;
+  /// The component with its names qualified ("A.theta1") except shared ones; its own slots.
+  Automaton automaton;
+  /// automaton slot -> System slot.
+  std::vector<int> global_slot;
+  /// The automaton as declared, before renaming (what a printer writes back).
+  Automaton source;
+  friend bool operator==(const Component&, const Component&) = default;
+};
+
+/// Parallel composition of automata.
+///
+/// Names: a component added with instance name `A` has every symbol `x` and every transition
+/// label `l` renamed to `A.x` and `A.l`, unless the name is shared (Share); a component with an
+/// empty instance name keeps its names. Equal names after renaming denote one thing: shared
+/// variables are one state variable (at most one component may give it a flow), shared inputs one
+/// input, shared parameters must agree.
+///
+/// Semantics: the state is the tuple of component modes plus the union of the variables. A
+/// transition with an empty label, or with a label no other component uses, is taken alone
+/// (interleaving). A transition labelled `l` where other components also have transitions
+/// labelled `l` is taken only together with one such transition of each of them, all guards
+/// holding; the resets then apply together (a variable reset by two of them is an error of the
+/// product).
+class System {
+ public:
+  /// `name` must be non-empty.
+  explicit System(std::string name);
+  /// `automaton` as a system of one unqualified component, with its properties and scenario.
+  static System Of(const Automaton& automaton);
+
+  const std::string& name() const { return name_; }
+  /// Declares `name` (a symbol or a label) shared by every component added afterwards.
+  void Share(std::string name);
+  /// Adds a renamed copy of `automaton` (see the class comment). Throws std::invalid_argument
+  /// ("System::AddComponent: ...") on a duplicate instance name, a shared name used with
+  /// different kinds, or a shared variable given a flow by two components.
+  void AddComponent(std::string instance, const Automaton& automaton);
+  /// A system-level property over System slots; `in` atoms name component modes qualified by the
+  /// instance (`A.open`) or, for an unqualified component, plainly.
+  void AddProperty(Property property);
+  /// The system's default run; inputs are System slots.
+  void SetScenario(Scenario scenario);
+
+  const SymbolTable& symbols() const { return symbols_; }
+  std::span<const Component> components() const { return components_; }
+  std::span<const Property> properties() const { return properties_; }
+  const std::optional<Scenario>& scenario() const { return scenario_; }
+  const std::set<std::string>& shared() const { return shared_; }
+  /// Component index and mode of a qualified mode name, or nullopt.
+  std::optional<std::pair<int, ModeId>> FindMode(std::string_view qualified) const;
+  /// The name of mode `m` of component `c` as written at system level ("A.open" or "open").
+  std::string QualifiedModeName(int c, ModeId m) const;
+
+  /// The product automaton over System slots: one mode per tuple of component modes reachable
+  /// from the initial tuples through the transition graph (guards are not evaluated), named by
+  /// joining the component mode names with "__"; flows are the union of the components' flows,
+  /// invariants their conjunction; transitions follow the synchronisation rule above. Throws
+  /// std::invalid_argument ("System::Product: ...") past `max_modes` modes.
+  Automaton Product(int max_modes = 100000) const;
+
+  friend bool operator==(const System&, const System&) = default;
+
+ private:
+  std::string name_;
+  std::set<std::string> shared_;
+  SymbolTable symbols_;
+  std::vector<Component> components_;
+  std::vector<Property> properties_;
+  std::optional<Scenario> scenario_;
+};
+
+}  // namespace hybrid

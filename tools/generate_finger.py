@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""Writes spec/finger.ha: one Robotiq 3-finger gripper finger as the hybrid automaton of section 3
+of Franchi and Hauser's report (TR711).
+
+The discrete states, flows and the six transition kinds are enumerated by the rules below rather
+than typed by hand, so that every state tuple of the report's table and every transition between
+them is covered uniformly. Run `python3 tools/generate_finger.py > spec/finger.ha`; the test
+`finger_spec_test` checks that the committed file equals this script's output.
+Decisions where the report is silent or inconsistent are documented in docs/finger_model.md.
+"""
+
+import itertools
+
+# (c, l) pairs of one link: free, blocked by contact, blocked by its upper limit.
+LINK = [(0, 0), (1, 0), (0, 1)]
+
+
+def phase(s):
+    c1, c2, c3, l1, l2, l3 = s
+    if c3 == 1 or l3 == 1:
+        return "4"
+    if c2 == 1 or l2 == 1:
+        return "3"
+    if c1 == 1 or l1 == 1:
+        return "2'" if l3 == -1 else "2"
+    return "1'" if l3 == -1 else "1"
+
+
+def states():
+    """The state tuples of the report's table (section 3), plus phase 4 with l3 = -1."""
+    out = [(0, 0, 0, 0, 0, 0), (0, 0, 0, 0, 0, -1)]                 # phases 1, 1'
+    out += [(1, 0, 0, 0, 0, 0), (0, 0, 0, 1, 0, 0)]                 # phase 2
+    out += [(1, 0, 0, 0, 0, -1), (0, 0, 0, 1, 0, -1)]               # phase 2'
+    for (c1, l1), (c2, l2) in itertools.product(LINK, [(1, 0), (0, 1)]):
+        out.append((c1, c2, 0, l1, l2, 0))                          # phase 3
+    for (c1, l1), (c2, l2) in itertools.product(LINK, LINK):
+        out.append((c1, c2, 1, l1, l2, 0))                          # phase 4, link 3 in contact
+    for (c1, l1), (c2, l2) in itertools.product(LINK, [(1, 0), (0, 1)]):
+        out.append((c1, c2, 0, l1, l2, 1))                          # phase 4, link 3 at its limit
+    for c1, l1 in LINK:
+        out.append((c1, 0, 1, l1, 0, -1))                           # phase 4, contact at lower limit
+    return out
+
+
+def name(s):
+    c1, c2, c3, l1, l2, l3 = s
+    l = lambda v: "n" if v == -1 else str(v)
+    return f"c{c1}{c2}{c3}_l{l(l1)}{l(l2)}{l(l3)}"
+
+
+FLOWS = {
+    "1": {"theta1": "m1 * u", "theta3": "-(m1 * u)", "g": "u"},
+    "1'": {"theta1": "m1 * u", "g": "u"},
+    "2": {"theta2": "m2 * u", "theta3": "-(m2 * u)", "g": "u"},
+    "2'": {"theta2": "m2 * u", "g": "u"},
+    "3": {"theta3": "m3 * u", "g": "u"},
+    "4": {},
+}
+
+# Links whose position in space changes in each phase (an object can newly touch only these).
+MOVING = {"1": {1, 2, 3}, "1'": {1, 2, 3}, "2": {2, 3}, "2'": {2, 3}, "3": {3}, "4": set()}
+
+
+def normalise(s):
+    """A link-2 block with l3 = -1 is not a state of the table: transition 6 (l3: -1 -> 0, guard
+    theta3 + u > theta3_min) is enabled at once for u > 0, so the target is the l3 = 0 state."""
+    c1, c2, c3, l1, l2, l3 = s
+    if (c2 or l2) and l3 == -1 and not c3:
+        return (c1, c2, c3, l1, l2, 0)
+    return s
+
+
+def transitions(all_states):
+    known = set(all_states)
+    out = []
+    for s in all_states:
+        c = list(s[:3])
+        l = list(s[3:])
+        p = phase(s)
+        flows = FLOWS[p]
+
+        def emit(kind, link, target, guard, label):
+            target = normalise(tuple(target))
+            if target in known and target != s:
+                out.append((f"t{kind}_{name(s)}_to_{name(target)}", s, target, guard, label))
+
+        for i in (1, 2, 3):
+            ci, li = c[i - 1], l[i - 1]
+            theta = f"theta{i}"
+            # 1. c_i: 0 -> 1, an object is hit by link i (at motor position gob_i).
+            if ci == 0 and li != 1 and i in MOVING[p]:
+                t = c + l
+                t[i - 1] = 1
+                emit(1, i, t, f"g >= gob{i}", f"contact{i}")
+            # 2. c_i: 1 -> 0 when theta_{i+1} = theta_{i+1,min} and u < 0 (link 3: u < 0).
+            if ci == 1:
+                t = c + l
+                t[i - 1] = 0
+                guard = (f"theta{i + 1} == theta{i + 1}_min and u < 0" if i < 3 else "u < 0")
+                emit(2, i, t, guard, f"release{i}")
+            # 3. l_i: 0 -> 1 when theta_i reaches its upper limit.
+            if li == 0 and ci == 0 and theta in flows:
+                t = c + l
+                t[3 + i - 1] = 1
+                emit(3, i, t, f"{theta} >= {theta}_max", "")
+            # 4. l_i: 1 -> 0 when theta_i + u < theta_i,max.
+            if li == 1:
+                t = c + l
+                t[3 + i - 1] = 0
+                emit(4, i, t, f"{theta} + u < {theta}_max", "")
+        # 5. l3: 0 -> -1 when theta3 reaches its lower limit (phases 1 and 2, where the table has a
+        #    primed phase to go to).
+        if l[2] == 0 and c[2] == 0 and "theta3" in flows and p in ("1", "2"):
+            emit(5, 3, c + l[:2] + [-1], "theta3 <= theta3_min", "")
+        # 6. l3: -1 -> 0 when theta3 + u > theta3,min.
+        if l[2] == -1:
+            emit(6, 3, c + l[:2] + [0], "theta3 + u > theta3_min", "")
+    return out
+
+
+def main():
+    all_states = states()
+    print("""# One finger of the Robotiq 3-Finger Adaptive Gripper: the hybrid automaton of section 3 of
+# G. Franchi and K. Hauser, "Technical Report: Use of Hybrid Systems to model the RobotiQ Adaptive
+# Gripper" (Indiana University TR711). Generated by tools/generate_finger.py; do not edit by hand.
+#
+# State x = (theta1, theta2, theta3, g): joint angles in degrees (theta3 relative to link 2) and
+# the motor position in counts. Input u in [-1, 1]: motor counts per second. Discrete state
+# (c1, c2, c3, l1, l2, l3): c_i = 1 when link i is blocked by an object, l_i = 1 when it is at its
+# upper joint limit, l3 = -1 when link 3 is at its lower limit. Modes are named c<c1c2c3>_l<l1l2l3>
+# with n for -1. Joint ranges: ../shared/robotiq/kinematics.md (Klamp't limits). See
+# docs/finger_model.md for the phases, the transitions and every interpretation made.
+
+automaton finger {
+  param theta1_min [deg] = 0;
+  param theta1_max [deg] = 70;
+  param theta2_min [deg] = 0;
+  param theta2_max [deg] = 90;
+  param theta3_min [deg] = -55;
+  param theta3_max [deg] = 43;
+  # m1 = theta1_max / 140 and m2 = theta2_max / 100 (degrees per motor count), as in the report.
+  param m1 [deg/count] = theta1_max / 140;
+  param m2 [deg/count] = theta2_max / 100;
+  # Motor position at which link i first touches an object; 256 (beyond the motor range) = no
+  # object. Issue-level scenarios set these; geometry-based contact replaces them later.
+  param gob1 [count] = 256;
+  param gob2 [count] = 256;
+  param gob3 [count] = 256;
+  var theta1 [deg] in [theta1_min, theta1_max];
+  var theta2 [deg] in [theta2_min, theta2_max];
+  var theta3 [deg] in [theta3_min, theta3_max];
+  var g [count] in [0, 255];
+  discrete c1, c2, c3, l1, l2, l3;
+  input u [count/s] in [-1, 1];""")
+    invariant = ("theta1 >= theta1_min and theta1 <= theta1_max and theta2 >= theta2_min and "
+                 "theta2 <= theta2_max and theta3 >= theta3_min and theta3 <= theta3_max and "
+                 "g >= 0 and g <= 255")
+    for s in all_states:
+        c1, c2, c3, l1, l2, l3 = s
+        p = phase(s)
+        print(f"\n  # phase {p}")
+        print(f"  mode {name(s)} (c1 = {c1}, c2 = {c2}, c3 = {c3}, l1 = {l1}, l2 = {l2}, "
+              f"l3 = {l3}) {{")
+        for var in ("theta1", "theta2", "theta3", "g"):
+            if var in FLOWS[p]:
+                rhs = FLOWS[p][var]
+                if rhs == "m3 * u":
+                    # m3(g) = theta3_min + (theta3_max - theta3_min) / (255 - g), section 3.
+                    rhs = "(theta3_min + (theta3_max - theta3_min) / (255 - g)) * u"
+                print(f"    {var}' = {rhs};")
+        print(f"    inv {invariant};")
+        print("  }")
+    for tname, s, t, guard, label in transitions(all_states):
+        print(f"\n  transition {tname}: {name(s)} -> {name(t)} {{")
+        print(f"    guard {guard};")
+        if label:
+            print(f"    label {label};")
+        print("  }")
+    print("""
+  init c000_l000 { theta1 = 0; theta2 = 0; theta3 = 0; g = 0; }
+
+  # Close at full speed, hold for 10 s, open at full speed (the controller's position request).
+  scenario {
+    until 530;
+    u = step(0: 1, 255: 0, 265: -1);
+  }
+
+  # The report: no reachable state has c_i = l_i = 1.
+  property never_contact_at_limit_1: never c1 == 1 and l1 == 1;
+  property never_contact_at_limit_2: never c2 == 1 and l2 == 1;
+  property never_contact_at_limit_3: never c3 == 1 and l3 == 1;
+  # The joint ranges and the motor range.
+  property theta1_range: always theta1 >= theta1_min and theta1 <= theta1_max;
+  property theta2_range: always theta2 >= theta2_min and theta2 <= theta2_max;
+  property theta3_range: always theta3 >= theta3_min and theta3 <= theta3_max;
+  property motor_range: always g >= 0 and g <= 255;
+  # Reachability questions.
+  property can_close_fully: reach l1 == 1 and l2 == 1;
+}""")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,345 @@
+// The `hybrid` command: inspect, draw (and, in later versions, simulate, check and diagnose)
+// hybrid-automaton models written in the model language (docs/model_language.md).
+//
+// Exit codes (docs/cli.md): 0 success, 1 invalid model (parse or validation error, reported as
+// FILE:LINE:COL: message), 2 usage error (bad options), 3 output error (cannot write a file).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <unistd.h>
+
+#include "automaton/dot_writer.h"
+#include "automaton/mode_graph.h"
+#include "automaton/parser.h"
+#include "automaton/system.h"
+
+namespace {
+
+using hybrid::Automaton;
+using hybrid::ModeGraph;
+using hybrid::ModeId;
+using hybrid::System;
+using json = nlohmann::ordered_json;
+
+constexpr int kExitModelError = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitOutput = 3;
+
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Writes `text` to `path` atomically (temporary file in the same directory, then rename), so a
+// failed run never leaves a half-written file; "-" or empty writes to stdout.
+void WriteOutput(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::cout << text;
+    std::cout.flush();
+    return;
+  }
+  const std::filesystem::path target(path);
+  const std::filesystem::path temp =
+      target.string() + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) throw OutputError("cannot write '" + path + "'");
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temp, ignored);
+      throw OutputError("cannot write '" + path + "'");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, target, ec);
+  if (ec) {
+    std::filesystem::remove(temp, ec);
+    throw OutputError("cannot write '" + path + "'");
+  }
+}
+
+std::string RangeText(const hybrid::Range& r) {
+  return "[" + r.lo.ToString() + ", " + r.hi.ToString() + "]";
+}
+
+json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
+  json out = json::array();
+  for (ModeId m : modes) out.push_back(s.QualifiedModeName(c, m));
+  return out;
+}
+
+json PropertyJson(const hybrid::Property& p) {
+  json j = {{"name", p.name},
+            {"kind", std::string(hybrid::KindKeyword(p.kind))},
+            {"predicate", p.predicate.ToString()}};
+  if (p.horizon) j["within"] = *p.horizon;
+  return j;
+}
+
+json ScenarioJson(const hybrid::Scenario& sc, const hybrid::SymbolTable& symbols) {
+  json inputs = json::array();
+  for (const auto& sig : sc.inputs) {
+    json points = json::array();
+    for (const auto& [t, v] : sig.points) points.push_back({t, v});
+    inputs.push_back({{"input", symbols[sig.slot].name},
+                      {"shape", sig.shape == hybrid::InputSignal::Shape::kStep ? "step" : "linear"},
+                      {"points", points}});
+  }
+  return {{"until", sc.until}, {"inputs", inputs}};
+}
+
+// Everything `hybrid info` reports, as JSON; the text form is rendered from it.
+json Info(const System& s, const std::string& file) {
+  json components = json::array();
+  json warnings = json::array();
+  for (int c = 0; c < static_cast<int>(s.components().size()); ++c) {
+    const auto& comp = s.components()[c];
+    const Automaton& a = comp.automaton;
+    const auto& sym = a.symbols();
+    const std::vector<double> env = a.ParameterEnvironment();
+    json variables = json::array();
+    for (const auto& v : a.variables()) {
+      json j = {{"name", sym[v.slot].name}, {"unit", sym[v.slot].unit}};
+      if (v.domain) j["domain"] = {v.domain->lo.Evaluate(env), v.domain->hi.Evaluate(env)};
+      variables.push_back(j);
+    }
+    json discrete = json::array();
+    for (int d : a.discrete_variables()) discrete.push_back(sym[d].name);
+    json inputs = json::array();
+    for (const auto& in : a.inputs()) {
+      inputs.push_back({{"name", sym[in.slot].name},
+                        {"unit", sym[in.slot].unit},
+                        {"bounds", {in.bounds.lo.Evaluate(env), in.bounds.hi.Evaluate(env)}}});
+    }
+    json parameters = json::array();
+    for (const auto& [slot, value] : a.parameters()) {
+      parameters.push_back({{"name", sym[slot].name},
+                            {"unit", sym[slot].unit},
+                            {"value", env[slot]},
+                            {"expression", value.ToString()}});
+    }
+    json modes = json::array();
+    for (const auto& m : a.modes()) {
+      json flows = json::object();
+      for (const auto& [slot, rhs] : m.flows) flows[sym[slot].name] = rhs.ToString();
+      json values = json::object();
+      for (const auto& [slot, v] : m.discrete_values) values[sym[slot].name] = v;
+      modes.push_back({{"name", m.name},
+                       {"discrete", values},
+                       {"flows", flows},
+                       {"invariant", m.invariant.ToString()}});
+    }
+    json transitions = json::array();
+    for (const auto& t : a.transitions()) {
+      json resets = json::object();
+      for (const auto& r : t.resets) resets[sym[r.slot].name] = r.value.ToString();
+      transitions.push_back({{"name", t.name},
+                             {"source", a.mode(t.source).name},
+                             {"target", a.mode(t.target).name},
+                             {"label", t.label},
+                             {"guard", t.guard.ToString()},
+                             {"resets", resets},
+                             {"urgency", t.urgency == hybrid::Urgency::kLazy ? "lazy" : "urgent"}});
+    }
+    json initial = json::array();
+    for (const auto& init : a.initial_states()) {
+      json values = json::object();
+      for (const auto& v : init.values) {
+        values[sym[v.slot].name] =
+            v.is_point ? json(v.range.lo.Evaluate(env))
+                       : json({v.range.lo.Evaluate(env), v.range.hi.Evaluate(env)});
+      }
+      initial.push_back({{"mode", a.mode(init.mode).name}, {"values", values}});
+    }
+    const ModeGraph graph(a);
+    json sccs = json::array();
+    for (const auto& scc : graph.StronglyConnectedComponents()) {
+      if (scc.size() > 1) sccs.push_back(ModeList(s, c, scc));
+    }
+    json component_warnings = json::array();
+    for (const std::string& w : graph.Warnings()) {
+      const std::string qualified = comp.instance.empty() ? w : comp.instance + ": " + w;
+      component_warnings.push_back(qualified);
+      warnings.push_back(qualified);
+    }
+    json properties = json::array();
+    for (const auto& p : a.properties()) properties.push_back(PropertyJson(p));
+    components.push_back({{"instance", comp.instance},
+                          {"automaton", a.name()},
+                          {"variables", variables},
+                          {"discrete_variables", discrete},
+                          {"inputs", inputs},
+                          {"parameters", parameters},
+                          {"modes", modes},
+                          {"transitions", transitions},
+                          {"initial_states", initial},
+                          {"reachable_modes", ModeList(s, c, graph.ReachableModes())},
+                          {"unreachable_modes", ModeList(s, c, graph.UnreachableModes())},
+                          {"terminal_modes", ModeList(s, c, graph.TerminalModes())},
+                          {"cycles", sccs},
+                          {"properties", properties},
+                          {"warnings", component_warnings}});
+  }
+  json properties = json::array();
+  for (const auto& p : s.properties()) properties.push_back(PropertyJson(p));
+  json shared = json::array();
+  for (const auto& n : s.shared()) shared.push_back(n);
+  json out = {{"file", file},
+              {"name", s.name()},
+              {"shared", shared},
+              {"components", components},
+              {"properties", properties},
+              {"scenario", s.scenario() ? ScenarioJson(*s.scenario(), s.symbols()) : json()},
+              {"warnings", warnings}};
+  return out;
+}
+
+std::string Join(const json& array, const std::string& sep = ", ") {
+  std::string out;
+  for (size_t i = 0; i < array.size(); ++i) {
+    out += (i > 0 ? sep : "") + (array[i].is_string() ? array[i].get<std::string>() : array[i].dump());
+  }
+  return out;
+}
+
+std::string InfoText(const json& info) {
+  std::ostringstream out;
+  out << "model " << info["name"].get<std::string>() << " (" << info["file"].get<std::string>()
+      << ")\n";
+  if (!info["shared"].empty()) out << "shared: " << Join(info["shared"]) << "\n";
+  for (const auto& c : info["components"]) {
+    const std::string instance = c["instance"].get<std::string>();
+    out << "\n" << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
+        << c["automaton"].get<std::string>() << "\n";
+    out << "  variables (" << c["variables"].size() << "):";
+    for (const auto& v : c["variables"]) {
+      out << " " << v["name"].get<std::string>();
+      if (!v["unit"].get<std::string>().empty()) out << " [" << v["unit"].get<std::string>() << "]";
+      if (v.contains("domain")) out << " in " << v["domain"].dump();
+      out << ";";
+    }
+    out << "\n";
+    if (!c["discrete_variables"].empty()) {
+      out << "  discrete variables (" << c["discrete_variables"].size()
+          << "): " << Join(c["discrete_variables"]) << "\n";
+    }
+    for (const auto& in : c["inputs"]) {
+      out << "  input " << in["name"].get<std::string>() << " in " << in["bounds"].dump() << "\n";
+    }
+    out << "  parameters (" << c["parameters"].size() << "):";
+    for (const auto& p : c["parameters"]) {
+      out << " " << p["name"].get<std::string>() << " = " << p["value"].dump() << ";";
+    }
+    out << "\n  modes (" << c["modes"].size() << "): ";
+    json names = json::array();
+    for (const auto& m : c["modes"]) names.push_back(m["name"]);
+    out << Join(names) << "\n";
+    out << "  transitions (" << c["transitions"].size() << "):\n";
+    for (const auto& t : c["transitions"]) {
+      out << "    " << t["name"].get<std::string>() << ": " << t["source"].get<std::string>()
+          << " -> " << t["target"].get<std::string>();
+      if (!t["label"].get<std::string>().empty()) out << " [" << t["label"].get<std::string>() << "]";
+      out << " when " << t["guard"].get<std::string>();
+      if (t["urgency"] == "lazy") out << " (lazy)";
+      out << "\n";
+    }
+    for (const auto& init : c["initial_states"]) {
+      out << "  initial: " << init["mode"].get<std::string>() << " " << init["values"].dump()
+          << "\n";
+    }
+    out << "  reachable modes (" << c["reachable_modes"].size() << " of " << c["modes"].size()
+        << "): " << Join(c["reachable_modes"]) << "\n";
+    out << "  terminal modes: " << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"]))
+        << "\n";
+    out << "  cycles (strongly connected components with more than one mode): "
+        << c["cycles"].size() << "\n";
+    for (const auto& p : c["properties"]) {
+      out << "  property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
+          << " " << p["predicate"].get<std::string>() << "\n";
+    }
+  }
+  for (const auto& p : info["properties"]) {
+    if (info["components"].size() == 1) break;  // single automaton: already listed
+    out << "property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
+        << " " << p["predicate"].get<std::string>() << "\n";
+  }
+  if (!info["scenario"].is_null()) {
+    out << "\nscenario: until " << info["scenario"]["until"].dump();
+    for (const auto& in : info["scenario"]["inputs"]) {
+      out << "; " << in["input"].get<std::string>() << " = " << in["shape"].get<std::string>()
+          << in["points"].dump();
+    }
+    out << "\n";
+  }
+  out << "\nwarnings: " << (info["warnings"].empty() ? "none" : std::to_string(info["warnings"].size())) << "\n";
+  for (const auto& w : info["warnings"]) out << "  warning: " << w.get<std::string>() << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hybrid: declare, inspect and draw hybrid automata (see docs/cli.md)", "hybrid"};
+  app.footer(
+      "Exit codes: 0 success; 1 invalid model (FILE:LINE:COL: message on stderr); 2 usage error; "
+      "3 cannot write output.");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hybrid 0.1.0");
+
+  std::string model;
+  bool as_json = false;
+  auto* info = app.add_subcommand("info", "Summarise a model: variables, modes, transitions, "
+                                          "reachable modes, cycles, warnings");
+  info->add_option("MODEL", model, "Model file (.ha)")->required();
+  info->add_flag("--json", as_json, "Machine-readable output");
+
+  std::string output;
+  bool product = false;
+  auto* dot = app.add_subcommand("dot", "Write the mode graph in Graphviz DOT (render with "
+                                        "`dot -Tsvg`)");
+  dot->add_option("MODEL", model, "Model file (.ha)")->required();
+  dot->add_option("-o,--output", output, "Output file (default: standard output)");
+  dot->add_flag("--product", product,
+                "Draw a composed model as its product automaton instead of one cluster per "
+                "component");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitUsage;
+  }
+
+  try {
+    const System system = hybrid::ParseModelFile(model);
+    if (info->parsed()) {
+      const json report = Info(system, model);
+      for (const auto& w : report["warnings"]) {
+        if (!as_json) continue;
+        std::cerr << model << ": warning: " << w.get<std::string>() << "\n";
+      }
+      WriteOutput("-", as_json ? report.dump(2) + "\n" : InfoText(report));
+    } else if (dot->parsed()) {
+      WriteOutput(output, hybrid::WriteDot(system, {.product = product}));
+    }
+  } catch (const hybrid::ParseError& e) {
+    std::cerr << e.what() << "\n";
+    return kExitModelError;
+  } catch (const OutputError& e) {
+    std::cerr << "hybrid: " << e.what() << "\n";
+    return kExitOutput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << model << ": " << e.what() << "\n";
+    return kExitModelError;
+  } catch (const std::exception& e) {
+    std::cerr << "hybrid: internal error: " << e.what() << "\n";
+    return 4;
+  }
+  return 0;
+}

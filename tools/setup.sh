@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs every Debian package the project needs to build, test and render its outputs.
+# Idempotent: safe to run again. Needs root (or sudo) and access to Debian's package mirrors.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libsundials-dev        # CVODE: integration with root finding (events)
+  libeigen3-dev          # vectors and matrices at the API
+  libboost-graph-dev     # the mode graph
+  libgtest-dev libgmock-dev
+  librapidcheck-dev      # property tests
+  libbenchmark-dev       # Google Benchmark
+  tao-pegtl-dev          # the model-language grammar
+  libcli11-dev           # the `hybrid` command line
+  nlohmann-json3-dev     # --json output
+  graphviz               # `dot -Tsvg` for the rendered mode graphs
+  clang-format
+)
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update
+"${sudo_cmd[@]}" apt-get install -y --no-install-recommends "${packages[@]}"
