@@ -143,23 +143,21 @@ ModeId Automaton::AddMode(Mode mode) {
       }
     }
   }
+  mode_index_.emplace(mode.name, num_modes());
   modes_.push_back(std::move(mode));
   return ModeId(num_modes() - 1);
 }
 
 std::optional<ModeId> Automaton::FindMode(std::string_view name) const {
-  for (int i = 0; i < num_modes(); ++i) {
-    if (modes_[i].name == name) return ModeId(i);
-  }
-  return std::nullopt;
+  auto it = mode_index_.find(std::string(name));
+  if (it == mode_index_.end()) return std::nullopt;
+  return ModeId(it->second);
 }
 
 TransitionId Automaton::AddTransition(Transition t) {
   constexpr std::string_view kApi = "Automaton::AddTransition";
   if (t.name.empty()) Fail(kApi, "empty transition name");
-  for (const Transition& other : transitions_) {
-    if (other.name == t.name) Fail(kApi, "duplicate transition '" + t.name + "'");
-  }
+  if (transition_index_.count(t.name)) Fail(kApi, "duplicate transition '" + t.name + "'");
   if (!t.source.is_valid() || t.source.value() >= num_modes()) {
     Fail(kApi, "transition '" + t.name + "' has an unknown source mode");
   }
@@ -180,6 +178,7 @@ TransitionId Automaton::AddTransition(Transition t) {
     CheckSlots(r.value, std::string(kApi) + ": reset of '" + symbols_[r.slot].name + "' in '" +
                             t.name + "'", true, true);
   }
+  transition_index_.emplace(t.name, num_transitions());
   transitions_.push_back(std::move(t));
   return TransitionId(num_transitions() - 1);
 }

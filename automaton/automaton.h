@@ -4,6 +4,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "automaton/expression.h"
@@ -126,6 +127,9 @@ class Automaton {
   std::vector<std::pair<int, Expression>> parameters_;
   std::vector<Mode> modes_;
   std::vector<Transition> transitions_;
+  // Name -> index look-ups (derived from modes_ and transitions_).
+  std::unordered_map<std::string, int> mode_index_;
+  std::unordered_map<std::string, int> transition_index_;
   std::vector<InitialState> initial_states_;
   std::vector<Property> properties_;
   std::optional<Scenario> scenario_;

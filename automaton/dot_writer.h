@@ -11,6 +11,9 @@ struct DotOptions {
   /// false: one cluster per component, each with its own modes and transitions.
   /// true: the product automaton (System::Product), one node per reachable tuple of modes.
   bool product = false;
+  /// Largest product drawn; a larger one throws std::invalid_argument (a graph that size is not
+  /// readable; draw the components as clusters instead).
+  int max_product_modes = 2000;
 };
 
 /// A Graphviz `digraph` of `system`. Nodes are modes, labelled with the mode name, each flow

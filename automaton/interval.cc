@@ -36,9 +36,12 @@ Interval IntegerPower(const Interval& x, int n) {
 // True when some point c + 2*pi*k lies in [lo, hi].
 bool ContainsPeriodicPoint(double lo, double hi, double c) {
   constexpr double kTwoPi = 2.0 * std::numbers::pi;
-  // A slightly generous test: including a spurious extremum only widens the result.
-  const double k = std::ceil((lo - c) / kTwoPi - 1e-12);
-  return c + kTwoPi * k <= hi + 1e-12;
+  // A generous test: including a spurious extremum only widens the result. The slack grows with
+  // the magnitude of the bounds, since the rounding of c + 2*pi*k and the error of kTwoPi itself
+  // reach several ulps of |lo| for large arguments (an absolute slack misses extrema there).
+  const double slack = 1e-12 + 1e-14 * std::max(std::abs(lo), std::abs(hi));
+  const double k = std::ceil((lo - slack - c) / kTwoPi);
+  return c + kTwoPi * k <= hi + slack;
 }
 
 }  // namespace

@@ -26,6 +26,13 @@ ParseError::ParseError(std::string file, int line, int column, const std::string
 namespace {
 namespace pegtl = tao::pegtl;
 
+// "a variable", "an input", ...
+std::string WithArticle(std::string_view noun) {
+  const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) !=
+                                          std::string_view::npos;
+  return (vowel ? "an " : "a ") + std::string(noun);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Grammar. Tokens consume the white space and comments that follow them, so every rule starts on
 // a significant character.
@@ -376,7 +383,9 @@ class Builder {
                        static_cast<int>(root.m_begin.column),
                        "the file declares no automaton and no system");
     }
-    throw ParseError(file_, 1, 1,
+    // Point at the second automaton: the first one alone would have been the model.
+    const pegtl::position& second = local_positions_.at(1);
+    throw ParseError(file_, static_cast<int>(second.line), static_cast<int>(second.column),
                      "the file declares " + std::to_string(local_automata_.size()) +
                          " automata and no system: add 'system NAME { instance A = a; ... }'");
   }
@@ -386,19 +395,34 @@ class Builder {
   bool has_system() const { return system_.has_value(); }
 
  private:
-  // Symbol resolution context: an automaton being built, or a system.
+  // Symbol resolution context: an automaton being built, or a system, and the kinds of symbol
+  // its expressions may read besides parameters.
   struct Scope {
     const SymbolTable* symbols;
+    bool allow_state = true;  // continuous and discrete variables
+    bool allow_inputs = true;
+    // Why a symbol is not allowed (the end of the message).
+    const char* rule = "";
   };
+  // Parameter values, domains, input bounds and initial values: parameters only.
+  static Scope ConstantScope(const SymbolTable& symbols) {
+    return {&symbols, false, false,
+            "a parameter value, domain, bound or initial value may read only parameters"};
+  }
+  // Properties: the state and parameters, not inputs.
+  static Scope PropertyScope(const SymbolTable& symbols) {
+    return {&symbols, true, false, "a property may not read inputs"};
+  }
 
   static std::string Text(const Node& n) { return n.string(); }
 
   double Number(const Node& n) const {
-    std::string text = n.string();
-    text.erase(std::remove_if(text.begin(), text.end(), [](char c) {
-                 return std::isspace(static_cast<unsigned char>(c)) || c == '+';
-               }),
-               text.end());
+    // A signed number is a sign, white space or comments, then its `number` child.
+    if (n.is_type<grammar::signed_number>()) {
+      const double magnitude = Number(*n.children.at(0));
+      return n.string_view().front() == '-' ? -magnitude : magnitude;
+    }
+    const std::string text = n.string();
     double value = 0.0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (ec == std::errc::result_out_of_range || !std::isfinite(value)) {
@@ -408,26 +432,59 @@ class Builder {
     return value;
   }
 
+  // depth + 1: the depth of a tree node whose deepest child has `depth`. Fails at `n` past
+  // kMaxExpressionDepth.
+  int Deeper(const Node& n, int depth) const {
+    if (depth >= kMaxExpressionDepth) {
+      Fail(n, "expression too long or nested too deeply (more than " +
+                  std::to_string(kMaxExpressionDepth) + " levels)");
+    }
+    return depth + 1;
+  }
+
   Expression Expr(const Node& n, const Scope& scope) const {
+    int depth = 0;
+    return Expr(n, scope, &depth);
+  }
+
+  // Builds the expression of `n` and sets `*depth` to the depth of its tree.
+  Expression Expr(const Node& n, const Scope& scope, int* depth) const {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
+    *depth = 1;
     if (n.is_type<number>()) return Expression::Constant(Number(n));
     if (n.is_type<name>()) {
       const std::string id = Text(n);
       const auto slot = scope.symbols->Find(id);
       if (!slot) Fail(n, "undefined name '" + id + "'");
+      const SymbolKind kind = (*scope.symbols)[*slot].kind;
+      const bool state = kind == SymbolKind::kVariable || kind == SymbolKind::kDiscrete;
+      if ((state && !scope.allow_state) || (kind == SymbolKind::kInput && !scope.allow_inputs)) {
+        Fail(n, std::string(KindName(kind)) + " '" + id + "' is not allowed here: " + scope.rule);
+      }
       return Expression::Symbol(id, *slot);
     }
-    if (n.is_type<negation>()) return -Expr(*n.children.back(), scope);
+    int d = 0;
+    if (n.is_type<negation>()) {
+      Expression arg = Expr(*n.children.back(), scope, &d);
+      *depth = Deeper(n, d);
+      return -arg;
+    }
     if (n.is_type<power>()) {
-      Expression base = Expr(*n.children.at(0), scope);
+      Expression base = Expr(*n.children.at(0), scope, depth);
       if (n.children.size() == 1) return base;
-      return Expression::Binary(Op::kPow, base, Expr(*n.children.at(1), scope));
+      Expression exponent = Expr(*n.children.at(1), scope, &d);
+      *depth = Deeper(n, std::max(*depth, d));
+      return Expression::Binary(Op::kPow, base, exponent);
     }
     if (n.is_type<call>()) {
       const std::string fn = Text(*n.children.at(0));
       std::vector<Expression> args;
+      int deepest = 0;
       if (n.children.size() > 1) {
-        for (const auto& a : n.children.at(1)->children) args.push_back(Expr(*a, scope));
+        for (const auto& a : n.children.at(1)->children) {
+          args.push_back(Expr(*a, scope, &d));
+          deepest = std::max(deepest, d);
+        }
       }
       const auto op = FunctionByName(fn, static_cast<int>(args.size()));
       if (!op) {
@@ -437,14 +494,17 @@ class Builder {
         }
         Fail(n, "unknown function '" + fn + "'");
       }
+      *depth = Deeper(n, deepest);
       return args.size() == 1 ? Expression::Unary(*op, args[0])
                               : Expression::Binary(*op, args[0], args[1]);
     }
     if (n.is_type<sum>() || n.is_type<product>()) {
-      Expression acc = Expr(*n.children.at(0), scope);
+      // Left-associative: a long sum is a deep tree, one level per operator.
+      Expression acc = Expr(*n.children.at(0), scope, depth);
       for (size_t i = 1; i + 1 < n.children.size(); i += 2) {
         const Node& op = *n.children[i];
-        Expression rhs = Expr(*n.children[i + 1], scope);
+        Expression rhs = Expr(*n.children[i + 1], scope, &d);
+        *depth = Deeper(op, std::max(*depth, d));
         if (op.is_type<plus_op>()) acc = acc + rhs;
         else if (op.is_type<minus_op>()) acc = acc - rhs;
         else if (op.is_type<times_op>()) acc = acc * rhs;
@@ -456,6 +516,12 @@ class Builder {
   }
 
   Comparison Compare(const Node& n, const Scope& scope) const {
+    int depth = 0;
+    return Compare(n, scope, &depth);
+  }
+
+  // Sets `*depth` to the depth of the comparison's residual lhs - rhs.
+  Comparison Compare(const Node& n, const Scope& scope, int* depth) const {
     const std::string rel = Text(*n.children.at(1));
     Relation r = Relation::kEqual;
     if (rel.starts_with("<=")) r = Relation::kLessEqual;
@@ -463,7 +529,11 @@ class Builder {
     else if (rel.starts_with("==")) r = Relation::kEqual;
     else if (rel.starts_with("<")) r = Relation::kLess;
     else if (rel.starts_with(">")) r = Relation::kGreater;
-    return {Expr(*n.children.at(0), scope), r, Expr(*n.children.at(2), scope)};
+    int lhs_depth = 0, rhs_depth = 0;
+    Expression lhs = Expr(*n.children.at(0), scope, &lhs_depth);
+    Expression rhs = Expr(*n.children.at(2), scope, &rhs_depth);
+    *depth = Deeper(*n.children.at(1), std::max(lhs_depth, rhs_depth));
+    return {std::move(lhs), r, std::move(rhs)};
   }
 
   Constraint Conjunction(const Node& n, const Scope& scope) const {
@@ -476,21 +546,40 @@ class Builder {
 
   Predicate Pred(const Node& n, const Scope& scope,
                  const std::function<bool(const std::string&)>& is_mode) const {
+    int depth = 0;
+    return Pred(n, scope, is_mode, &depth);
+  }
+
+  // Sets `*depth` to the depth of the predicate tree, counting its comparisons' expressions.
+  Predicate Pred(const Node& n, const Scope& scope,
+                 const std::function<bool(const std::string&)>& is_mode, int* depth) const {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
+    *depth = 1;
     if (n.is_type<kw_true>()) return Predicate::True();
     if (n.is_type<kw_false>()) return Predicate::False();
-    if (n.is_type<comparison>()) return Predicate::Compare(Compare(n, scope));
+    if (n.is_type<comparison>()) {
+      Comparison c = Compare(n, scope, depth);
+      *depth = Deeper(n, *depth);
+      return Predicate::Compare(std::move(c));
+    }
     if (n.is_type<in_mode>()) {
       const std::string m = Text(*n.children.at(0));
       if (!is_mode(m)) Fail(*n.children.at(0), "unknown mode '" + m + "'");
       return Predicate::InMode(m);
     }
-    if (n.is_type<negated>()) return Predicate::Not(Pred(*n.children.at(0), scope, is_mode));
-    if (n.is_type<paren_predicate>()) return Pred(*n.children.at(0), scope, is_mode);
+    if (n.is_type<negated>()) {
+      Predicate operand = Pred(*n.children.at(0), scope, is_mode, depth);
+      *depth = Deeper(n, *depth);
+      return Predicate::Not(std::move(operand));
+    }
+    if (n.is_type<paren_predicate>()) return Pred(*n.children.at(0), scope, is_mode, depth);
     if (n.is_type<and_predicate>() || n.is_type<predicate>()) {
-      Predicate acc = Pred(*n.children.at(0), scope, is_mode);
+      // Left-associative, like sums.
+      Predicate acc = Pred(*n.children.at(0), scope, is_mode, depth);
       for (size_t i = 1; i < n.children.size(); ++i) {
-        Predicate rhs = Pred(*n.children[i], scope, is_mode);
+        int d = 0;
+        Predicate rhs = Pred(*n.children[i], scope, is_mode, &d);
+        *depth = Deeper(*n.children[i], std::max(*depth, d));
         acc = n.is_type<and_predicate>() ? Predicate::And(acc, rhs) : Predicate::Or(acc, rhs);
       }
       return acc;
@@ -522,8 +611,8 @@ class Builder {
     const auto slot = a.symbols().Find(id);
     if (!slot) Fail(n, "undefined " + std::string(what) + " '" + id + "'");
     if (a.symbols()[*slot].kind != kind) {
-      Fail(n, "'" + id + "' is a " + std::string(KindName(a.symbols()[*slot].kind)) + ", not a " +
-                  std::string(what));
+      Fail(n, "'" + id + "' is " + WithArticle(KindName(a.symbols()[*slot].kind)) + ", not " +
+                  WithArticle(what));
     }
     return *slot;
   }
@@ -548,7 +637,9 @@ class Builder {
     return p;
   }
 
-  Scenario ScenarioOf(const Node& n, const SymbolTable& symbols) const {
+  // `bounds(slot)` gives the evaluated bounds of the input at `slot`.
+  Scenario ScenarioOf(const Node& n, const SymbolTable& symbols,
+                      const std::function<std::pair<double, double>(int)>& bounds) const {
     Scenario s;
     bool has_until = false;
     for (const auto& item : n.children) {
@@ -564,7 +655,7 @@ class Builder {
       const auto slot = symbols.Find(Text(input));
       if (!slot) Fail(input, "undefined input '" + Text(input) + "'");
       if (symbols[*slot].kind != SymbolKind::kInput) {
-        Fail(input, "'" + Text(input) + "' is a " + std::string(KindName(symbols[*slot].kind)) +
+        Fail(input, "'" + Text(input) + "' is " + WithArticle(KindName(symbols[*slot].kind)) +
                         ", not an input");
       }
       if (std::any_of(s.inputs.begin(), s.inputs.end(),
@@ -572,9 +663,17 @@ class Builder {
         Fail(input, "input '" + Text(input) + "' driven twice");
       }
       sig.slot = *slot;
+      const auto [lo, hi] = bounds(*slot);
+      auto check_bounds = [&](const Node& v, double x) {
+        if (x < lo || x > hi) {
+          Fail(v, "signal for '" + Text(input) + "' takes value " + FormatNumber(x) +
+                      " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+        }
+        return x;
+      };
       const Node& value = *item->children.at(1);
       if (value.is_type<grammar::signed_number>()) {
-        sig.points = {{0.0, Number(value)}};
+        sig.points = {{0.0, check_bounds(value, Number(value))}};
       } else {
         sig.shape = value.children.at(0)->is_type<grammar::kw_linear>()
                         ? InputSignal::Shape::kLinear
@@ -585,7 +684,8 @@ class Builder {
           if (!sig.points.empty() && !(sig.points.back().first < t)) {
             Fail(p, "signal times must increase strictly");
           }
-          sig.points.emplace_back(t, Number(*p.children.at(1)));
+          const Node& v = *p.children.at(1);
+          sig.points.emplace_back(t, check_bounds(v, Number(v)));
         }
       }
       s.inputs.push_back(std::move(sig));
@@ -600,7 +700,7 @@ class Builder {
     const std::string name = Text(name_node);
     if (automata_.count(name)) Fail(name_node, "duplicate automaton '" + name + "'");
     Automaton a(name);
-    const Scope scope{&a.symbols()};
+    const Scope scope = ConstantScope(a.symbols());
     bool has_scenario = false;
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
@@ -632,10 +732,15 @@ class Builder {
       } else if (item.is_type<scenario_decl>()) {
         if (has_scenario) Fail(item, "scenario declared twice");
         has_scenario = true;
-        Scenario s = ScenarioOf(item, a.symbols());
+        Scenario s = ScenarioOf(item, a.symbols(), [&](int slot) {
+          const InputInfo& in = *std::find_if(a.inputs().begin(), a.inputs().end(),
+                                              [&](const InputInfo& x) { return x.slot == slot; });
+          return std::make_pair(a.EvaluateConstant(in.bounds.lo, "input bounds"),
+                                a.EvaluateConstant(in.bounds.hi, "input bounds"));
+        });
         At(item, [&] { a.SetScenario(std::move(s)); });
       } else if (item.is_type<property_decl>()) {
-        Property p = PropertyOf(item, scope, [&](const std::string& m) {
+        Property p = PropertyOf(item, PropertyScope(a.symbols()), [&](const std::string& m) {
           return a.FindMode(m).has_value();
         });
         At(*item.children.at(0), [&] { a.AddProperty(std::move(p)); });
@@ -647,6 +752,7 @@ class Builder {
     }
     automata_.emplace(name, std::move(a));
     local_automata_.push_back(name);
+    local_positions_.push_back(name_node.begin());
   }
 
   void ModeDecl(const Node& n, Automaton* a) {
@@ -741,7 +847,7 @@ class Builder {
   }
 
   void InitDecl(const Node& n, Automaton* a) {
-    const Scope scope{&a->symbols()};
+    const Scope scope = ConstantScope(a->symbols());
     const Node& mode_node = *n.children.at(0);
     InitialState s;
     s.mode = ModeOf(mode_node, *a);
@@ -795,14 +901,15 @@ class Builder {
         At(first, [&] { s.AddComponent(instance, it->second); });
       } else if (item.is_type<property_decl>()) {
         if (s.components().empty()) Fail(item, "declare the instances before the properties");
-        Property p = PropertyOf(item, Scope{&s.symbols()}, [&](const std::string& m) {
+        Property p = PropertyOf(item, PropertyScope(s.symbols()), [&](const std::string& m) {
           return s.FindMode(m).has_value();
         });
         At(*item.children.at(0), [&] { s.AddProperty(std::move(p)); });
       } else if (item.is_type<scenario_decl>()) {
         if (has_scenario) Fail(item, "scenario declared twice");
         has_scenario = true;
-        Scenario sc = ScenarioOf(item, s.symbols());
+        Scenario sc =
+            ScenarioOf(item, s.symbols(), [&](int slot) { return s.InputBounds(slot); });
         At(item, [&] { s.SetScenario(std::move(sc)); });
       }
     }
@@ -816,6 +923,8 @@ class Builder {
   std::set<std::filesystem::path>* active_imports_;
   std::map<std::string, Automaton> automata_;
   std::vector<std::string> local_automata_;
+  // Where each of local_automata_ is declared (its name).
+  std::vector<pegtl::position> local_positions_;
   std::optional<System> system_;
 };
 
@@ -894,15 +1003,27 @@ void Builder::Import(const Node& n) {
   ParseInto(text, path.string(), &imported, &tree);  // errors point into the imported file
   active_imports_->erase(canonical);
   for (const auto& [name, automaton] : imported.automata()) {
-    if (automata_.count(name)) Fail(n, "import redefines automaton '" + name + "'");
+    if (auto it = automata_.find(name); it != automata_.end()) {
+      // The same automaton reached twice (a file imported by two imports) is fine.
+      if (!(it->second == automaton)) Fail(n, "import redefines automaton '" + name + "'");
+      continue;
+    }
     automata_.emplace(name, automaton);
   }
+}
+
+// The import stack of a top-level file: the file itself, so that importing it is a cycle.
+std::set<std::filesystem::path> TopLevelImports(const std::string& file_name) {
+  std::error_code ec;
+  const auto canonical = std::filesystem::weakly_canonical(file_name, ec);
+  if (ec || !std::filesystem::is_regular_file(canonical, ec)) return {};
+  return {canonical};
 }
 
 }  // namespace
 
 System ParseModel(std::string_view text, const std::string& file_name) {
-  std::set<std::filesystem::path> active;
+  std::set<std::filesystem::path> active = TopLevelImports(file_name);
   Builder builder(file_name, &active);
   std::unique_ptr<Node> tree;
   ParseInto(text, file_name, &builder, &tree);
@@ -914,7 +1035,7 @@ System ParseModelFile(const std::filesystem::path& path) {
 }
 
 Automaton ParseAutomaton(std::string_view text, const std::string& file_name) {
-  std::set<std::filesystem::path> active;
+  std::set<std::filesystem::path> active = TopLevelImports(file_name);
   Builder builder(file_name, &active);
   std::unique_ptr<Node> tree;
   ParseInto(text, file_name, &builder, &tree);

@@ -31,6 +31,11 @@ class ParseError : public std::runtime_error {
 /// Largest model file accepted (bytes); larger files are rejected before parsing.
 inline constexpr std::size_t kMaxModelFileBytes = 64u << 20;
 
+/// Deepest expression or predicate tree accepted, in levels of operators (each operator of a
+/// left-associative chain such as `a + b + c` is one level). Deeper ones are a ParseError: the
+/// IR's tree walks recurse, so a sum of millions of terms would overflow the stack.
+inline constexpr int kMaxExpressionDepth = 10000;
+
 /// Parses model-language text (see docs/model_language.md) into the model it declares: its
 /// `system` block if it has one, otherwise its only automaton wrapped by System::Of. `file_name`
 /// is used in messages and to resolve `import "path";` (relative to its directory).

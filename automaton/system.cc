@@ -1,6 +1,7 @@
 #include "automaton/system.h"
 
 #include <algorithm>
+#include <cmath>
 #include <deque>
 #include <map>
 #include <stdexcept>
@@ -10,6 +11,13 @@ namespace {
 
 [[noreturn]] void Fail(std::string_view api, const std::string& message) {
   throw std::invalid_argument(std::string(api) + ": " + message);
+}
+
+// "a variable", "an input", ...
+std::string WithArticle(std::string_view noun) {
+  const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) !=
+                                          std::string_view::npos;
+  return (vowel ? "an " : "a ") + std::string(noun);
 }
 
 // Rewrites every symbol of `e` through `slot_map` (old slot -> new slot) with new names.
@@ -140,12 +148,28 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
   };
   Component c{instance, Renamed(automaton, rename, rename), {}, automaton};
   const SymbolTable& local = c.automaton.symbols();
+  const std::vector<double> parameters = c.automaton.ParameterEnvironment();
   for (int s = 0; s < local.size(); ++s) {
     if (auto g = symbols_.Find(local[s].name)) {
       if (symbols_[*g].kind != local[s].kind) {
-        Fail(kApi, "'" + local[s].name + "' is a " + std::string(KindName(local[s].kind)) +
-                       " in '" + automaton.name() + "' but a " +
-                       std::string(KindName(symbols_[*g].kind)) + " elsewhere");
+        Fail(kApi, "'" + local[s].name + "' is " + WithArticle(KindName(local[s].kind)) +
+                       " in '" + automaton.name() + "' but " +
+                       WithArticle(KindName(symbols_[*g].kind)) + " elsewhere");
+      }
+      if (local[s].kind == SymbolKind::kParameter) {
+        // A shared parameter is one constant: its values must agree.
+        for (const Component& other : components_) {
+          auto it = std::find(other.global_slot.begin(), other.global_slot.end(), *g);
+          if (it == other.global_slot.end()) continue;
+          const double theirs =
+              other.automaton.ParameterEnvironment()[it - other.global_slot.begin()];
+          if (theirs != parameters[s]) {
+            Fail(kApi, "shared parameter '" + local[s].name + "' is " +
+                           FormatNumber(parameters[s]) + " in '" + automaton.name() + "' but " +
+                           FormatNumber(theirs) + " in '" + other.automaton.name() + "'");
+          }
+          break;
+        }
       }
       c.global_slot.push_back(*g);
     } else {
@@ -214,13 +238,51 @@ void System::AddProperty(Property property) {
   properties_.push_back(std::move(property));
 }
 
-void System::SetScenario(Scenario scenario) {
-  for (const InputSignal& s : scenario.inputs) {
-    if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
-      Fail("System::SetScenario", "signal for something that is not an input");
+std::pair<double, double> System::InputBounds(int slot) const {
+  if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kInput) {
+    Fail("System::InputBounds", "slot " + std::to_string(slot) + " is not an input");
+  }
+  for (const Component& c : components_) {
+    auto it = std::find(c.global_slot.begin(), c.global_slot.end(), slot);
+    if (it == c.global_slot.end()) continue;
+    const int local = static_cast<int>(it - c.global_slot.begin());
+    for (const InputInfo& in : c.automaton.inputs()) {
+      if (in.slot != local) continue;
+      return {c.automaton.EvaluateConstant(in.bounds.lo, "System::InputBounds"),
+              c.automaton.EvaluateConstant(in.bounds.hi, "System::InputBounds")};
     }
   }
-  if (!(scenario.until > 0.0)) Fail("System::SetScenario", "'until' must be positive");
+  Fail("System::InputBounds", "no component declares input '" + symbols_[slot].name + "'");
+}
+
+void System::SetScenario(Scenario scenario) {
+  constexpr std::string_view kApi = "System::SetScenario";
+  if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {
+    Fail(kApi, "'until' must be positive and finite");
+  }
+  std::set<int> seen;
+  for (const InputSignal& s : scenario.inputs) {
+    if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
+      Fail(kApi, "signal for something that is not an input");
+    }
+    const std::string& name = symbols_[s.slot].name;
+    if (!seen.insert(s.slot).second) Fail(kApi, "input '" + name + "' driven twice");
+    if (s.points.empty()) Fail(kApi, "signal for '" + name + "' has no points");
+    const auto [lo, hi] = InputBounds(s.slot);
+    for (size_t i = 0; i < s.points.size(); ++i) {
+      const auto [t, v] = s.points[i];
+      if (!std::isfinite(t) || !std::isfinite(v)) {
+        Fail(kApi, "signal for '" + name + "' has a non-finite point");
+      }
+      if (i > 0 && !(s.points[i - 1].first < t)) {
+        Fail(kApi, "signal for '" + name + "': times must increase strictly");
+      }
+      if (v < lo || v > hi) {
+        Fail(kApi, "signal for '" + name + "' takes value " + FormatNumber(v) +
+                       " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+      }
+    }
+  }
   scenario_ = std::move(scenario);
 }
 

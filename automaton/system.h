@@ -54,7 +54,10 @@ class System {
   /// A system-level property over System slots; `in` atoms name component modes qualified by the
   /// instance (`A.open`) or, for an unqualified component, plainly.
   void AddProperty(Property property);
-  /// The system's default run; inputs are System slots.
+  /// The system's default run; inputs are System slots. Validated like Automaton::SetScenario
+  /// (inputs each at most once, points finite and strictly increasing in time and within the
+  /// input's bounds, until > 0 and finite); throws std::invalid_argument
+  /// ("System::SetScenario: ...") otherwise.
   void SetScenario(Scenario scenario);
 
   const SymbolTable& symbols() const { return symbols_; }
@@ -66,6 +69,9 @@ class System {
   std::optional<std::pair<int, ModeId>> FindMode(std::string_view qualified) const;
   /// The name of mode `m` of component `c` as written at system level ("A.open" or "open").
   std::string QualifiedModeName(int c, ModeId m) const;
+  /// The bounds [lo, hi] of the input at System slot `slot`, evaluated in the first component
+  /// that declares it. Throws std::invalid_argument if `slot` is not an input.
+  std::pair<double, double> InputBounds(int slot) const;
 
   /// The product automaton over System slots: one mode per tuple of component modes reachable
   /// from the initial tuples through the transition graph (guards are not evaluated), named by

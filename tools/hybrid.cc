@@ -35,11 +35,13 @@ struct OutputError : std::runtime_error {
 };
 
 // Writes `text` to `path` atomically (temporary file in the same directory, then rename), so a
-// failed run never leaves a half-written file; "-" or empty writes to stdout.
+// failed run never leaves a half-written file; "-" or empty writes to stdout. Throws OutputError
+// when the text cannot be written (also to stdout, e.g. a full disk).
 void WriteOutput(const std::string& path, const std::string& text) {
   if (path.empty() || path == "-") {
     std::cout << text;
     std::cout.flush();
+    if (!std::cout) throw OutputError("cannot write to standard output");
     return;
   }
   const std::filesystem::path target(path);
@@ -326,7 +328,15 @@ int main(int argc, char** argv) {
       }
       WriteOutput("-", as_json ? report.dump(2) + "\n" : InfoText(report));
     } else if (dot->parsed()) {
-      WriteOutput(output, hybrid::WriteDot(system, {.product = product}));
+      std::string text;
+      try {
+        text = hybrid::WriteDot(system, {.product = product});
+      } catch (const std::invalid_argument& e) {
+        std::cerr << model << ": cannot draw the product: " << e.what()
+                  << " (omit --product to draw one cluster per component)\n";
+        return kExitModelError;
+      }
+      WriteOutput(output, text);
     }
   } catch (const hybrid::ParseError& e) {
     std::cerr << e.what() << "\n";

@@ -1,0 +1,162 @@
+#include "automaton/compiled_expression.h"
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "tests/test_utilities/random_models.h"
+
+namespace hybrid {
+namespace {
+
+using ::hybrid::testing::GenExpression;
+using ::hybrid::testing::GenInt;
+using ::hybrid::testing::GenReal;
+
+const Expression x = Expression::Symbol("x", 0);
+const Expression y = Expression::Symbol("y", 1);
+const Expression z = Expression::Symbol("z", 2);
+const Expression w = Expression::Symbol("w", 3);
+
+Expression C(double v) { return Expression::Constant(v); }
+
+/// Same bits, or both NaN (NaN payloads and signs are not specified by the C library).
+bool SameDouble(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b) ||
+         (std::isnan(a) && std::isnan(b));
+}
+
+/// A right-nested chain sin(s0) + (sin(s1) + (...)): every right operand is a compound
+/// expression, so the evaluation stack grows by one per level.
+Expression RightChain(int depth, Op op) {
+  Expression e = Expression::Unary(Op::kCos, w);
+  for (int i = depth; i > 0; --i) {
+    const Expression s = std::vector<Expression>{x, y, z, w}[i % 4];
+    e = Expression::Binary(op, Expression::Unary(Op::kSin, s), e);
+  }
+  return e;
+}
+
+TEST(CompiledExpressionTest, DefaultEvaluatesToZero) {
+  const CompiledExpression c;
+  EXPECT_EQ(c.Evaluate(nullptr), 0.0);
+  EXPECT_EQ(c.size(), 1);
+}
+
+TEST(CompiledExpressionTest, Examples) {
+  const std::vector<double> env = {2.0, -3.0, 0.25, 0.0};
+  EXPECT_EQ(CompiledExpression(x * y + z)(env), -5.75);
+  EXPECT_EQ(CompiledExpression(C(1.5))(env), 1.5);
+  EXPECT_EQ(CompiledExpression(x / w)(env), std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(std::isnan(CompiledExpression(Expression::Unary(Op::kLog, y))(env)));
+  EXPECT_EQ(CompiledExpression(Expression::Unary(Op::kSign, y))(env), -1.0);
+  EXPECT_EQ(CompiledExpression(Expression::Unary(Op::kSign, w))(env), 0.0);
+  EXPECT_EQ(CompiledExpression(Expression::Binary(Op::kMin, x, y))(env), -3.0);
+  EXPECT_EQ(CompiledExpression(Expression::Binary(Op::kMax, x, y))(env), 2.0);
+  EXPECT_EQ(CompiledExpression(Expression::Binary(Op::kPow, x, C(10.0)))(env), 1024.0);
+  EXPECT_EQ(CompiledExpression(x - (y - z))(env), 2.0 - (-3.0 - 0.25));
+  EXPECT_EQ(CompiledExpression((x - y) - z)(env), (2.0 + 3.0) - 0.25);
+  EXPECT_EQ(CompiledExpression(-x)(env), -2.0);
+}
+
+TEST(CompiledExpressionTest, ConstantAndSymbolRightOperandsAreFused) {
+  // `m1 * u`: push m1, multiply by the slot of u.
+  EXPECT_EQ(CompiledExpression(x * y).size(), 2);
+  EXPECT_EQ(CompiledExpression(x + C(1.0)).size(), 2);
+  // A compound right operand needs its own instructions and a stack slot.
+  EXPECT_EQ(CompiledExpression(x * (y + z)).size(), 4);
+  EXPECT_EQ(CompiledExpression(Expression::Unary(Op::kSin, x)).size(), 2);
+}
+
+TEST(CompiledExpressionTest, NonCommutativeOperandsKeepTheirOrder) {
+  const std::vector<double> env = {3.0, 2.0, 0.5, -1.0};
+  const auto sub = Expression::Unary(Op::kSin, y);
+  for (Op op : {Op::kSub, Op::kDiv, Op::kPow, Op::kAtan2}) {
+    for (const auto& [a, b] : std::vector<std::pair<Expression, Expression>>{
+             {x, y}, {x, C(2.0)}, {C(2.0), x}, {x, sub}, {sub, x}, {sub, sub * z}}) {
+      const Expression e = Expression::Binary(op, a, b);
+      EXPECT_TRUE(SameDouble(CompiledExpression(e)(env), e.Evaluate(env))) << e.ToString();
+    }
+  }
+}
+
+TEST(CompiledExpressionTest, DeepExpressionsUseAHeapStack) {
+  for (int depth : {CompiledExpression::kMaxInlineStack - 2, CompiledExpression::kMaxInlineStack,
+                    CompiledExpression::kMaxInlineStack + 1, 200, 3000}) {
+    for (Op op : {Op::kAdd, Op::kSub, Op::kMul, Op::kAtan2}) {
+      const Expression e = RightChain(depth, op);
+      const CompiledExpression c(e);
+      for (const std::vector<double>& env :
+           {std::vector<double>{0.5, -1.0, 2.0, 0.25}, std::vector<double>{1.0, 1.0, 1.0, 1.0}}) {
+        EXPECT_TRUE(SameDouble(c(env), e.Evaluate(env))) << "depth " << depth;
+      }
+    }
+  }
+  // A deep left-nested chain needs no stack but many instructions.
+  Expression left = x;
+  for (int i = 0; i < 5000; ++i) left = Expression::Unary(Op::kSin, left) + y;
+  const std::vector<double> env = {0.5, 0.001, 0.0, 0.0};
+  EXPECT_TRUE(SameDouble(CompiledExpression(left)(env), left.Evaluate(env)));
+}
+
+TEST(CompiledExpressionTest, CopiesEvaluateIndependently) {
+  CompiledExpression a(x + y);
+  const CompiledExpression b = a;
+  a = CompiledExpression(x * y);
+  const std::vector<double> env = {2.0, 5.0, 0.0, 0.0};
+  EXPECT_EQ(a(env), 10.0);
+  EXPECT_EQ(b(env), 7.0);
+}
+
+/// A random environment mixing ordinary values, zeros, negative values and large magnitudes.
+std::vector<double> RandomEnvironment() {
+  std::vector<double> env;
+  for (int i = 0; i < 4; ++i) {
+    switch (*GenInt(0, 5)) {
+      case 0: env.push_back(*rc::gen::element(0.0, -0.0, 1.0, -1.0, 0.5)); break;
+      case 1: env.push_back(*GenReal(-1e6, 1e6)); break;
+      case 2: env.push_back(*rc::gen::element(1e300, -1e-300, 710.0, 1e-320)); break;
+      default: env.push_back(*GenReal(-5.0, 5.0)); break;
+    }
+  }
+  return env;
+}
+
+RC_GTEST_PROP(CompiledExpressionProperty, EvaluatesLikeTheTreeBitForBit, ()) {
+  const Expression e = *GenExpression(6);
+  const CompiledExpression c(e);
+  for (int k = 0; k < 8; ++k) {
+    const std::vector<double> env = RandomEnvironment();
+    const double expected = e.Evaluate(env);
+    const double actual = c.Evaluate(env.data());
+    RC_ASSERT(SameDouble(actual, expected));
+  }
+}
+
+RC_GTEST_PROP(CompiledExpressionProperty, DeepRandomExpressionsEvaluateLikeTheTree, ()) {
+  // Nest random expressions as right operands deeper than the inline stack.
+  const int depth = *GenInt(CompiledExpression::kMaxInlineStack - 4,
+                            3 * CompiledExpression::kMaxInlineStack);
+  Expression e = *GenExpression(2);
+  for (int i = 0; i < depth; ++i) {
+    const Op op = *rc::gen::element(Op::kAdd, Op::kSub, Op::kMul, Op::kDiv, Op::kMin, Op::kMax,
+                                    Op::kAtan2, Op::kPow);
+    Expression lhs = *GenExpression(2);
+    if (*GenInt(0, 4) == 0) e = Expression::Unary(Op::kSin, e);
+    e = Expression::Binary(op, lhs, e.is_constant() || e.is_symbol() ? -e + x : e);
+  }
+  const CompiledExpression c(e);
+  for (int k = 0; k < 4; ++k) {
+    std::vector<double> env;
+    for (int i = 0; i < 4; ++i) env.push_back(*GenReal(-2.0, 2.0));
+    RC_ASSERT(SameDouble(c(env), e.Evaluate(env)));
+  }
+}
+
+}  // namespace
+}  // namespace hybrid

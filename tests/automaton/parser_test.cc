@@ -1,0 +1,776 @@
+// Tests of the model-language parser: every malformed model of tests/data/malformed gives the
+// ParseError recorded in tests/data/malformed/expected.txt (file, line, column and message
+// exactly); binary and 10 MB inputs give a ParseError or parse, quickly, and never crash; and
+// valid models give the expected IR.
+
+#include "automaton/parser.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "automaton/automaton.h"
+#include "automaton/expression.h"
+#include "automaton/system.h"
+
+namespace hybrid {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSourceDir = HYBRID_SOURCE_DIR;
+const fs::path kMalformedDir = kSourceDir / "tests" / "data" / "malformed";
+
+// ---------------------------------------------------------------------------------------------
+// Helpers.
+
+// One line of tests/data/malformed/expected.txt.
+struct Expectation {
+  std::string file;         // the file parsed, relative to kMalformedDir
+  int line = 0;
+  int column = 0;
+  std::string message;      // ParseError::message(), exactly
+  std::string reported_in;  // the file the error is reported in (relative), usually `file`
+};
+
+std::vector<std::string> SplitTabs(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  std::string field;
+  while (std::getline(in, field, '\t')) fields.push_back(field);
+  return fields;
+}
+
+std::vector<Expectation> LoadExpectations() {
+  std::vector<Expectation> out;
+  std::ifstream in(kMalformedDir / "expected.txt");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> f = SplitTabs(line);
+    if (f.size() != 4 && f.size() != 5) {
+      ADD_FAILURE() << "malformed line in expected.txt: " << line;
+      continue;
+    }
+    out.push_back({f[0], std::stoi(f[1]), std::stoi(f[2]), f[3], f.size() == 5 ? f[4] : f[0]});
+  }
+  return out;
+}
+
+std::string TestName(const ::testing::TestParamInfo<Expectation>& info) {
+  std::string name = fs::path(info.param.file).stem().string();
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+// A fresh directory under the system temporary directory, removed by the destructor.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("hybrid_parser_test_" + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path Write(const std::string& name, const std::string& text) const {
+    const fs::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+ private:
+  fs::path path_;
+};
+
+// The ParseError that parsing `text` throws; fails the test if none (or another exception) is
+// thrown.
+ParseError ParseFailure(std::string_view text, const std::string& file = "test.ha") {
+  try {
+    ParseModel(text, file);
+  } catch (const ParseError& e) {
+    return e;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected a ParseError, got another exception: " << e.what();
+    return ParseError(file, -1, -1, "wrong exception");
+  }
+  ADD_FAILURE() << "expected a ParseError, but the model parsed";
+  return ParseError(file, -1, -1, "no exception");
+}
+
+// Parses `text` and returns its only automaton (as declared).
+Automaton OnlyAutomaton(std::string_view text) {
+  const System s = ParseModel(text, "test.ha");
+  EXPECT_EQ(s.components().size(), 1u);
+  return s.components()[0].source;
+}
+
+Expression Sym(const Automaton& a, const std::string& name) {
+  const auto slot = a.symbols().Find(name);
+  EXPECT_TRUE(slot.has_value()) << name;
+  return Expression::Symbol(name, slot.value_or(0));
+}
+
+Expression C(double v) { return Expression::Constant(v); }
+
+// Runs `f` and returns its wall time in seconds.
+double Seconds(const std::function<void()>& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// ParseModel on `text`: must either parse or throw a ParseError with a location inside the text,
+// within `limit` seconds. Returns whether it parsed.
+bool ParsesOrFailsCleanly(const std::string& text, double limit) {
+  bool parsed = false;
+  const double t = Seconds([&] {
+    try {
+      ParseModel(text, "big.ha");
+      parsed = true;
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.file(), "big.ha");
+      EXPECT_GE(e.line(), 1);
+      EXPECT_GE(e.column(), 1);
+      EXPECT_FALSE(e.message().empty());
+      EXPECT_EQ(std::string(e.what()).rfind("big.ha:", 0), 0u) << e.what();
+    }
+  });
+  EXPECT_LT(t, limit) << "parsing " << text.size() << " bytes took " << t << " s";
+  return parsed;
+}
+
+constexpr double kTimeLimit = 5.0;  // seconds, for every 10 MB input below
+constexpr size_t kTenMegabytes = 10u << 20;
+
+const char* const kSmallModel = R"(automaton a {
+  var x;
+  mode m { x' = 1; }
+  init m { x = 0; }
+}
+)";
+
+// ---------------------------------------------------------------------------------------------
+// Malformed files.
+
+class MalformedFileTest : public ::testing::TestWithParam<Expectation> {};
+
+TEST_P(MalformedFileTest, ThrowsParseErrorAtTheOffendingToken) {
+  const Expectation& x = GetParam();
+  const fs::path path = kMalformedDir / x.file;
+  ASSERT_TRUE(fs::exists(path)) << path;
+  try {
+    ParseModelFile(path);
+    FAIL() << x.file << " parsed";
+  } catch (const ParseError& e) {
+    const std::string file = (kMalformedDir / x.reported_in).string();
+    EXPECT_EQ(e.file(), file);
+    EXPECT_EQ(e.line(), x.line);
+    EXPECT_EQ(e.column(), x.column);
+    EXPECT_EQ(e.message(), x.message);
+    EXPECT_EQ(std::string(e.what()), file + ":" + std::to_string(x.line) + ":" +
+                                         std::to_string(x.column) + ": " + x.message);
+  } catch (const std::exception& e) {
+    FAIL() << x.file << ": not a ParseError: " << e.what();
+  }
+}
+
+// Parsing the text directly (ParseModel) reports the same location under the given name.
+TEST_P(MalformedFileTest, ParseModelOnTheTextGivesTheSameError) {
+  const Expectation& x = GetParam();
+  if (x.reported_in != x.file) GTEST_SKIP() << "error is in an imported file";
+  std::ifstream in(kMalformedDir / x.file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string name = (kMalformedDir / x.file).string();
+  const ParseError e = ParseFailure(text.str(), name);
+  EXPECT_EQ(e.line(), x.line);
+  EXPECT_EQ(e.column(), x.column);
+  EXPECT_EQ(e.message(), x.message);
+}
+
+INSTANTIATE_TEST_SUITE_P(Malformed, MalformedFileTest, ::testing::ValuesIn(LoadExpectations()),
+                         TestName);
+
+TEST(MalformedFiles, TableCoversEveryFileAndNoMore) {
+  std::set<std::string> on_disk;
+  for (const auto& entry : fs::directory_iterator(kMalformedDir)) {
+    if (entry.path().extension() == ".ha") on_disk.insert(entry.path().filename().string());
+  }
+  std::set<std::string> in_table;
+  for (const Expectation& x : LoadExpectations()) {
+    EXPECT_TRUE(in_table.insert(x.file).second) << "listed twice: " << x.file;
+  }
+  EXPECT_EQ(on_disk, in_table);
+  EXPECT_GE(in_table.size(), 20u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Generated malformed inputs: binary, NUL bytes, limits.
+
+TEST(ParseErrors, NulByteIsReportedWhereItIs) {
+  const char raw[] = "automaton a {\n  var x;\0\n}\n";
+  const std::string text(raw, sizeof(raw) - 1);
+  const ParseError e = ParseFailure(text);
+  EXPECT_EQ(e.line(), 2);
+  EXPECT_EQ(e.column(), 9);
+  EXPECT_EQ(e.message(), "NUL byte in model file (binary file?)");
+}
+
+TEST(ParseErrors, BinaryGarbageIsReportedAtTheFirstControlByte) {
+  // The start of an ELF header: DEL, 'E', 'L', 'F', then byte 2.
+  const std::string text("\x7f" "ELF\x02\x01\x01\x00\x00\x00", 10);
+  const ParseError e = ParseFailure(text, "prog.ha");
+  EXPECT_EQ(e.file(), "prog.ha");
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_EQ(e.column(), 5);
+  EXPECT_EQ(e.message(), "control character 2 in model file (binary file?)");
+}
+
+TEST(ParseErrors, NonAsciiBytesOutsideCommentsAreSyntaxErrors) {
+  const ParseError e = ParseFailure("automaton \xc3\xa9t\xc3\xa9 { }\n");
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_EQ(e.column(), 11);
+  EXPECT_EQ(e.message(), "expected a name");
+}
+
+TEST(ParseErrors, NonAsciiBytesInCommentsAreFine) {
+  EXPECT_NO_THROW(ParseModel("# \xc3\xa9t\xc3\xa9 \xff\xfe\n" + std::string(kSmallModel), "t.ha"));
+}
+
+TEST(ParseErrors, MissingFileIsReportedAtLineZero) {
+  const fs::path path = kMalformedDir / "this_file_does_not_exist.ha";
+  try {
+    ParseModelFile(path);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), path.string());
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_EQ(e.column(), 0);
+    EXPECT_EQ(e.message().rfind("cannot read file: ", 0), 0u) << e.message();
+  }
+}
+
+TEST(ParseErrors, DirectoryIsNotAModelFile) {
+  EXPECT_THROW(ParseModelFile(kMalformedDir), ParseError);
+}
+
+TEST(ParseErrors, FileLargerThanTheLimitIsRejectedBeforeReading) {
+  TempDir dir;
+  const fs::path path = dir.Write("huge.ha", "");
+  fs::resize_file(path, kMaxModelFileBytes + 1);  // sparse: nothing is written
+  try {
+    ParseModelFile(path);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_EQ(e.column(), 0);
+    EXPECT_EQ(e.message(), "file is " + std::to_string(kMaxModelFileBytes + 1) +
+                               " bytes, larger than the " + std::to_string(kMaxModelFileBytes) +
+                               "-byte limit for model files");
+  }
+}
+
+TEST(ParseErrors, ErrorsInAnImportedFilePointIntoThatFile) {
+  TempDir dir;
+  dir.Write("lib.ha", "automaton lib {\n  var x;\n  mode m { x' = y; }\n  init m { x = 0; }\n}\n");
+  const fs::path main = dir.Write("main.ha", "import \"lib.ha\";\nsystem s { instance L = lib; }\n");
+  try {
+    ParseModelFile(main);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), (dir.path() / "lib.ha").string());
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.column(), 17);
+    EXPECT_EQ(e.message(), "undefined name 'y'");
+  }
+}
+
+TEST(ParseErrors, ImportingItselfIsACycleDetectedAtOnce) {
+  TempDir dir;
+  const fs::path self = dir.Write("self.ha", std::string("import \"self.ha\";\n") + kSmallModel);
+  try {
+    ParseModelFile(self);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), self.string());
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_EQ(e.column(), 1);
+    EXPECT_EQ(e.message(), "import cycle through 'self.ha'");
+  }
+}
+
+TEST(ParseErrors, ParseAutomatonWantsExactlyOneAutomaton) {
+  EXPECT_NO_THROW(ParseAutomaton(kSmallModel, "t.ha"));
+  EXPECT_THROW(ParseAutomaton(std::string(kSmallModel) + "system s { instance a; }\n", "t.ha"),
+               ParseError);
+  EXPECT_THROW(ParseAutomaton(std::string(kSmallModel) +
+                                  "automaton b { var y; mode n { y' = 1; } init n { y = 0; } }",
+                              "t.ha"),
+               ParseError);
+  EXPECT_THROW(ParseAutomaton("", "t.ha"), ParseError);
+}
+
+TEST(ParseErrors, SignalValueOutsideTheInputBoundsIsReportedAtTheValue) {
+  const ParseError e = ParseFailure(R"(automaton a {
+  var x;
+  input u in [0, 2];
+  mode m { x' = u; }
+  init m { x = 0; }
+  scenario { until 1; u = -0.5; }
+})");
+  EXPECT_EQ(e.line(), 6);
+  EXPECT_EQ(e.column(), 27);
+  EXPECT_EQ(e.message(), "signal for 'u' takes value -0.5 outside its bounds [0, 2]");
+}
+
+// An expression as deep as allowed parses and survives the IR's recursive tree walks; one level
+// more is a ParseError at the operator that crosses the limit.
+TEST(ParseErrors, ExpressionDepthLimitIsExact) {
+  auto model = [](int terms) {
+    std::string text = "automaton a {\n  var x;\n  mode m { x' = x";
+    for (int i = 1; i < terms; ++i) text += " + x";
+    return text + "; }\n  init m { x = 0; }\n}\n";
+  };
+  const Automaton a = OnlyAutomaton(model(kMaxExpressionDepth));
+  const Expression& flow = a.modes()[0].flows.at(0).second;
+  EXPECT_EQ(flow.Evaluate(std::vector<double>{2.0}), 2.0 * kMaxExpressionDepth);
+  EXPECT_EQ(flow.Slots(), std::vector<int>{0});
+  EXPECT_EQ(flow.ToString().size(), 4u * kMaxExpressionDepth - 3);
+  EXPECT_EQ(flow.Derivative(0).Evaluate(std::vector<double>{0.0}), kMaxExpressionDepth);
+
+  const ParseError e = ParseFailure(model(kMaxExpressionDepth + 1));
+  EXPECT_EQ(e.line(), 3);
+  // "  mode m { x' = x" is 17 bytes; operator j (from 1) is at column 19 + 4 (j - 1).
+  EXPECT_EQ(e.column(), 19 + 4 * (kMaxExpressionDepth - 1));
+  EXPECT_EQ(e.message(), "expression too long or nested too deeply (more than " +
+                             std::to_string(kMaxExpressionDepth) + " levels)");
+}
+
+TEST(ParseErrors, LongDisjunctionInAPropertyIsRejectedNotACrash) {
+  std::string text = std::string(kSmallModel, std::string(kSmallModel).size() - 2) +
+                     "  property p: always x > 0";
+  for (int i = 0; i < 100000; ++i) text += " or x > 0";
+  text += ";\n}\n";
+  const ParseError e = ParseFailure(text);
+  EXPECT_EQ(e.line(), 5);
+  EXPECT_EQ(e.message().rfind("expression too long or nested too deeply", 0), 0u) << e.message();
+}
+
+TEST(ParseErrors, OneMegabyteSumIsRejectedQuickly) {
+  std::string text = "automaton a {\n  var x;\n  mode m { x' = x";
+  while (text.size() < (1u << 20)) text += "+x";
+  text += "; }\n  init m { x = 0; }\n}\n";
+  EXPECT_FALSE(ParsesOrFailsCleanly(text, kTimeLimit));
+}
+
+TEST(ParseErrors, OneMegabyteInvariantParsesQuickly) {
+  std::string text = "automaton a {\n  var x;\n  mode m { x' = 1; inv x >= 0";
+  while (text.size() < (1u << 20)) text += " and x <= 1";
+  text += "; }\n  init m { x = 0; }\n}\n";
+  EXPECT_TRUE(ParsesOrFailsCleanly(text, kTimeLimit));
+}
+
+// ---------------------------------------------------------------------------------------------
+// 10 MB inputs.
+
+TEST(LargeInputs, TenMegabytesOfOpeningParentheses) {
+  const std::string text(kTenMegabytes, '(');
+  EXPECT_FALSE(ParsesOrFailsCleanly(text, kTimeLimit));
+  const ParseError e = ParseFailure(text, "big.ha");
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_EQ(e.column(), 1);
+  EXPECT_EQ(e.message(), "expected 'automaton', 'system' or 'import' at top level");
+}
+
+TEST(LargeInputs, TenMegabytesOfParenthesesInsideAnExpression) {
+  const std::string text = "automaton a {\n  var x;\n  mode m { x' = " +
+                           std::string(kTenMegabytes, '(') + "x; }\n}\n";
+  EXPECT_FALSE(ParsesOrFailsCleanly(text, kTimeLimit));
+  const ParseError e = ParseFailure(text, "big.ha");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.message(), "expression nested too deeply");
+}
+
+TEST(LargeInputs, TenMegabyteCommentFollowedByAValidModel) {
+  const std::string text = "#" + std::string(kTenMegabytes, 'c') + "\n" + kSmallModel;
+  EXPECT_TRUE(ParsesOrFailsCleanly(text, kTimeLimit));
+  EXPECT_EQ(ParseModel(text, "big.ha").components()[0].automaton.num_modes(), 1);
+}
+
+TEST(LargeInputs, TenMegabytesOfRandomBytes) {
+  std::mt19937 rng(20261121);
+  std::string text(kTenMegabytes, '\0');
+  for (char& c : text) c = static_cast<char>(rng() & 0xff);
+  EXPECT_FALSE(ParsesOrFailsCleanly(text, kTimeLimit));
+}
+
+TEST(LargeInputs, TenMegabytesOfRandomPrintableText) {
+  // No control bytes, so the grammar itself has to reject it.
+  const std::string alphabet = "abcxyz_019 \n\t(){}[];:=<>+-*/^.,'#\"";
+  std::mt19937 rng(7);
+  std::string text(kTenMegabytes, ' ');
+  for (char& c : text) c = alphabet[rng() % alphabet.size()];
+  EXPECT_FALSE(ParsesOrFailsCleanly(text, kTimeLimit));
+}
+
+TEST(LargeInputs, TenMegabytesOfRandomTokensInsideAMode) {
+  const std::vector<std::string> tokens = {"x", "1", "+", "-", "*", "(", ")", " ", "sin", ","};
+  std::mt19937 rng(11);
+  std::string text = "automaton a {\n  var x;\n  mode m { x' = ";
+  while (text.size() < kTenMegabytes) text += tokens[rng() % tokens.size()];
+  text += "; }\n  init m { x = 0; }\n}\n";
+  ParsesOrFailsCleanly(text, kTimeLimit);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Valid models: the IR.
+
+TEST(Parser, EveryBundledSpecParses) {
+  int count = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(kSourceDir / "spec")) {
+    if (entry.path().extension() != ".ha") continue;
+    ++count;
+    try {
+      const System s = ParseModelFile(entry.path());
+      EXPECT_FALSE(s.components().empty()) << entry.path();
+    } catch (const ParseError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+  EXPECT_GE(count, 1);
+}
+
+TEST(Parser, FingerModel) {
+  const System s = ParseModelFile(kSourceDir / "spec" / "finger.ha");
+  ASSERT_EQ(s.components().size(), 1u);
+  const Automaton& a = s.components()[0].automaton;
+  EXPECT_EQ(a.name(), "finger");
+  EXPECT_EQ(s.components()[0].instance, "");
+  EXPECT_EQ(a.num_modes(), 30);
+  EXPECT_EQ(a.variables().size(), 4u);
+  EXPECT_EQ(a.discrete_variables().size(), 6u);
+  EXPECT_EQ(a.inputs().size(), 1u);
+  EXPECT_EQ(a.parameters().size(), 11u);
+  EXPECT_EQ(a.initial_states().size(), 1u);
+  EXPECT_EQ(a.mode(a.initial_states()[0].mode).name, "c000_l000");
+  EXPECT_EQ(a.properties().size(), 8u);
+  EXPECT_EQ(s.properties().size(), 8u);
+  ASSERT_TRUE(s.scenario().has_value());
+  EXPECT_EQ(s.scenario()->until, 530.0);
+  const auto m1 = a.symbols().Find("m1");
+  ASSERT_TRUE(m1);
+  EXPECT_EQ(a.symbols()[*m1].unit, "deg/count");
+  EXPECT_DOUBLE_EQ(a.ParameterEnvironment()[*m1], 70.0 / 140.0);
+}
+
+TEST(Parser, UnitsDomainsAndParameters) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton arm {
+  param lo [deg] = -10;
+  param hi [deg] = 2 * 45;
+  var theta [deg] in [lo, hi], omega [deg/s];
+  input torque [N*m] in [-1.5, 1.5];
+  mode free { theta' = omega; omega' = torque; }
+  init free { theta in [lo, 0]; omega = 0; }
+})");
+  const SymbolTable& s = a.symbols();
+  ASSERT_EQ(s.size(), 5);
+  EXPECT_EQ(s[0], (Symbol{"lo", SymbolKind::kParameter, "deg"}));
+  EXPECT_EQ(s[1], (Symbol{"hi", SymbolKind::kParameter, "deg"}));
+  EXPECT_EQ(s[2], (Symbol{"theta", SymbolKind::kVariable, "deg"}));
+  EXPECT_EQ(s[3], (Symbol{"omega", SymbolKind::kVariable, "deg/s"}));
+  EXPECT_EQ(s[4], (Symbol{"torque", SymbolKind::kInput, "N*m"}));
+  EXPECT_EQ(a.parameters()[1].second, C(2) * C(45));
+  ASSERT_EQ(a.variables().size(), 2u);
+  ASSERT_TRUE(a.variables()[0].domain.has_value());
+  EXPECT_EQ(*a.variables()[0].domain, (Range{Sym(a, "lo"), Sym(a, "hi")}));
+  EXPECT_FALSE(a.variables()[1].domain.has_value());
+  EXPECT_EQ(a.inputs()[0].bounds, (Range{C(-1.5), C(1.5)}));
+  EXPECT_EQ(a.ParameterEnvironment(), (std::vector<double>{-10, 90, 0, 0, 0}));
+  const InitialState& init = a.initial_states()[0];
+  ASSERT_EQ(init.values.size(), 2u);
+  EXPECT_FALSE(init.values[0].is_point);
+  EXPECT_EQ(init.values[0].range, (Range{Sym(a, "lo"), C(0)}));
+  EXPECT_TRUE(init.values[1].is_point);
+  EXPECT_EQ(init.values[1].range, (Range{C(0), C(0)}));
+}
+
+TEST(Parser, ExpressionsFollowPrecedenceAndAssociativity) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton e {
+  var x, y;
+  mode m {
+    x' = -2 * x + sin(y) ^ 2 - x / y / 2;   # comment after a flow
+    y' = -x ^ 2 ^ 3 + atan2(y, 1.5e1) - min(.5, 2.) + 1e+2;
+  }
+  init m { x = 0; y = 0; }
+})");
+  const Expression x = Sym(a, "x"), y = Sym(a, "y");
+  const auto& flows = a.modes()[0].flows;
+  ASSERT_EQ(flows.size(), 2u);
+  EXPECT_EQ(flows[0].second, C(-2) * x + Expression::Binary(Op::kPow, Expression::Unary(Op::kSin, y),
+                                                             C(2)) -
+                                 x / y / C(2));
+  EXPECT_EQ(flows[1].second,
+            -Expression::Binary(Op::kPow, x, Expression::Binary(Op::kPow, C(2), C(3))) +
+                Expression::Binary(Op::kAtan2, y, C(15)) - Expression::Binary(Op::kMin, C(0.5), C(2)) +
+                C(100));
+}
+
+TEST(Parser, DiscreteValuesAndSignedNumbers) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton d {
+  var x;
+  discrete c, l;
+  mode m (l = - # a comment between the sign and the digits
+           3, c = +1) { x' = 1; }
+  mode n (c = 0, l = 2e0) { }
+  init m { x = 0; }
+})");
+  const int c = *a.symbols().Find("c"), l = *a.symbols().Find("l");
+  EXPECT_EQ(a.symbols()[c].kind, SymbolKind::kDiscrete);
+  EXPECT_EQ(a.modes()[0].discrete_values, (std::vector<std::pair<int, int>>{{c, 1}, {l, -3}}));
+  EXPECT_EQ(a.modes()[1].discrete_values, (std::vector<std::pair<int, int>>{{c, 0}, {l, 2}}));
+  EXPECT_TRUE(a.modes()[1].flows.empty());
+}
+
+TEST(Parser, TransitionsGuardsResetsLabelsAndUrgency) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton t {
+  var x, y;
+  input u in [0, 1];
+  mode m { x' = u; inv x <= 10 and y >= -1; }
+  mode n { x' = -1; }
+  transition m -> n { guard x >= 5 and u > 0.5; reset y := x + 1, x := 0; label hit; }
+  transition m -> n { lazy; }
+  transition back: n -> m { guard x <= 0; urgent; }
+  transition m -> n { guard true; }
+  init m { x = 0; y = 0; }
+})");
+  const Expression x = Sym(a, "x"), y = Sym(a, "y"), u = Sym(a, "u");
+  EXPECT_EQ(a.modes()[0].invariant.comparisons,
+            (std::vector<Comparison>{{x, Relation::kLessEqual, C(10)},
+                                     {y, Relation::kGreaterEqual, C(-1)}}));
+  ASSERT_EQ(a.num_transitions(), 4);
+  const Transition& t0 = a.transitions()[0];
+  EXPECT_EQ(t0.name, "m_to_n");
+  EXPECT_EQ(t0.source, ModeId(0));
+  EXPECT_EQ(t0.target, ModeId(1));
+  EXPECT_EQ(t0.label, "hit");
+  EXPECT_EQ(t0.urgency, Urgency::kUrgent);
+  EXPECT_EQ(t0.guard.comparisons,
+            (std::vector<Comparison>{{x, Relation::kGreaterEqual, C(5)},
+                                     {u, Relation::kGreater, C(0.5)}}));
+  // Resets are sorted by slot whatever the order written.
+  EXPECT_EQ(t0.resets, (std::vector<Reset>{{0, C(0)}, {1, x + C(1)}}));
+  EXPECT_EQ(a.transitions()[1].name, "m_to_n_2");
+  EXPECT_EQ(a.transitions()[1].urgency, Urgency::kLazy);
+  EXPECT_TRUE(a.transitions()[1].guard.empty());
+  EXPECT_EQ(a.transitions()[2].name, "back");
+  EXPECT_EQ(a.transitions()[2].urgency, Urgency::kUrgent);
+  EXPECT_EQ(a.transitions()[3].name, "m_to_n_3");
+  EXPECT_TRUE(a.transitions()[3].guard.empty());
+}
+
+TEST(Parser, ScenarioSignals) {
+  const System s = ParseModel(R"(
+automaton sc {
+  var x;
+  input u in [-1, 1];
+  input v in [0, 10];
+  input w in [0, 1];
+  mode m { x' = u + v + w; }
+  init m { x = 0; }
+  scenario {
+    until 20;
+    u = step(0: 1, 5: -1, 10: 0);
+    v = linear(-1: 0, 2.5: 10);
+    w = 0.25;
+  }
+})",
+                              "sc.ha");
+  ASSERT_TRUE(s.scenario().has_value());
+  const Scenario& sc = *s.scenario();
+  EXPECT_EQ(sc.until, 20.0);
+  ASSERT_EQ(sc.inputs.size(), 3u);
+  EXPECT_EQ(sc.inputs[0].slot, *s.symbols().Find("u"));
+  EXPECT_EQ(sc.inputs[0].shape, InputSignal::Shape::kStep);
+  EXPECT_EQ(sc.inputs[0].points,
+            (std::vector<std::pair<double, double>>{{0, 1}, {5, -1}, {10, 0}}));
+  EXPECT_EQ(sc.inputs[1].shape, InputSignal::Shape::kLinear);
+  EXPECT_EQ(sc.inputs[1].points, (std::vector<std::pair<double, double>>{{-1, 0}, {2.5, 10}}));
+  EXPECT_EQ(sc.inputs[2].points, (std::vector<std::pair<double, double>>{{0, 0.25}}));
+  EXPECT_EQ(s.components()[0].source.scenario(), s.scenario());
+}
+
+TEST(Parser, Properties) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton p {
+  var x;
+  discrete d;
+  mode low (d = 0) { x' = 1; }
+  mode high (d = 1) { x' = -1; }
+  init low { x = 0; }
+  property safe: always x >= 0 and x <= 10;
+  property never_high_and_big: never in high and x > 5 or d == 2 within 100;
+  property reaches: reach not (in low) and (x > 1 or false);
+})");
+  const Expression x = Sym(a, "x"), d = Sym(a, "d");
+  ASSERT_EQ(a.properties().size(), 3u);
+  const Property& p0 = a.properties()[0];
+  EXPECT_EQ(p0.name, "safe");
+  EXPECT_EQ(p0.kind, Property::Kind::kAlways);
+  EXPECT_FALSE(p0.horizon.has_value());
+  EXPECT_EQ(p0.predicate, Predicate::And(Predicate::Compare({x, Relation::kGreaterEqual, C(0)}),
+                                         Predicate::Compare({x, Relation::kLessEqual, C(10)})));
+  const Property& p1 = a.properties()[1];
+  EXPECT_EQ(p1.kind, Property::Kind::kNever);
+  EXPECT_EQ(p1.horizon, 100.0);
+  // `and` binds tighter than `or`.
+  EXPECT_EQ(p1.predicate,
+            Predicate::Or(Predicate::And(Predicate::InMode("high"),
+                                         Predicate::Compare({x, Relation::kGreater, C(5)})),
+                          Predicate::Compare({d, Relation::kEqual, C(2)})));
+  const Property& p2 = a.properties()[2];
+  EXPECT_EQ(p2.kind, Property::Kind::kReach);
+  EXPECT_EQ(p2.predicate,
+            Predicate::And(Predicate::Not(Predicate::InMode("low")),
+                           Predicate::Or(Predicate::Compare({x, Relation::kGreater, C(1)}),
+                                         Predicate::False())));
+}
+
+TEST(Parser, SystemWithInstancesAndShare) {
+  const System s = ParseModel(R"(
+automaton tank {
+  param k = 2;
+  var level, flow;
+  input valve in [0, 1];
+  mode filling { level' = k * valve - flow; }
+  mode full { }
+  transition filling -> full { guard level >= 10; label stop; }
+  init filling { level = 0; flow = 1; }
+}
+
+system plant {
+  share flow, valve, stop;
+  instance A = tank;
+  instance B = tank;
+  property both_full: reach in A.full and in B.full;
+  property low: always A.level <= 10;
+  scenario { until 5; valve = 1; }
+}
+)",
+                              "plant.ha");
+  EXPECT_EQ(s.name(), "plant");
+  EXPECT_EQ(s.shared(), (std::set<std::string>{"flow", "stop", "valve"}));
+  ASSERT_EQ(s.components().size(), 2u);
+  EXPECT_EQ(s.components()[0].instance, "A");
+  EXPECT_EQ(s.components()[1].instance, "B");
+  std::vector<std::string> names;
+  for (int i = 0; i < s.symbols().size(); ++i) names.push_back(s.symbols()[i].name);
+  EXPECT_EQ(names, (std::vector<std::string>{"A.k", "A.level", "flow", "valve", "B.k", "B.level"}));
+  EXPECT_EQ(s.components()[0].global_slot, (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(s.components()[1].global_slot, (std::vector<int>{4, 5, 2, 3}));
+  // The shared label keeps its name; the source automaton is kept as declared.
+  EXPECT_EQ(s.components()[1].automaton.transitions()[0].label, "stop");
+  EXPECT_EQ(s.components()[1].source.symbols()[1].name, "level");
+  EXPECT_EQ(s.QualifiedModeName(1, ModeId(1)), "B.full");
+  ASSERT_EQ(s.properties().size(), 2u);
+  EXPECT_EQ(s.properties()[0].predicate,
+            Predicate::And(Predicate::InMode("A.full"), Predicate::InMode("B.full")));
+  EXPECT_EQ(s.properties()[1].predicate,
+            Predicate::Compare({Expression::Symbol("A.level", 1), Relation::kLessEqual, C(10)}));
+  ASSERT_TRUE(s.scenario().has_value());
+  EXPECT_EQ(s.scenario()->inputs[0].slot, 3);
+}
+
+TEST(Parser, InstanceWithoutAliasIsUnqualified) {
+  const System s = ParseModel(std::string(kSmallModel) + "system s { instance a; }\n", "t.ha");
+  ASSERT_EQ(s.components().size(), 1u);
+  EXPECT_EQ(s.components()[0].instance, "");
+  EXPECT_EQ(s.symbols()[0].name, "x");
+}
+
+TEST(Parser, Imports) {
+  TempDir dir;
+  fs::create_directories(dir.path() / "lib");
+  dir.Write("lib/base.ha", "automaton base { var x; mode m { x' = 1; } init m { x = 0; } }\n");
+  // Two files import base.ha: the diamond brings the same automaton twice, which is fine.
+  dir.Write("lib/left.ha",
+            "import \"base.ha\";\nautomaton left { var y; mode m { y' = 1; } init m { y = 0; } }\n");
+  dir.Write("lib/right.ha", "import \"base.ha\";\n");
+  const fs::path main = dir.Write("main.ha", R"(# Imports are relative to the importing file.
+import "lib/left.ha";
+import "lib/right.ha";
+system s {
+  instance B = base;
+  instance L = left;
+}
+)");
+  const System s = ParseModelFile(main);
+  ASSERT_EQ(s.components().size(), 2u);
+  EXPECT_EQ(s.components()[0].source.name(), "base");
+  EXPECT_EQ(s.components()[1].source.name(), "left");
+  EXPECT_EQ(s.symbols()[0].name, "B.x");
+  EXPECT_EQ(s.symbols()[1].name, "L.y");
+}
+
+TEST(Parser, ImportThatRedefinesAnAutomatonIsAnError) {
+  TempDir dir;
+  dir.Write("one.ha", "automaton a { var x; mode m { x' = 1; } init m { x = 0; } }\n");
+  dir.Write("two.ha", "automaton a { var x; mode m { x' = 2; } init m { x = 0; } }\n");
+  const fs::path main = dir.Write("main.ha", "import \"one.ha\";\nimport \"two.ha\";\n");
+  try {
+    ParseModelFile(main);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), main.string());
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_EQ(e.column(), 1);
+    EXPECT_EQ(e.message(), "import redefines automaton 'a'");
+  }
+}
+
+TEST(Parser, FileWithOnlyAnImportedAutomatonDeclaresNothing) {
+  TempDir dir;
+  dir.Write("lib.ha", kSmallModel);
+  const fs::path main = dir.Write("main.ha", "import \"lib.ha\";\n");
+  try {
+    ParseModelFile(main);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.message(), "the file declares no automaton and no system");
+  }
+}
+
+TEST(Parser, CommentsAndWhitespaceAnywhere) {
+  const Automaton a = OnlyAutomaton(
+      "#c\n\tautomaton#c\n a #c\n{ var #c\n x\r\n;mode m{x'#c\n=#c\n1#c\n;}init m{x=0;}}#end");
+  EXPECT_EQ(a.num_modes(), 1);
+  EXPECT_EQ(a.modes()[0].flows[0].second, C(1));
+}
+
+TEST(Parser, ErrorLocationsCountBytesAndLines) {
+  // A tab is one column; CRLF ends a line.
+  const ParseError e = ParseFailure("automaton a {\r\n\tvar x;\r\n\tmode m { x' = q; }\r\n}\r\n");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.column(), 16);
+  EXPECT_EQ(e.message(), "undefined name 'q'");
+}
+
+}  // namespace
+}  // namespace hybrid
