@@ -2,38 +2,148 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace hybrid {
 
+// Binary operations come in three forms: right operand on the stack (S), a constant in the
+// instruction (C) or a symbol read from the environment (V). The accumulator holds the top of the
+// stack; `stack` holds the entries below it.
+#define HYBRID_BINARY_CODES(OP) OP##S, OP##C, OP##V
+enum class CompiledExpression::Code : std::uint32_t {
+  kPushC,
+  kPushV,
+  kNeg,
+  kSin,
+  kCos,
+  kTan,
+  kExp,
+  kLog,
+  kSqrt,
+  kAbs,
+  kSign,
+  kSquare,
+  kCube,
+  kPowInt,  // slot holds the (small) integer exponent
+  HYBRID_BINARY_CODES(kAdd),
+  HYBRID_BINARY_CODES(kSub),
+  HYBRID_BINARY_CODES(kMul),
+  HYBRID_BINARY_CODES(kDiv),
+  HYBRID_BINARY_CODES(kPow),
+  HYBRID_BINARY_CODES(kMin),
+  HYBRID_BINARY_CODES(kMax),
+  HYBRID_BINARY_CODES(kAtan2),
+  kRSubC,  // acc = value - acc
+  kRSubV,  // acc = env[slot] - acc
+  kRDivC,
+  kRDivV,
+  kEnd,
+};
+#undef HYBRID_BINARY_CODES
+
+namespace {
+
+using Code = CompiledExpression::Code;
+
+Code UnaryCode(Op op) {
+  switch (op) {
+    case Op::kNeg: return Code::kNeg;
+    case Op::kSin: return Code::kSin;
+    case Op::kCos: return Code::kCos;
+    case Op::kTan: return Code::kTan;
+    case Op::kExp: return Code::kExp;
+    case Op::kLog: return Code::kLog;
+    case Op::kSqrt: return Code::kSqrt;
+    case Op::kAbs: return Code::kAbs;
+    case Op::kSign: return Code::kSign;
+    default: throw std::logic_error("CompiledExpression: not a unary op");
+  }
+}
+
+// The stack form of a binary op; the constant and symbol forms follow it.
+Code BinaryCode(Op op) {
+  switch (op) {
+    case Op::kAdd: return Code::kAddS;
+    case Op::kSub: return Code::kSubS;
+    case Op::kMul: return Code::kMulS;
+    case Op::kDiv: return Code::kDivS;
+    case Op::kPow: return Code::kPowS;
+    case Op::kMin: return Code::kMinS;
+    case Op::kMax: return Code::kMaxS;
+    case Op::kAtan2: return Code::kAtan2S;
+    default: throw std::logic_error("CompiledExpression: not a binary op");
+  }
+}
+
+Code Offset(Code base, int k) {
+  return static_cast<Code>(static_cast<std::uint32_t>(base) + static_cast<std::uint32_t>(k));
+}
+
+double PowInt(double x, int n) {
+  double r = 1.0;
+  for (int i = 0; i < std::abs(n); ++i) r *= x;
+  return n < 0 ? 1.0 / r : r;
+}
+
+}  // namespace
+
 CompiledExpression::CompiledExpression() : CompiledExpression(Expression::Constant(0.0)) {}
 
-CompiledExpression::CompiledExpression(const Expression& expression) { Emit(expression, 1); }
+CompiledExpression::CompiledExpression(const Expression& expression) {
+  Emit(expression, 1);
+  code_.push_back({Code::kEnd, 0, 0.0});
+}
 
-// Emits code leaving the value of `e` on top of the stack; `depth` is the stack height after it.
+// Emits code that leaves the value of `e` in the accumulator; `depth` counts the stack entries
+// in use (accumulator included) once it is there.
 void CompiledExpression::Emit(const Expression& e, int depth) {
   max_depth_ = std::max(max_depth_, depth);
   switch (e.op()) {
-    case Op::kConstant:
-      code_.push_back({Op::kConstant, Operand::kConstant, -1, e.constant()});
-      return;
-    case Op::kSymbol:
-      code_.push_back({Op::kSymbol, Operand::kSlot, e.slot(), 0.0});
-      return;
+    case Op::kConstant: code_.push_back({Code::kPushC, 0, e.constant()}); return;
+    case Op::kSymbol: code_.push_back({Code::kPushV, e.slot(), 0.0}); return;
     default: break;
   }
   Emit(e.args()[0], depth);
   if (Arity(e.op()) == 1) {
-    code_.push_back({e.op(), Operand::kStack, -1, 0.0});
+    code_.push_back({UnaryCode(e.op()), 0, 0.0});
     return;
   }
   const Expression& rhs = e.args()[1];
+  if (e.op() == Op::kPow && rhs.is_constant() && std::nearbyint(rhs.constant()) == rhs.constant() &&
+      std::abs(rhs.constant()) <= 4) {
+    const int n = static_cast<int>(rhs.constant());
+    if (n == 2) code_.push_back({Code::kSquare, 0, 0.0});
+    else if (n == 3) code_.push_back({Code::kCube, 0, 0.0});
+    else code_.push_back({Code::kPowInt, n, 0.0});
+    return;
+  }
+  const Code base = BinaryCode(e.op());
+  const Expression& lhs = e.args()[0];
+  if ((lhs.is_constant() || lhs.is_symbol()) && !rhs.is_constant() && !rhs.is_symbol() &&
+      (e.op() == Op::kAdd || e.op() == Op::kMul || e.op() == Op::kSub || e.op() == Op::kDiv)) {
+    // A leaf on the left of a compound right operand: evaluate the right operand first and apply
+    // the operation with the leaf taken from the instruction (exact: + and * commute in IEEE
+    // arithmetic, and the reversed forms compute leaf - acc and leaf / acc).
+    code_.pop_back();  // the push of the leaf emitted above
+    Emit(rhs, depth);
+    Code code;
+    switch (e.op()) {
+      case Op::kAdd: code = lhs.is_constant() ? Code::kAddC : Code::kAddV; break;
+      case Op::kMul: code = lhs.is_constant() ? Code::kMulC : Code::kMulV; break;
+      case Op::kSub: code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV; break;
+      default: code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV; break;
+    }
+    code_.push_back({code, lhs.is_symbol() ? lhs.slot() : 0,
+                     lhs.is_constant() ? lhs.constant() : 0.0});
+    return;
+  }
   if (rhs.is_constant()) {
-    code_.push_back({e.op(), Operand::kConstant, -1, rhs.constant()});
+    code_.push_back({Offset(base, 1), 0, rhs.constant()});
   } else if (rhs.is_symbol()) {
-    code_.push_back({e.op(), Operand::kSlot, rhs.slot(), 0.0});
+    code_.push_back({Offset(base, 2), rhs.slot(), 0.0});
   } else {
     Emit(rhs, depth + 1);
-    code_.push_back({e.op(), Operand::kStack, -1, 0.0});
+    code_.push_back({base, 0, 0.0});
   }
 }
 
@@ -47,39 +157,111 @@ double CompiledExpression::Evaluate(const double* env) const {
 }
 
 double CompiledExpression::Run(const double* env, double* stack) const {
-  double* top = stack - 1;  // points at the top element once something is pushed
-  for (const Instruction& in : code_) {
-    switch (in.op) {
-      case Op::kConstant: *++top = in.value; continue;
-      case Op::kSymbol: *++top = env[in.slot]; continue;
-      case Op::kNeg: *top = -*top; continue;
-      case Op::kSin: *top = std::sin(*top); continue;
-      case Op::kCos: *top = std::cos(*top); continue;
-      case Op::kTan: *top = std::tan(*top); continue;
-      case Op::kExp: *top = std::exp(*top); continue;
-      case Op::kLog: *top = std::log(*top); continue;
-      case Op::kSqrt: *top = std::sqrt(*top); continue;
-      case Op::kAbs: *top = std::abs(*top); continue;
-      case Op::kSign: *top = *top > 0.0 ? 1.0 : (*top < 0.0 ? -1.0 : 0.0); continue;
-      default: break;
-    }
-    const double b = in.operand == Operand::kStack      ? *top--
-                     : in.operand == Operand::kConstant ? in.value
-                                                        : env[in.slot];
-    double& a = *top;
-    switch (in.op) {
-      case Op::kAdd: a = a + b; break;
-      case Op::kSub: a = a - b; break;
-      case Op::kMul: a = a * b; break;
-      case Op::kDiv: a = a / b; break;
-      case Op::kPow: a = std::pow(a, b); break;
-      case Op::kMin: a = std::min(a, b); break;
-      case Op::kMax: a = std::max(a, b); break;
-      case Op::kAtan2: a = std::atan2(a, b); break;
-      default: break;
-    }
+  // Direct threading (GCC/Clang "labels as values"): each handler jumps straight to the next.
+  static const void* const kDispatch[] = {
+      &&push_c, &&push_v, &&neg,   &&sin_,  &&cos_,  &&tan_,   &&exp_,   &&log_,
+      &&sqrt_,  &&abs_,   &&sign_, &&sq,    &&cube,  &&powint, &&add_s,  &&add_c,
+      &&add_v,  &&sub_s,  &&sub_c, &&sub_v, &&mul_s, &&mul_c,  &&mul_v,  &&div_s,
+      &&div_c,  &&div_v,  &&pow_s, &&pow_c, &&pow_v, &&min_s,  &&min_c,  &&min_v,
+      &&max_s,  &&max_c,  &&max_v, &&atan2_s, &&atan2_c, &&atan2_v, &&rsub_c, &&rsub_v,
+      &&rdiv_c, &&rdiv_v, &&end};
+  static_assert(sizeof(kDispatch) / sizeof(kDispatch[0]) ==
+                static_cast<std::size_t>(Code::kEnd) + 1);
+  const Instruction* pc = code_.data();
+  double acc = 0.0;
+  double* sp = stack;  // next free entry below the accumulator
+#define NEXT goto* kDispatch[static_cast<std::uint32_t>((++pc)->code)]
+#define BINARY(label, expr_s, expr_c, expr_v) \
+  label##_s : {                               \
+    const double b = acc;                     \
+    const double a = *--sp;                   \
+    acc = (expr_s);                           \
+    NEXT;                                     \
+  }                                           \
+  label##_c : {                               \
+    const double a = acc;                     \
+    const double b = pc->value;               \
+    acc = (expr_c);                           \
+    NEXT;                                     \
+  }                                           \
+  label##_v : {                               \
+    const double a = acc;                     \
+    const double b = env[pc->slot];           \
+    acc = (expr_v);                           \
+    NEXT;                                     \
   }
-  return *top;
+#define BINARY_SAME(label, expr) BINARY(label, expr, expr, expr)
+
+  goto* kDispatch[static_cast<std::uint32_t>(pc->code)];
+push_c:
+  *sp++ = acc;
+  acc = pc->value;
+  NEXT;
+push_v:
+  *sp++ = acc;
+  acc = env[pc->slot];
+  NEXT;
+neg:
+  acc = -acc;
+  NEXT;
+sin_:
+  acc = std::sin(acc);
+  NEXT;
+cos_:
+  acc = std::cos(acc);
+  NEXT;
+tan_:
+  acc = std::tan(acc);
+  NEXT;
+exp_:
+  acc = std::exp(acc);
+  NEXT;
+log_:
+  acc = std::log(acc);
+  NEXT;
+sqrt_:
+  acc = std::sqrt(acc);
+  NEXT;
+abs_:
+  acc = std::abs(acc);
+  NEXT;
+sign_:
+  acc = acc > 0.0 ? 1.0 : (acc < 0.0 ? -1.0 : 0.0);
+  NEXT;
+sq:
+  acc = acc * acc;
+  NEXT;
+cube:
+  acc = acc * acc * acc;
+  NEXT;
+powint:
+  acc = PowInt(acc, pc->slot);
+  NEXT;
+  BINARY_SAME(add, a + b)
+  BINARY_SAME(sub, a - b)
+  BINARY_SAME(mul, a * b)
+  BINARY_SAME(div, a / b)
+  BINARY_SAME(pow, std::pow(a, b))
+  BINARY_SAME(min, std::min(a, b))
+  BINARY_SAME(max, std::max(a, b))
+  BINARY_SAME(atan2, std::atan2(a, b))
+rsub_c:
+  acc = pc->value - acc;
+  NEXT;
+rsub_v:
+  acc = env[pc->slot] - acc;
+  NEXT;
+rdiv_c:
+  acc = pc->value / acc;
+  NEXT;
+rdiv_v:
+  acc = env[pc->slot] / acc;
+  NEXT;
+end:
+  return acc;
+#undef BINARY_SAME
+#undef BINARY
+#undef NEXT
 }
 
 }  // namespace hybrid

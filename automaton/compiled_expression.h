@@ -10,12 +10,16 @@ namespace hybrid {
 
 /// An Expression compiled once into a flat postfix program for fast repeated evaluation.
 ///
-/// Evaluation walks a contiguous instruction array with a small value stack: no tree pointers, no
-/// strings, no map look-ups and no heap allocation (for programs whose stack depth is at most
-/// kMaxInlineStack, which covers every expression of practical size; deeper ones use a heap buffer).
-/// Binary operations whose right operand is a constant or a symbol read it directly from the
-/// instruction, halving the dispatches of typical flows such as `m1 * u`.
-/// The result equals Expression::Evaluate bit for bit (same operations in the same order).
+/// The program is an array of 16-byte instructions run by a direct-threaded interpreter (one
+/// indirect jump per instruction) that keeps the top of the value stack in a register. There are
+/// no tree pointers, strings, map look-ups or heap allocations per evaluation (programs deeper
+/// than kMaxInlineStack use a heap buffer). Binary operations whose right operand is a constant
+/// or a symbol read it straight from the instruction, and `x^n` for a small integer constant n
+/// becomes repeated multiplication.
+///
+/// The result equals Expression::Evaluate bit for bit, except that `x^n` with integer n in
+/// [-4, 4] is computed by multiplication (like the C++ compilers' own expansion of std::pow with
+/// small integer exponents), which can differ from std::pow in the last bit.
 class CompiledExpression {
  public:
   static constexpr int kMaxInlineStack = 64;
@@ -31,11 +35,12 @@ class CompiledExpression {
   /// Number of instructions (for diagnostics and tests).
   int size() const { return static_cast<int>(code_.size()); }
 
+  /// Opcodes; public only so that the implementation's dispatch table can name them.
+  enum class Code : std::uint32_t;
+
  private:
-  enum class Operand : std::uint8_t { kStack, kConstant, kSlot };
   struct Instruction {
-    Op op;
-    Operand operand;  // where the right operand (binary) or the pushed value (leaf) comes from
+    Code code;
     std::int32_t slot;
     double value;
   };

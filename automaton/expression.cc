@@ -193,6 +193,32 @@ AffineForm Combine(const AffineForm& a, const AffineForm& b, double sign) {
   return r;
 }
 
+/// FoldConstants() of `e`, with the value of `e` when it reads no symbol. A symbol-free subtree
+/// whose value is not finite stays unfolded but still passes its value up, so that a finite
+/// result above it (`sign(log(0))`, `min(1 / 0, 2)`) folds like any other symbol-free subtree.
+std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e) {
+  switch (e.op()) {
+    case Op::kConstant: return {e, e.constant()};
+    case Op::kSymbol: return {e, std::nullopt};
+    default: break;
+  }
+  std::vector<Expression> args;
+  std::vector<double> values;
+  for (const Expression& a : e.args()) {
+    auto [folded, value] = FoldWithValue(a);
+    args.push_back(std::move(folded));
+    if (value) values.push_back(*value);
+  }
+  const bool unary = Arity(e.op()) == 1;
+  std::optional<double> value;
+  if (values.size() == args.size()) {
+    value = unary ? ApplyUnary(e.op(), values[0]) : ApplyBinary(e.op(), values[0], values[1]);
+    if (std::isfinite(*value)) return {Expression::Constant(*value), value};
+  }
+  return {unary ? Expression::Unary(e.op(), args[0]) : Expression::Binary(e.op(), args[0], args[1]),
+          value};
+}
+
 }  // namespace
 
 int Arity(Op op) {
@@ -430,22 +456,7 @@ Expression Expression::Substitute(
   return Binary(n.op, n.args[0].Substitute(f), n.args[1].Substitute(f));
 }
 
-Expression Expression::FoldConstants() const {
-  const Node& n = *node_;
-  if (Arity(n.op) == 0) return *this;
-  std::vector<Expression> args;
-  bool all_constant = true;
-  for (const Expression& a : n.args) {
-    args.push_back(a.FoldConstants());
-    all_constant = all_constant && args.back().is_constant();
-  }
-  if (all_constant) {
-    const double v = Arity(n.op) == 1 ? ApplyUnary(n.op, args[0].constant())
-                                      : ApplyBinary(n.op, args[0].constant(), args[1].constant());
-    if (std::isfinite(v)) return Constant(v);
-  }
-  return Arity(n.op) == 1 ? Unary(n.op, args[0]) : Binary(n.op, args[0], args[1]);
-}
+Expression Expression::FoldConstants() const { return FoldWithValue(*this).first; }
 
 std::string Expression::ToString() const {
   std::string out;

@@ -331,9 +331,13 @@ TEST(ExpressionTest, FoldConstants) {
   EXPECT_EQ((C(2.0) * C(3.0) + x).FoldConstants(), C(6.0) + x);
   EXPECT_EQ((x * (C(1.0) + C(1.0))).FoldConstants(), x * C(2.0));
   EXPECT_EQ(Fn(Op::kSin, Pow(C(2.0), C(-1.0))).FoldConstants(), C(std::sin(0.5)));
-  // Non-finite results stay unfolded.
+  EXPECT_EQ((x + C(1.0) * C(2.0)).FoldConstants(), x + C(2.0));
+  // Non-finite results stay unfolded, but a finite result above them folds.
   EXPECT_EQ((C(1.0) / C(0.0)).FoldConstants(), C(1.0) / C(0.0));
   EXPECT_EQ(Fn(Op::kLog, C(-1.0)).FoldConstants(), Fn(Op::kLog, C(-1.0)));
+  EXPECT_EQ(Fn(Op::kSign, Fn(Op::kLog, C(0.0))).FoldConstants(), C(-1.0));
+  EXPECT_EQ(Fn(Op::kMin, C(1.0) / C(0.0), C(2.0) + C(1.0)).FoldConstants(), C(3.0));
+  EXPECT_EQ((x * Fn(Op::kExp, -(C(1.0) / C(0.0)))).FoldConstants(), x * C(0.0));
 }
 
 // --- properties ------------------------------------------------------------------------------
@@ -418,6 +422,15 @@ Expression RandomAffine(int depth) {
   }
 }
 
+/// The largest finite magnitude of `e` and its subexpressions at `env`: evaluating `e` may lose
+/// about eps times this to cancellation (x + 1e20 - 1e20), which an affine form does not.
+double LargestMagnitude(const Expression& e, std::span<const double> env) {
+  const double v = std::abs(e.Evaluate(env));
+  double m = std::isfinite(v) ? v : 0.0;
+  for (const Expression& a : e.args()) m = std::max(m, LargestMagnitude(a, env));
+  return m;
+}
+
 void CheckAffineForm(const Expression& e, const AffineForm& form) {
   for (size_t i = 0; i < form.terms.size(); ++i) {
     RC_ASSERT(form.terms[i].second != 0.0);
@@ -434,6 +447,7 @@ void CheckAffineForm(const Expression& e, const AffineForm& form) {
       value += c * point[slot];
       scale += std::abs(c * point[slot]);
     }
+    scale = std::max(scale, LargestMagnitude(e, point));
     RC_ASSERT(std::abs(value - expected) <= 1e-9 * (1.0 + scale + std::abs(expected)));
   }
 }

@@ -61,10 +61,15 @@ std::vector<Leaf> StandardLeaves() {
   return leaves;
 }
 
-Expression RandomLeaf(const std::vector<Leaf>& leaves) {
+/// A symbol of `leaves` or a constant; `moderate` constants are at most 10, so that finite
+/// differences can resolve the expressions they appear in (sin(1e20 + x) cannot).
+Expression RandomLeaf(const std::vector<Leaf>& leaves, bool moderate = false) {
   if (!leaves.empty() && Chance(60)) {
     const Leaf& leaf = Pick(leaves);
     return Expression::Symbol(leaf.name, leaf.slot);
+  }
+  if (moderate) {
+    return Expression::Constant(Chance(50) ? Uniform(0, 11) : Uniform(0, 1001) / 100.0);
   }
   return Expression::Constant(*GenConstant());
 }
@@ -85,7 +90,7 @@ Expression Num(double v) { return Expression::Constant(v); }
 
 /// Operations smooth on the whole real line (compositions of them are smooth too).
 Expression RandomSmoothExpression(int depth, const std::vector<Leaf>& leaves) {
-  if (depth <= 0 || Chance(25)) return RandomLeaf(leaves);
+  if (depth <= 0 || Chance(25)) return RandomLeaf(leaves, /*moderate=*/true);
   const auto sub = [&] { return RandomSmoothExpression(depth - 1, leaves); };
   switch (Uniform(0, 14)) {
     case 0: return -sub();
