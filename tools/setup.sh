@@ -16,6 +16,7 @@ packages=(
   nlohmann-json3-dev     # --json output
   graphviz               # `dot -Tsvg` for the rendered mode graphs
   clang-format
+  python3                # tools/generate_finger.py (checked by a test), benchmark scripts
 )
 
 sudo_cmd=()

@@ -1,0 +1,167 @@
+// The Automaton API validates every declaration and names itself in the error.
+#include "automaton/automaton.h"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace hybrid {
+namespace {
+
+Expression Sym(const Automaton& a, const std::string& name) {
+  return Expression::Symbol(name, *a.symbols().Find(name));
+}
+
+// Expects `f` to throw std::invalid_argument whose message contains `api` and `detail`.
+template <class F>
+void ExpectInvalid(F f, const std::string& api, const std::string& detail) {
+  try {
+    f();
+    FAIL() << "no exception; expected " << detail;
+  } catch (const std::invalid_argument& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(api), std::string::npos) << message;
+    EXPECT_NE(message.find(detail), std::string::npos) << message;
+  }
+}
+
+class AutomatonTest : public ::testing::Test {
+ protected:
+  AutomatonTest() : a_("ball") {
+    a_.AddParameter("g", Expression::Constant(9.81));
+    a_.AddVariable("h", "m", Range{Expression::Constant(0), Expression::Constant(100)});
+    a_.AddVariable("v");
+    a_.AddInput("u", {Expression::Constant(-1), Expression::Constant(1)});
+    Mode falling;
+    falling.name = "falling";
+    falling.flows = {{Slot("h"), Sym(a_, "v")}, {Slot("v"), -Sym(a_, "g")}};
+    falling.invariant.comparisons.push_back(
+        {Sym(a_, "h"), Relation::kGreaterEqual, Expression::Constant(0)});
+    falling_ = a_.AddMode(falling);
+  }
+  int Slot(const std::string& name) const { return *a_.symbols().Find(name); }
+
+  Automaton a_;
+  ModeId falling_;
+};
+
+TEST_F(AutomatonTest, SlotsFollowDeclarationOrder) {
+  EXPECT_EQ(Slot("g"), 0);
+  EXPECT_EQ(Slot("h"), 1);
+  EXPECT_EQ(Slot("v"), 2);
+  EXPECT_EQ(Slot("u"), 3);
+  EXPECT_EQ(a_.variables().size(), 2u);
+  EXPECT_EQ(a_.symbols()[1].unit, "m");
+}
+
+TEST_F(AutomatonTest, ParameterEnvironmentEvaluatesInOrder) {
+  a_.AddParameter("g2", Sym(a_, "g") * Expression::Constant(2));
+  const std::vector<double> env = a_.ParameterEnvironment();
+  EXPECT_DOUBLE_EQ(env[Slot("g2")], 19.62);
+  EXPECT_DOUBLE_EQ(env[Slot("h")], 0.0);
+}
+
+TEST_F(AutomatonTest, RejectsDuplicateNames) {
+  ExpectInvalid([&] { a_.AddVariable("h"); }, "Automaton::AddVariable", "duplicate name 'h'");
+  ExpectInvalid([&] { a_.AddParameter("v", Expression::Constant(1)); },
+                "Automaton::AddParameter", "already declared as variable");
+}
+
+TEST_F(AutomatonTest, ParametersReadOnlyEarlierParameters) {
+  ExpectInvalid([&] { a_.AddParameter("k", Sym(a_, "h")); }, "Automaton::AddParameter",
+                "variable 'h' is not allowed");
+  ExpectInvalid([&] { a_.AddParameter("k", Expression::Constant(1) / Expression::Constant(0)); },
+                "Automaton::AddParameter", "not finite");
+}
+
+TEST_F(AutomatonTest, RejectsFlowsOfNonVariablesAndUnsortedFlows) {
+  Mode m;
+  m.name = "m";
+  m.flows = {{Slot("g"), Expression::Constant(1)}};
+  ExpectInvalid([&] { a_.AddMode(m); }, "Automaton::AddMode", "not a continuous variable");
+  m.flows = {{Slot("v"), Expression::Constant(1)}, {Slot("h"), Expression::Constant(1)}};
+  ExpectInvalid([&] { a_.AddMode(m); }, "Automaton::AddMode", "not sorted");
+  m.flows = {};
+  m.name = "falling";
+  ExpectInvalid([&] { a_.AddMode(m); }, "Automaton::AddMode", "duplicate mode 'falling'");
+}
+
+TEST_F(AutomatonTest, RejectsExpressionsReadingUndeclaredSlots) {
+  Mode m;
+  m.name = "m";
+  m.flows = {{Slot("h"), Expression::Symbol("ghost", 99)}};
+  ExpectInvalid([&] { a_.AddMode(m); }, "Automaton::AddMode", "undeclared slot 99");
+}
+
+TEST_F(AutomatonTest, DiscreteVariablesMustPrecedeModesAndBeSetByEveryMode) {
+  ExpectInvalid([&] { a_.AddDiscreteVariable("c"); }, "Automaton::AddDiscreteVariable",
+                "after the first mode");
+  Automaton b("b");
+  b.AddDiscreteVariable("c");
+  Mode m;
+  m.name = "m";
+  ExpectInvalid([&] { b.AddMode(m); }, "Automaton::AddMode", "does not set discrete variable 'c'");
+  m.discrete_values = {{0, 1}};
+  EXPECT_NO_THROW(b.AddMode(m));
+}
+
+TEST_F(AutomatonTest, TransitionsNeedKnownModesAndResetVariables) {
+  Transition t;
+  t.name = "bounce";
+  t.source = falling_;
+  t.target = ModeId(7);
+  ExpectInvalid([&] { a_.AddTransition(t); }, "Automaton::AddTransition", "unknown target mode");
+  t.target = falling_;
+  t.resets = {{Slot("u"), Expression::Constant(0)}};
+  ExpectInvalid([&] { a_.AddTransition(t); }, "Automaton::AddTransition",
+                "not a continuous variable");
+  t.resets = {{Slot("v"), -Sym(a_, "v")}};
+  EXPECT_EQ(a_.AddTransition(t), TransitionId(0));
+  ExpectInvalid([&] { a_.AddTransition(t); }, "Automaton::AddTransition",
+                "duplicate transition 'bounce'");
+}
+
+TEST_F(AutomatonTest, InitialStatesGiveEveryVariable) {
+  InitialState s{falling_, {{Slot("h"), {Expression::Constant(1), Expression::Constant(1)}, true}}};
+  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState",
+                "no value for 'v'");
+  s.values.push_back({Slot("v"), {Expression::Constant(2), Expression::Constant(1)}, false});
+  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState", "empty initial range");
+  s.values[1].range = {Expression::Constant(0), Expression::Constant(1)};
+  EXPECT_NO_THROW(a_.AddInitialState(s));
+  EXPECT_EQ(a_.initial_states().size(), 1u);
+}
+
+TEST_F(AutomatonTest, PropertiesMayNotReadInputsOrUnknownModes) {
+  Property p{"p", Property::Kind::kAlways,
+             Predicate::Compare({Sym(a_, "u"), Relation::kLess, Expression::Constant(0)}), {}};
+  ExpectInvalid([&] { a_.AddProperty(p); }, "Automaton::AddProperty", "input 'u' is not allowed");
+  p.predicate = Predicate::InMode("nowhere");
+  ExpectInvalid([&] { a_.AddProperty(p); }, "Automaton::AddProperty", "unknown mode 'nowhere'");
+  p.predicate = Predicate::InMode("falling");
+  p.horizon = -1.0;
+  ExpectInvalid([&] { a_.AddProperty(p); }, "Automaton::AddProperty", "horizon");
+}
+
+TEST_F(AutomatonTest, ScenarioSignalsStayInBoundsAndIncrease) {
+  Scenario s{10.0, {{Slot("u"), InputSignal::Shape::kStep, {{0.0, 2.0}}}}};
+  ExpectInvalid([&] { a_.SetScenario(s); }, "Automaton::SetScenario", "outside its bounds");
+  s.inputs[0].points = {{0.0, 1.0}, {0.0, -1.0}};
+  ExpectInvalid([&] { a_.SetScenario(s); }, "Automaton::SetScenario", "increase strictly");
+  s.inputs[0].points = {{0.0, 1.0}, {5.0, -1.0}};
+  s.until = 0.0;
+  ExpectInvalid([&] { a_.SetScenario(s); }, "Automaton::SetScenario", "positive");
+  s.until = 10.0;
+  EXPECT_NO_THROW(a_.SetScenario(s));
+}
+
+TEST_F(AutomatonTest, EqualityIsStructural) {
+  Automaton copy = a_;
+  EXPECT_EQ(copy, a_);
+  copy.AddVariable("w");
+  EXPECT_NE(copy, a_);
+}
+
+}  // namespace
+}  // namespace hybrid
