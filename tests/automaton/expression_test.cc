@@ -196,10 +196,10 @@ TEST(ExpressionPrintTest, FunctionsAndNumbers) {
 }
 
 TEST(ExpressionPrintTest, PrintedExpressionsParseBack) {
-  for (const Expression& e :
-       {-Pow(x, C(2.0)), Pow(-x, C(2.0)), (x - y) - z, x - (y - z), Pow(C(2.0), Pow(C(3.0), C(2.0))),
-        Pow(Pow(C(2.0), C(3.0)), C(2.0)), x - C(-2.0), Pow(C(-2.0), x), Pow(x, C(-0.5)),
-        -(-x), x / (y * z), Fn(Op::kAtan2, -y, x - C(1.0)), C(1.0 / 3.0) * x}) {
+  for (const Expression& e : {-Pow(x, C(2.0)), Pow(-x, C(2.0)), (x - y) - z, x - (y - z),
+                              Pow(C(2.0), Pow(C(3.0), C(2.0))), Pow(Pow(C(2.0), C(3.0)), C(2.0)),
+                              x - C(-2.0), Pow(C(-2.0), x), Pow(x, C(-0.5)), -(-x), x / (y * z),
+                              Fn(Op::kAtan2, -y, x - C(1.0)), C(1.0 / 3.0) * x}) {
     EXPECT_EQ(Parse(e.ToString()), e) << e.ToString();
   }
 }
@@ -297,7 +297,7 @@ TEST(ExpressionDerivativeTest, Examples) {
 TEST(ExpressionDerivativeTest, Values) {
   const std::vector<double> env = {2.0, 3.0, 0.5, -1.0};
   EXPECT_DOUBLE_EQ(Pow(x, C(3.0)).Derivative(0).Evaluate(env), 12.0);
-  EXPECT_DOUBLE_EQ(Pow(x, y).Derivative(0).Evaluate(env), 3.0 * 4.0);             // y x^(y-1)
+  EXPECT_DOUBLE_EQ(Pow(x, y).Derivative(0).Evaluate(env), 3.0 * 4.0);            // y x^(y-1)
   EXPECT_DOUBLE_EQ(Pow(x, y).Derivative(1).Evaluate(env), 8.0 * std::log(2.0));  // x^y log x
   EXPECT_DOUBLE_EQ((x / y).Derivative(1).Evaluate(env), -2.0 / 9.0);
   EXPECT_DOUBLE_EQ(Fn(Op::kLog, x).Derivative(0).Evaluate(env), 0.5);
@@ -411,14 +411,22 @@ Expression RandomAffine(int depth) {
     return Expression::Symbol(testing::kSymbolNames[slot], slot);
   }
   switch (*GenInt(0, 8)) {
-    case 0: return -RandomAffine(depth - 1);
-    case 1: return RandomAffine(depth - 1) + RandomAffine(depth - 1);
-    case 2: return RandomAffine(depth - 1) - RandomAffine(depth - 1);
-    case 3: return C(*GenInt(-4, 5) / 2.0) * RandomAffine(depth - 1);
-    case 4: return RandomAffine(depth - 1) * C(*GenInt(1, 20) / 4.0);
-    case 5: return RandomAffine(depth - 1) / C(*rc::gen::element(2.0, 3.0, -0.5, 10.0));
-    case 6: return Pow(RandomAffine(depth - 1), C(1.0));
-    default: return Fn(Op::kCos, C(*GenInt(0, 4))) * RandomAffine(depth - 1);
+    case 0:
+      return -RandomAffine(depth - 1);
+    case 1:
+      return RandomAffine(depth - 1) + RandomAffine(depth - 1);
+    case 2:
+      return RandomAffine(depth - 1) - RandomAffine(depth - 1);
+    case 3:
+      return C(*GenInt(-4, 5) / 2.0) * RandomAffine(depth - 1);
+    case 4:
+      return RandomAffine(depth - 1) * C(*GenInt(1, 20) / 4.0);
+    case 5:
+      return RandomAffine(depth - 1) / C(*rc::gen::element(2.0, 3.0, -0.5, 10.0));
+    case 6:
+      return Pow(RandomAffine(depth - 1), C(1.0));
+    default:
+      return Fn(Op::kCos, C(*GenInt(0, 4))) * RandomAffine(depth - 1);
   }
 }
 

@@ -42,8 +42,8 @@ double Down(double v) { return std::nextafter(v, -kInf); }
   if (r.lo() <= lo && hi <= r.hi() && outer_lo <= r.lo() && r.hi() <= outer_hi) {
     return ::testing::AssertionSuccess();
   }
-  return ::testing::AssertionFailure() << r.ToString() << " is not a tight enclosure of ["
-                                       << lo << ", " << hi << "]";
+  return ::testing::AssertionFailure()
+         << r.ToString() << " is not a tight enclosure of [" << lo << ", " << hi << "]";
 }
 
 // --- construction ----------------------------------------------------------------------------
@@ -85,8 +85,8 @@ TEST(IntervalTest, InvalidBoundsThrow) {
 TEST(IntervalTest, AdditionAndSubtraction) {
   EXPECT_TRUE(TightlyEncloses(Interval(1.0, 2.0) + Interval(3.0, 4.0), 4.0, 6.0));
   EXPECT_TRUE(TightlyEncloses(Interval(1.0, 2.0) - Interval(3.0, 4.0), -3.0, -1.0));
-  EXPECT_TRUE(TightlyEncloses(Interval(0.1) + Interval(0.2), 0.30000000000000004,
-                              0.30000000000000004));
+  EXPECT_TRUE(
+      TightlyEncloses(Interval(0.1) + Interval(0.2), 0.30000000000000004, 0.30000000000000004));
   // 0.1 + 0.2 rounds up: the exact sum of the two doubles lies below the rounded one.
   EXPECT_LT((Interval(0.1) + Interval(0.2)).lo(), 0.1 + 0.2);
   EXPECT_EQ(-Interval(1.0, 2.0), Interval(-2.0, -1.0));
@@ -282,8 +282,8 @@ void CheckBinaryEnclosure(
     const double q = *GenPointIn(b);
     const double v = f(p, q);
     if (!std::isfinite(v)) continue;
-    RC_LOG() << "a = " << a.ToString() << ", b = " << b.ToString() << ", p = " << p
-             << ", q = " << q << ", f(p, q) = " << v << ", f(a, b) = " << r.ToString() << "\n";
+    RC_LOG() << "a = " << a.ToString() << ", b = " << b.ToString() << ", p = " << p << ", q = " << q
+             << ", f(p, q) = " << v << ", f(a, b) = " << r.ToString() << "\n";
     RC_ASSERT(r.Contains(v));
   }
 }
@@ -308,25 +308,32 @@ RC_GTEST_PROP(IntervalProperty, NegationEncloses, ()) {
                       GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, SqrtEncloses, ()) {
-  CheckUnaryEnclosure(Sqrt, [](double v) { return std::sqrt(v); }, GenArgument(false));
+  CheckUnaryEnclosure(
+      Sqrt, [](double v) { return std::sqrt(v); }, GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, ExpEncloses, ()) {
-  CheckUnaryEnclosure(Exp, [](double v) { return std::exp(v); }, GenArgument(false));
+  CheckUnaryEnclosure(
+      Exp, [](double v) { return std::exp(v); }, GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, LogEncloses, ()) {
-  CheckUnaryEnclosure(Log, [](double v) { return std::log(v); }, GenArgument(false));
+  CheckUnaryEnclosure(
+      Log, [](double v) { return std::log(v); }, GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, SinEncloses, ()) {
-  CheckUnaryEnclosure(Sin, [](double v) { return std::sin(v); }, GenArgument(true));
+  CheckUnaryEnclosure(
+      Sin, [](double v) { return std::sin(v); }, GenArgument(true));
 }
 RC_GTEST_PROP(IntervalProperty, CosEncloses, ()) {
-  CheckUnaryEnclosure(Cos, [](double v) { return std::cos(v); }, GenArgument(true));
+  CheckUnaryEnclosure(
+      Cos, [](double v) { return std::cos(v); }, GenArgument(true));
 }
 RC_GTEST_PROP(IntervalProperty, TanEncloses, ()) {
-  CheckUnaryEnclosure(Tan, [](double v) { return std::tan(v); }, GenArgument(true));
+  CheckUnaryEnclosure(
+      Tan, [](double v) { return std::tan(v); }, GenArgument(true));
 }
 RC_GTEST_PROP(IntervalProperty, AbsEncloses, ()) {
-  CheckUnaryEnclosure(Abs, [](double v) { return std::abs(v); }, GenArgument(false));
+  CheckUnaryEnclosure(
+      Abs, [](double v) { return std::abs(v); }, GenArgument(false));
 }
 
 RC_GTEST_PROP(IntervalProperty, AdditionEncloses, ()) {
@@ -346,27 +353,37 @@ RC_GTEST_PROP(IntervalProperty, DivisionEncloses, ()) {
                        GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, MinEncloses, ()) {
-  CheckBinaryEnclosure(Min, [](double a, double b) { return std::min(a, b); }, GenArgument(false),
-                       GenArgument(false));
+  CheckBinaryEnclosure(
+      Min, [](double a, double b) { return std::min(a, b); }, GenArgument(false),
+      GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, MaxEncloses, ()) {
-  CheckBinaryEnclosure(Max, [](double a, double b) { return std::max(a, b); }, GenArgument(false),
-                       GenArgument(false));
+  CheckBinaryEnclosure(
+      Max, [](double a, double b) { return std::max(a, b); }, GenArgument(false),
+      GenArgument(false));
 }
 RC_GTEST_PROP(IntervalProperty, Atan2Encloses, ()) {
-  CheckBinaryEnclosure(Atan2, [](double a, double b) { return std::atan2(a, b); },
-                       GenArgument(false), GenArgument(false));
+  CheckBinaryEnclosure(
+      Atan2, [](double a, double b) { return std::atan2(a, b); }, GenArgument(false),
+      GenArgument(false));
 }
 
 RC_GTEST_PROP(IntervalProperty, PowEncloses, ()) {
   const Interval base = *GenInterval(*rc::gen::element(1.0, 3.0, 10.0));
   Interval exponent;
   switch (*GenInt(0, 3)) {
-    case 0: exponent = Interval(*GenInt(-6, 7)); break;  // integer: any base
-    case 1: exponent = Interval(*rc::gen::element(0.5, -0.5, 1.5, 2.25, 1e-3)); break;
-    default: exponent = *GenInterval(3.0); break;
+    case 0:
+      exponent = Interval(*GenInt(-6, 7));
+      break;  // integer: any base
+    case 1:
+      exponent = Interval(*rc::gen::element(0.5, -0.5, 1.5, 2.25, 1e-3));
+      break;
+    default:
+      exponent = *GenInterval(3.0);
+      break;
   }
-  CheckBinaryEnclosure(Pow, [](double a, double b) { return std::pow(a, b); }, base, exponent);
+  CheckBinaryEnclosure(
+      Pow, [](double a, double b) { return std::pow(a, b); }, base, exponent);
 }
 
 /// Monotone and bilinear operations attain their extremes at the endpoints: their enclosures

@@ -190,8 +190,7 @@ RC_GTEST_PROP(PrinterProperty, PrintThenParseGivesAnEqualSystem, ()) {
 class SpecRoundTripTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SpecRoundTripTest, PrintThenParseGivesAnEqualSystem) {
-  const std::filesystem::path path =
-      std::filesystem::path(HYBRID_SOURCE_DIR) / "spec" / GetParam();
+  const std::filesystem::path path = std::filesystem::path(HYBRID_SOURCE_DIR) / "spec" / GetParam();
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " does not exist";
   const System system = ParseModelFile(path);
   const std::string text = PrintSystem(system);

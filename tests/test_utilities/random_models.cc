@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -93,14 +94,22 @@ Expression RandomSmoothExpression(int depth, const std::vector<Leaf>& leaves) {
   if (depth <= 0 || Chance(25)) return RandomLeaf(leaves, /*moderate=*/true);
   const auto sub = [&] { return RandomSmoothExpression(depth - 1, leaves); };
   switch (Uniform(0, 14)) {
-    case 0: return -sub();
-    case 1: return sub() + sub();
-    case 2: return sub() - sub();
-    case 3: return sub() * sub();
-    case 4: return Expression::Unary(Op::kSin, sub());
-    case 5: return Expression::Unary(Op::kCos, sub());
-    case 6: return Expression::Binary(Op::kPow, sub(), Num(2.0));
-    case 7: return Expression::Binary(Op::kPow, sub(), Num(3.0));
+    case 0:
+      return -sub();
+    case 1:
+      return sub() + sub();
+    case 2:
+      return sub() - sub();
+    case 3:
+      return sub() * sub();
+    case 4:
+      return Expression::Unary(Op::kSin, sub());
+    case 5:
+      return Expression::Unary(Op::kCos, sub());
+    case 6:
+      return Expression::Binary(Op::kPow, sub(), Num(2.0));
+    case 7:
+      return Expression::Binary(Op::kPow, sub(), Num(3.0));
     case 8: {  // exp of a bounded argument
       const Op bounded = Chance(50) ? Op::kSin : Op::kCos;
       return Expression::Unary(Op::kExp, Expression::Unary(bounded, sub()));
@@ -127,26 +136,33 @@ Expression RandomSmoothExpression(int depth, const std::vector<Leaf>& leaves) {
 /// Words of the model language that are not identifiers, and function names (legal as symbol
 /// names, avoided anyway).
 const std::set<std::string, std::less<>> kReserved = {
-    "automaton", "system", "import", "var",      "discrete", "param",  "input",  "mode",
-    "inv",       "transition", "guard", "reset", "label",    "urgent", "lazy",   "init",
-    "scenario",  "until",  "step",   "linear",   "property", "always", "never",  "reach",
-    "within",    "instance", "share", "and",     "or",       "not",    "in",     "true",
-    "false",     "sin",    "cos",    "tan",      "exp",      "log",    "sqrt",   "abs",
-    "sign",      "min",    "max",    "atan2"};
+    "automaton", "system",     "import", "var",    "discrete", "param",  "input", "mode",
+    "inv",       "transition", "guard",  "reset",  "label",    "urgent", "lazy",  "init",
+    "scenario",  "until",      "step",   "linear", "property", "always", "never", "reach",
+    "within",    "instance",   "share",  "and",    "or",       "not",    "in",    "true",
+    "false",     "sin",        "cos",    "tan",    "exp",      "log",    "sqrt",  "abs",
+    "sign",      "min",        "max",    "atan2"};
 
 /// Identifiers that look like keywords, functions or numbers but are not (they exercise the
 /// parser's word boundaries).
 const std::vector<std::string> kTrickyNames = {
-    "mode_",  "init1", "in_x",  "inv0", "sinx",     "exp_", "not_", "trueish", "e",     "E",
-    "e1",     "E10",  "x",     "_",    "_tmp",     "orx",  "and1", "within_", "step2", "linear_",
-    "guards", "Reset", "labels", "inf", "nan",      "NaN",  "MODE", "sin_",   "max1",  "theta1_max"};
+    "mode_",  "init1", "in_x",   "inv0", "sinx", "exp_", "not_", "trueish", "e",     "E",
+    "e1",     "E10",   "x",      "_",    "_tmp", "orx",  "and1", "within_", "step2", "linear_",
+    "guards", "Reset", "labels", "inf",  "nan",  "NaN",  "MODE", "sin_",    "max1",  "theta1_max"};
 
-/// Unique names for everything an automaton declares.
+/// What a name names: each kind is a namespace of its own (a mode may share its name with a
+/// variable, a label with a transition, ...).
+enum class NameKind { kAutomaton, kSymbol, kMode, kTransition, kLabel, kProperty };
+
+/// Names for everything an automaton declares, unique within their kind.
 class NameSource {
  public:
-  std::string Fresh() {
+  std::string Fresh(NameKind kind) {
+    std::set<std::string>& used = used_[kind];
     std::string name;
-    if (Chance(15)) {
+    if (!all_.empty() && Chance(10)) {
+      name = Pick(all_);  // usually a name of another kind
+    } else if (Chance(15)) {
       name = Pick(kTrickyNames);
     } else {
       static constexpr std::string_view kFirst =
@@ -160,15 +176,17 @@ class NameSource {
       }
     }
     const std::string base = name;
-    for (int k = 1; kReserved.count(name) || used_.count(name); ++k) {
+    for (int k = 1; kReserved.count(name) || used.count(name); ++k) {
       name = base + "_" + std::to_string(k);
     }
-    used_.insert(name);
+    used.insert(name);
+    all_.push_back(name);
     return name;
   }
 
  private:
-  std::set<std::string> used_;
+  std::map<NameKind, std::set<std::string>> used_;
+  std::vector<std::string> all_;
 };
 
 std::string RandomUnit() {
@@ -211,9 +229,8 @@ Constraint RandomConstraint(const std::vector<Leaf>& leaves) {
   const int n = Uniform(0, 4);
   for (int i = 0; i < n; ++i) {
     Expression lhs = RandomExpression(2, leaves);
-    const Relation r = *rc::gen::element(Relation::kLess, Relation::kLessEqual,
-                                         Relation::kGreater, Relation::kGreaterEqual,
-                                         Relation::kEqual);
+    const Relation r = *rc::gen::element(Relation::kLess, Relation::kLessEqual, Relation::kGreater,
+                                         Relation::kGreaterEqual, Relation::kEqual);
     Expression rhs = RandomExpression(2, leaves);
     c.comparisons.push_back({std::move(lhs), r, std::move(rhs)});
   }
@@ -224,21 +241,25 @@ Predicate RandomPredicate(int depth, const std::vector<Leaf>& leaves,
                           const std::vector<std::string>& modes) {
   if (depth <= 0 || Chance(35)) {
     switch (Uniform(0, 10)) {
-      case 0: return Predicate::True();
-      case 1: return Predicate::False();
+      case 0:
+        return Predicate::True();
+      case 1:
+        return Predicate::False();
       case 2:
-      case 3: return Predicate::InMode(Pick(modes));
+      case 3:
+        return Predicate::InMode(Pick(modes));
       default: {
         Expression lhs = RandomExpression(2, leaves);
-        const Relation r = *rc::gen::element(Relation::kLess, Relation::kLessEqual,
-                                             Relation::kGreater, Relation::kGreaterEqual,
-                                             Relation::kEqual);
+        const Relation r =
+            *rc::gen::element(Relation::kLess, Relation::kLessEqual, Relation::kGreater,
+                              Relation::kGreaterEqual, Relation::kEqual);
         return Predicate::Compare({std::move(lhs), r, RandomExpression(2, leaves)});
       }
     }
   }
   switch (Uniform(0, 3)) {
-    case 0: return Predicate::Not(RandomPredicate(depth - 1, leaves, modes));
+    case 0:
+      return Predicate::Not(RandomPredicate(depth - 1, leaves, modes));
     case 1: {
       Predicate p = RandomPredicate(depth - 1, leaves, modes);
       return Predicate::And(std::move(p), RandomPredicate(depth - 1, leaves, modes));
@@ -252,7 +273,7 @@ Predicate RandomPredicate(int depth, const std::vector<Leaf>& leaves,
 
 Automaton BuildAutomaton() {
   NameSource names;
-  Automaton a(names.Fresh());
+  Automaton a(names.Fresh(NameKind::kAutomaton));
 
   // Declarations in random order (discrete variables necessarily before the modes).
   enum class Decl { kVariable, kDiscrete, kInput, kParameter };
@@ -272,7 +293,7 @@ Automaton BuildAutomaton() {
     const size_t index = Uniform<size_t>(0, pending.size());
     const Decl kind = pending[index];
     pending.erase(pending.begin() + static_cast<std::ptrdiff_t>(index));
-    std::string name = names.Fresh();
+    std::string name = names.Fresh(NameKind::kSymbol);
     switch (kind) {
       case Decl::kVariable: {
         std::optional<Range> domain;
@@ -310,7 +331,7 @@ Automaton BuildAutomaton() {
   std::vector<std::string> mode_names;
   for (int i = Uniform(1, 5); i > 0; --i) {
     Mode m;
-    m.name = names.Fresh();
+    m.name = names.Fresh(NameKind::kMode);
     for (int slot : variables) {
       if (Chance(70)) m.flows.emplace_back(slot, RandomExpression(3, all));
     }
@@ -323,10 +344,10 @@ Automaton BuildAutomaton() {
     a.AddMode(std::move(m));
   }
 
-  std::vector<std::string> labels = {names.Fresh(), names.Fresh()};
+  std::vector<std::string> labels = {names.Fresh(NameKind::kLabel), names.Fresh(NameKind::kLabel)};
   for (int i = Uniform(0, 6); i > 0; --i) {
     Transition t;
-    t.name = names.Fresh();
+    t.name = names.Fresh(NameKind::kTransition);
     t.source = ModeId(Uniform(0, a.num_modes()));
     t.target = ModeId(Uniform(0, a.num_modes()));
     t.guard = RandomConstraint(all);
@@ -378,9 +399,9 @@ Automaton BuildAutomaton() {
 
   for (int i = Uniform(0, 4); i > 0; --i) {
     Property p;
-    p.name = names.Fresh();
-    p.kind = *rc::gen::element(Property::Kind::kAlways, Property::Kind::kNever,
-                               Property::Kind::kReach);
+    p.name = names.Fresh(NameKind::kProperty);
+    p.kind =
+        *rc::gen::element(Property::Kind::kAlways, Property::Kind::kNever, Property::Kind::kReach);
     p.predicate = RandomPredicate(3, readable, mode_names);
     if (Chance(40)) p.horizon = *rc::gen::element(1.0, 2.5, 100.0, 0.1);
     a.AddProperty(std::move(p));
@@ -395,12 +416,17 @@ rc::Gen<double> GenConstant() {
     switch (Uniform(0, 8)) {
       case 0:
       case 1:
-      case 2: return Uniform(0, 11);
+      case 2:
+        return Uniform(0, 11);
       case 3:
-      case 4: return Uniform(0, 1000) / 100.0;  // 2.35: not exact in binary
-      case 5: return Uniform(1, 64) / 8.0;
-      case 6: return *rc::gen::element(0.1, 0.001, 1.0 / 3.0, 3.141592653589793, 2.5e-8);
-      default: return *rc::gen::element(1e6, 123456.789, 1e20, 6.02214076e23, 1e-300);
+      case 4:
+        return Uniform(0, 1000) / 100.0;  // 2.35: not exact in binary
+      case 5:
+        return Uniform(1, 64) / 8.0;
+      case 6:
+        return *rc::gen::element(0.1, 0.001, 1.0 / 3.0, 3.141592653589793, 2.5e-8);
+      default:
+        return *rc::gen::element(1e6, 123456.789, 1e20, 6.02214076e23, 1e-300);
     }
   });
 }
@@ -429,10 +455,18 @@ rc::Gen<Interval> GenInterval(double scale) {
     const double lo = scale * (Uniform(-1000000, 1000001) / 1e6);
     double width = 0.0;
     switch (Uniform(0, 5)) {
-      case 0: width = 0.0; break;
-      case 1: width = scale * 1e-9 * Uniform(1, 1000); break;
-      case 2: width = scale * (Uniform(0, 1001) / 1e4); break;
-      default: width = scale * (Uniform(0, 2001) / 1e3); break;
+      case 0:
+        width = 0.0;
+        break;
+      case 1:
+        width = scale * 1e-9 * Uniform(1, 1000);
+        break;
+      case 2:
+        width = scale * (Uniform(0, 1001) / 1e4);
+        break;
+      default:
+        width = scale * (Uniform(0, 2001) / 1e3);
+        break;
     }
     return Interval(lo, lo + width);
   });
@@ -442,10 +476,18 @@ rc::Gen<double> GenPointIn(const Interval& x) {
   return rc::gen::exec([x] {
     double v = 0.0;
     switch (Uniform(0, 6)) {
-      case 0: v = x.lo(); break;
-      case 1: v = x.hi(); break;
-      case 2: v = x.mid(); break;
-      default: v = x.lo() + (Uniform(0, 1000001) / 1e6) * (x.hi() - x.lo()); break;
+      case 0:
+        v = x.lo();
+        break;
+      case 1:
+        v = x.hi();
+        break;
+      case 2:
+        v = x.mid();
+        break;
+      default:
+        v = x.lo() + (Uniform(0, 1000001) / 1e6) * (x.hi() - x.lo());
+        break;
     }
     return std::clamp(v, x.lo(), x.hi());
   });
