@@ -28,8 +28,8 @@ namespace pegtl = tao::pegtl;
 
 // "a variable", "an input", ...
 std::string WithArticle(std::string_view noun) {
-  const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) !=
-                                          std::string_view::npos;
+  const bool vowel =
+      !noun.empty() && std::string_view("aeiou").find(noun.front()) != std::string_view::npos;
   return (vowel ? "an " : "a ") + std::string(noun);
 }
 
@@ -740,9 +740,8 @@ class Builder {
         });
         At(item, [&] { a.SetScenario(std::move(s)); });
       } else if (item.is_type<property_decl>()) {
-        Property p = PropertyOf(item, PropertyScope(a.symbols()), [&](const std::string& m) {
-          return a.FindMode(m).has_value();
-        });
+        Property p = PropertyOf(item, PropertyScope(a.symbols()),
+                                [&](const std::string& m) { return a.FindMode(m).has_value(); });
         At(*item.children.at(0), [&] { a.AddProperty(std::move(p)); });
       }
     }
@@ -901,15 +900,13 @@ class Builder {
         At(first, [&] { s.AddComponent(instance, it->second); });
       } else if (item.is_type<property_decl>()) {
         if (s.components().empty()) Fail(item, "declare the instances before the properties");
-        Property p = PropertyOf(item, PropertyScope(s.symbols()), [&](const std::string& m) {
-          return s.FindMode(m).has_value();
-        });
+        Property p = PropertyOf(item, PropertyScope(s.symbols()),
+                                [&](const std::string& m) { return s.FindMode(m).has_value(); });
         At(*item.children.at(0), [&] { s.AddProperty(std::move(p)); });
       } else if (item.is_type<scenario_decl>()) {
         if (has_scenario) Fail(item, "scenario declared twice");
         has_scenario = true;
-        Scenario sc =
-            ScenarioOf(item, s.symbols(), [&](int slot) { return s.InputBounds(slot); });
+        Scenario sc = ScenarioOf(item, s.symbols(), [&](int slot) { return s.InputBounds(slot); });
         At(item, [&] { s.SetScenario(std::move(sc)); });
       }
     }

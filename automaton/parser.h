@@ -29,7 +29,7 @@ class ParseError : public std::runtime_error {
 };
 
 /// Largest model file accepted (bytes); larger files are rejected before parsing.
-inline constexpr std::size_t kMaxModelFileBytes = 64u << 20;
+inline constexpr std::size_t kMaxModelFileBytes = 16u << 20;
 
 /// Deepest expression or predicate tree accepted, in levels of operators (each operator of a
 /// left-associative chain such as `a + b + c` is one level). Deeper ones are a ParseError: the

@@ -15,8 +15,8 @@ namespace {
 
 // "a variable", "an input", ...
 std::string WithArticle(std::string_view noun) {
-  const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) !=
-                                          std::string_view::npos;
+  const bool vowel =
+      !noun.empty() && std::string_view("aeiou").find(noun.front()) != std::string_view::npos;
   return (vowel ? "an " : "a ") + std::string(noun);
 }
 
@@ -152,9 +152,9 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
   for (int s = 0; s < local.size(); ++s) {
     if (auto g = symbols_.Find(local[s].name)) {
       if (symbols_[*g].kind != local[s].kind) {
-        Fail(kApi, "'" + local[s].name + "' is " + WithArticle(KindName(local[s].kind)) +
-                       " in '" + automaton.name() + "' but " +
-                       WithArticle(KindName(symbols_[*g].kind)) + " elsewhere");
+        Fail(kApi, "'" + local[s].name + "' is " + WithArticle(KindName(local[s].kind)) + " in '" +
+                       automaton.name() + "' but " + WithArticle(KindName(symbols_[*g].kind)) +
+                       " elsewhere");
       }
       if (local[s].kind == SymbolKind::kParameter) {
         // A shared parameter is one constant: its values must agree.

@@ -49,7 +49,8 @@ class System {
   void Share(std::string name);
   /// Adds a renamed copy of `automaton` (see the class comment). Throws std::invalid_argument
   /// ("System::AddComponent: ...") on a duplicate instance name, a shared name used with
-  /// different kinds, or a shared variable given a flow by two components.
+  /// different kinds, a shared variable given a flow by two components, or a shared parameter
+  /// whose value differs from the one it already has.
   void AddComponent(std::string instance, const Automaton& automaton);
   /// A system-level property over System slots; `in` atoms name component modes qualified by the
   /// instance (`A.open`) or, for an unqualified component, plainly.

@@ -66,10 +66,6 @@ void WriteOutput(const std::string& path, const std::string& text) {
   }
 }
 
-std::string RangeText(const hybrid::Range& r) {
-  return "[" + r.lo.ToString() + ", " + r.hi.ToString() + "]";
-}
-
 json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
   json out = json::array();
   for (ModeId m : modes) out.push_back(s.QualifiedModeName(c, m));
@@ -326,7 +322,9 @@ int main(int argc, char** argv) {
         if (!as_json) continue;
         std::cerr << model << ": warning: " << w.get<std::string>() << "\n";
       }
-      WriteOutput("-", as_json ? report.dump(2) + "\n" : InfoText(report));
+      // The file name may be any bytes: replace invalid UTF-8 rather than throw.
+      WriteOutput("-", as_json ? report.dump(2, ' ', false, json::error_handler_t::replace) + "\n"
+                               : InfoText(report));
     } else if (dot->parsed()) {
       std::string text;
       try {

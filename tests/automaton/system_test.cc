@@ -1,0 +1,553 @@
+// Tests of System: renaming of components, shared names, composition errors, and the product
+// automaton (synchronisation on labels, interleaving, mode names and counts, limits).
+
+#include "automaton/system.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "automaton/automaton.h"
+#include "automaton/parser.h"
+
+namespace hybrid {
+namespace {
+
+Automaton Parse(const std::string& text) { return ParseAutomaton(text, "test.ha"); }
+
+// The message of the std::invalid_argument that `f` throws, or "" (and a failure) if none.
+template <class F>
+std::string InvalidArgument(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::invalid_argument thrown";
+  return "";
+}
+
+std::vector<std::string> SymbolNames(const SymbolTable& symbols) {
+  std::vector<std::string> out;
+  for (int i = 0; i < symbols.size(); ++i) out.push_back(symbols[i].name);
+  return out;
+}
+
+std::set<std::string> ModeNames(const Automaton& a) {
+  std::set<std::string> out;
+  for (const Mode& m : a.modes()) out.insert(m.name);
+  return out;
+}
+
+// "source -> target [label]" for every transition of `a`.
+std::multiset<std::string> Edges(const Automaton& a) {
+  std::multiset<std::string> out;
+  for (const Transition& t : a.transitions()) {
+    out.insert(a.mode(t.source).name + " -> " + a.mode(t.target).name +
+               (t.label.empty() ? "" : " [" + t.label + "]"));
+  }
+  return out;
+}
+
+const Transition* FindEdge(const Automaton& a, const std::string& source,
+                           const std::string& target) {
+  for (const Transition& t : a.transitions()) {
+    if (a.mode(t.source).name == source && a.mode(t.target).name == target) return &t;
+  }
+  return nullptr;
+}
+
+// A component with everything that gets renamed.
+const char* const kTank = R"(
+automaton tank {
+  param k = 2;
+  var x;
+  discrete d;
+  input u in [0, 1];
+  mode low (d = 0) { x' = k * u; inv x <= 10; }
+  mode high (d = 1) { x' = -1; }
+  transition low -> high { guard x >= 10; reset x := x - 1; label full; }
+  transition high -> low { guard x <= 0; lazy; }
+  init low { x = 0; }
+  property bounded: always x <= 10 and d >= 0;
+  property high_reached: reach in high;
+}
+)";
+
+// Two modes p0/p1 (names prefixed by `prefix`) over variable `var`; p0 -> p1 labelled `label`
+// (when non-empty) with the given urgency, p1 -> p0 unlabelled.
+Automaton Toggle(const std::string& name, const std::string& prefix, const std::string& var,
+                 const std::string& label, bool lazy = false) {
+  std::string text = "automaton " + name + " {\n  var " + var + ";\n";
+  text += "  mode " + prefix + "0 { " + var + "' = 1; inv " + var + " <= 5; }\n";
+  text += "  mode " + prefix + "1 { " + var + "' = -1; }\n";
+  text += "  transition " + prefix + "0 -> " + prefix + "1 { guard " + var + " >= 1; reset " + var +
+          " := 0; " + (label.empty() ? "" : "label " + label + "; ") + (lazy ? "lazy; " : "") +
+          "}\n";
+  text += "  transition " + prefix + "1 -> " + prefix + "0 { guard " + var + " <= -1; }\n";
+  text += "  init " + prefix + "0 { " + var + " = 0; }\n}\n";
+  return Parse(text);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Renaming and sharing.
+
+TEST(System, InstanceNamesPrefixSymbolsAndLabels) {
+  const Automaton tank = Parse(kTank);
+  System s("plant");
+  s.AddComponent("A", tank);
+  ASSERT_EQ(s.components().size(), 1u);
+  const Component& c = s.components()[0];
+  EXPECT_EQ(c.instance, "A");
+  EXPECT_EQ(SymbolNames(c.automaton.symbols()),
+            (std::vector<std::string>{"A.k", "A.x", "A.d", "A.u"}));
+  EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"A.k", "A.x", "A.d", "A.u"}));
+  EXPECT_EQ(c.global_slot, (std::vector<int>{0, 1, 2, 3}));
+  // Units and kinds are kept.
+  EXPECT_EQ(s.symbols()[3].kind, SymbolKind::kInput);
+  // Mode names are not renamed; they are qualified at system level.
+  EXPECT_EQ(ModeNames(c.automaton), (std::set<std::string>{"low", "high"}));
+  EXPECT_EQ(s.QualifiedModeName(0, ModeId(1)), "A.high");
+  EXPECT_EQ(s.FindMode("A.high"), std::make_optional(std::make_pair(0, ModeId(1))));
+  EXPECT_FALSE(s.FindMode("high").has_value());
+  EXPECT_FALSE(s.FindMode("B.high").has_value());
+  // Labels, expressions and properties use the qualified names.
+  EXPECT_EQ(c.automaton.transitions()[0].label, "A.full");
+  EXPECT_EQ(c.automaton.modes()[0].flows[0].second.ToString(), "A.k * A.u");
+  EXPECT_EQ(c.automaton.transitions()[0].resets[0].value.ToString(), "A.x - 1");
+  EXPECT_EQ(c.automaton.properties()[0].predicate.ToString(), "A.x <= 10 and A.d >= 0");
+  // The source is the automaton as declared.
+  EXPECT_EQ(c.source, tank);
+  EXPECT_EQ(c.source.transitions()[0].label, "full");
+}
+
+TEST(System, EmptyInstanceNameKeepsNames) {
+  const Automaton tank = Parse(kTank);
+  System s("plant");
+  s.AddComponent("", tank);
+  EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"k", "x", "d", "u"}));
+  EXPECT_EQ(s.QualifiedModeName(0, ModeId(0)), "low");
+  EXPECT_EQ(s.FindMode("high"), std::make_optional(std::make_pair(0, ModeId(1))));
+  EXPECT_EQ(s.components()[0].automaton.transitions()[0].label, "full");
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("", tank); }),
+            "System::AddComponent: two unqualified components");
+}
+
+TEST(System, OfKeepsPropertiesAndScenario) {
+  const System s = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
+  const Automaton& finger = s.components()[0].source;
+  const System of = System::Of(finger);
+  EXPECT_EQ(of.name(), "finger");
+  EXPECT_EQ(of.properties().size(), finger.properties().size());
+  EXPECT_EQ(of.scenario(), finger.scenario());
+  EXPECT_EQ(of, s);
+}
+
+TEST(System, DuplicateInstanceIsAnError) {
+  const Automaton tank = Parse(kTank);
+  System s("plant");
+  s.AddComponent("A", tank);
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("A", tank); }),
+            "System::AddComponent: duplicate instance 'A'");
+  EXPECT_EQ(s.components().size(), 1u);
+}
+
+TEST(System, SharedVariablesAndInputsAreOneSymbol) {
+  const Automaton tank = Parse(kTank);
+  const Automaton reader = Parse(R"(
+automaton reader {
+  var y, x;
+  input u in [0, 1];
+  mode r { y' = x + u; }
+  init r { y = 0; x = 0; }
+})");
+  System s("plant");
+  s.Share("x");
+  s.Share("u");
+  s.AddComponent("A", tank);
+  s.AddComponent("B", reader);
+  EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"A.k", "x", "A.d", "u", "B.y"}));
+  EXPECT_EQ(s.components()[0].global_slot, (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(s.components()[1].global_slot, (std::vector<int>{4, 1, 3}));
+  EXPECT_EQ(s.components()[1].automaton.modes()[0].flows[0].second.ToString(), "x + u");
+
+  // In the product, B's flow reads the variable that A's flow drives.
+  const Automaton p = s.Product();
+  EXPECT_EQ(SymbolNames(p.symbols()), SymbolNames(s.symbols()));
+  EXPECT_EQ(p.variables().size(), 2u);
+  EXPECT_EQ(p.inputs().size(), 1u);
+  const Mode& m = p.modes()[0];
+  ASSERT_EQ(m.flows.size(), 2u);
+  EXPECT_EQ(m.flows[0].first, 1);
+  EXPECT_EQ(m.flows[0].second.ToString(), "A.k * u");
+  EXPECT_EQ(m.flows[1].first, 4);
+  EXPECT_EQ(m.flows[1].second.ToString(), "x + u");
+  EXPECT_EQ(m.flows[1].second.Slots(), (std::vector<int>{1, 3}));
+}
+
+TEST(System, SharedNameWithDifferentKindsIsAnError) {
+  const Automaton a = Parse("automaton a { var x; mode m { x' = 1; } init m { x = 0; } }");
+  const Automaton b =
+      Parse("automaton b { input x in [0, 1]; var y; mode n { y' = x; } init n { y = 0; } }");
+  System s("s");
+  s.Share("x");
+  s.AddComponent("A", a);
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("B", b); }),
+            "System::AddComponent: 'x' is an input in 'b' but a variable elsewhere");
+  System t("t");
+  t.Share("x");
+  t.AddComponent("B", b);
+  EXPECT_EQ(InvalidArgument([&] { t.AddComponent("A", a); }),
+            "System::AddComponent: 'x' is a variable in 'a' but an input elsewhere");
+}
+
+TEST(System, OnlyOneComponentMayGiveASharedVariableAFlow) {
+  const Automaton writer = Parse("automaton w { var x; mode m { x' = 1; } init m { x = 0; } }");
+  const Automaton reader =
+      Parse("automaton r { var x, y; mode m { y' = x; } init m { x = 0; y = 0; } }");
+  {
+    System s("s");
+    s.Share("x");
+    s.AddComponent("A", writer);
+    EXPECT_EQ(InvalidArgument([&] { s.AddComponent("B", writer); }),
+              "System::AddComponent: shared variable 'x' has flows in two components");
+  }
+  {
+    System s("s");
+    s.Share("x");
+    s.AddComponent("A", writer);
+    EXPECT_NO_THROW(s.AddComponent("B", reader));
+    EXPECT_NO_THROW(s.AddComponent("C", reader));
+  }
+  {
+    System s("s");
+    s.Share("x");
+    s.AddComponent("B", reader);
+    EXPECT_NO_THROW(s.AddComponent("A", writer));
+    EXPECT_EQ(InvalidArgument([&] { s.AddComponent("C", writer); }),
+              "System::AddComponent: shared variable 'x' has flows in two components");
+  }
+  {
+    // Not shared: two independent variables A.x and B.x.
+    System s("s");
+    s.AddComponent("A", writer);
+    EXPECT_NO_THROW(s.AddComponent("B", writer));
+    EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"A.x", "B.x"}));
+  }
+}
+
+TEST(System, SharedParametersMustAgree) {
+  auto with_k = [](const std::string& name, const std::string& k) {
+    return Parse("automaton " + name + " { param k = " + k +
+                 "; var x; mode m { x' = k; } init m { x = 0; } }");
+  };
+  System s("s");
+  s.Share("k");
+  s.AddComponent("A", with_k("a", "2"));
+  EXPECT_NO_THROW(s.AddComponent("B", with_k("b", "4 / 2")));
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("C", with_k("c", "3")); }),
+            "System::AddComponent: shared parameter 'k' is 3 in 'c' but 2 in 'a'");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Product.
+
+TEST(Product, SynchronisedLabelFiresOnlyJointly) {
+  System s("sync");
+  s.Share("go");
+  s.AddComponent("A", Toggle("a", "a", "x", "go"));
+  s.AddComponent("B", Toggle("b", "b", "y", "go"));
+  const Automaton p = s.Product();
+  EXPECT_EQ(p.name(), "sync");
+  EXPECT_EQ(ModeNames(p), (std::set<std::string>{"a0__b0", "a1__b1", "a0__b1", "a1__b0"}));
+  EXPECT_EQ(p.mode(p.initial_states()[0].mode).name, "a0__b0");
+  // From a0__b0 only the joint step; a0__b1 and a1__b0 are reached by the unlabelled returns, and
+  // there the labelled transition is blocked because the partner cannot take part.
+  EXPECT_EQ(Edges(p), (std::multiset<std::string>{
+                          "a0__b0 -> a1__b1 [go]",
+                          "a1__b1 -> a0__b1",
+                          "a1__b1 -> a1__b0",
+                          "a0__b1 -> a0__b0",
+                          "a1__b0 -> a0__b0",
+                      }));
+  const Transition* joint = FindEdge(p, "a0__b0", "a1__b1");
+  ASSERT_NE(joint, nullptr);
+  EXPECT_EQ(joint->name, "t0_A_a0_to_a1__B_b0_to_b1");
+  // Guards conjoined, resets applied together.
+  EXPECT_EQ(joint->guard.ToString(), "A.x >= 1 and B.y >= 1");
+  ASSERT_EQ(joint->resets.size(), 2u);
+  EXPECT_EQ(p.symbols()[joint->resets[0].slot].name, "A.x");
+  EXPECT_EQ(p.symbols()[joint->resets[1].slot].name, "B.y");
+  EXPECT_EQ(joint->urgency, Urgency::kUrgent);
+  // Flows are the union, invariants the conjunction.
+  const Mode& initial = p.modes()[p.initial_states()[0].mode.value()];
+  EXPECT_EQ(initial.flows.size(), 2u);
+  EXPECT_EQ(initial.invariant.ToString(), "A.x <= 5 and B.y <= 5");
+  EXPECT_EQ(p.initial_states()[0].values.size(), 2u);
+}
+
+TEST(Product, JointUrgencyIsLazyOnlyWhenEveryPartIsLazy) {
+  for (const bool a_lazy : {false, true}) {
+    for (const bool b_lazy : {false, true}) {
+      System s("sync");
+      s.Share("go");
+      s.AddComponent("A", Toggle("a", "a", "x", "go", a_lazy));
+      s.AddComponent("B", Toggle("b", "b", "y", "go", b_lazy));
+      const Automaton p = s.Product();
+      const Transition* joint = FindEdge(p, "a0__b0", "a1__b1");
+      ASSERT_NE(joint, nullptr);
+      EXPECT_EQ(joint->urgency, a_lazy && b_lazy ? Urgency::kLazy : Urgency::kUrgent)
+          << a_lazy << b_lazy;
+    }
+  }
+}
+
+TEST(Product, ComponentsWithoutTheLabelInterleave) {
+  System s("sync");
+  s.Share("go");
+  s.AddComponent("A", Toggle("a", "a", "x", "go"));
+  s.AddComponent("B", Toggle("b", "b", "y", "go"));
+  s.AddComponent("C", Toggle("c", "c", "z", ""));
+  const Automaton p = s.Product();
+  EXPECT_EQ(p.num_modes(), 8);
+  EXPECT_TRUE(ModeNames(p).count("a0__b0__c1"));
+  // From the initial tuple: the joint step of A and B (C stays), or C alone.
+  std::multiset<std::string> from_initial;
+  for (const std::string& e : Edges(p)) {
+    if (e.starts_with("a0__b0__c0 ->")) from_initial.insert(e);
+  }
+  EXPECT_EQ(from_initial, (std::multiset<std::string>{"a0__b0__c0 -> a1__b1__c0 [go]",
+                                                      "a0__b0__c0 -> a0__b0__c1"}));
+  // A never moves alone along its labelled transition.
+  for (const Transition& t : p.transitions()) {
+    const std::string source = p.mode(t.source).name, target = p.mode(t.target).name;
+    if (source[1] == '0' && target[1] == '1') {
+      EXPECT_EQ(target[5], '1') << source << " -> " << target;
+    }
+  }
+}
+
+TEST(Product, LabelNotSharedIsRenamedSoTransitionsInterleave) {
+  System s("free");
+  s.AddComponent("A", Toggle("a", "a", "x", "go"));
+  s.AddComponent("B", Toggle("b", "b", "y", "go"));
+  const Automaton p = s.Product();
+  EXPECT_EQ(p.num_modes(), 4);
+  std::multiset<std::string> from_initial;
+  for (const std::string& e : Edges(p)) {
+    if (e.starts_with("a0__b0 ->")) from_initial.insert(e);
+  }
+  EXPECT_EQ(from_initial,
+            (std::multiset<std::string>{"a0__b0 -> a1__b0 [A.go]", "a0__b0 -> a0__b1 [B.go]"}));
+}
+
+TEST(Product, LabelThatNoOtherComponentUsesIsTakenAlone) {
+  System s("alone");
+  s.Share("go");
+  s.AddComponent("A", Toggle("a", "a", "x", "go"));
+  s.AddComponent("B", Toggle("b", "b", "y", "stop"));
+  const Automaton p = s.Product();
+  EXPECT_EQ(p.num_modes(), 4);
+  EXPECT_NE(FindEdge(p, "a0__b0", "a1__b0"), nullptr);
+  EXPECT_NE(FindEdge(p, "a0__b0", "a0__b1"), nullptr);
+  EXPECT_EQ(FindEdge(p, "a0__b0", "a1__b1"), nullptr);
+}
+
+TEST(Product, EveryPartnerCombinationIsATransition) {
+  // A has one `go` transition, B two from the same mode: two joint transitions.
+  const Automaton b = Parse(R"(
+automaton b {
+  var y;
+  mode b0 { y' = 1; }
+  mode b1 { }
+  mode b2 { }
+  transition b0 -> b1 { label go; }
+  transition b0 -> b2 { label go; }
+  init b0 { y = 0; }
+})");
+  System s("s");
+  s.Share("go");
+  s.AddComponent("A", Toggle("a", "a", "x", "go"));
+  s.AddComponent("B", b);
+  const Automaton p = s.Product();
+  EXPECT_NE(FindEdge(p, "a0__b0", "a1__b1"), nullptr);
+  EXPECT_NE(FindEdge(p, "a0__b0", "a1__b2"), nullptr);
+  EXPECT_EQ(FindEdge(p, "a0__b0", "a0__b1"), nullptr);
+  EXPECT_EQ(FindEdge(p, "a0__b0", "a1__b0"), nullptr);
+  EXPECT_EQ(p.num_modes(), 5);  // a0__b0, a1__b1, a1__b2, a0__b1, a0__b2
+}
+
+TEST(Product, SynchronisedResetsOfOneSharedVariableAreAnError) {
+  const Automaton a = Parse(R"(
+automaton a {
+  var x;
+  mode m { x' = 1; }
+  mode n { }
+  transition m -> n { reset x := 0; label go; }
+  init m { x = 0; }
+})");
+  const Automaton b = Parse(R"(
+automaton b {
+  var x;
+  mode m { }
+  mode n { }
+  transition m -> n { reset x := 1; label go; }
+  init m { x = 0; }
+})");
+  System s("s");
+  s.Share("x");
+  s.Share("go");
+  s.AddComponent("A", a);
+  s.AddComponent("B", b);
+  EXPECT_EQ(InvalidArgument([&] { s.Product(); }),
+            "System::Product: synchronised transitions reset 'x' twice");
+}
+
+TEST(Product, InitialStatesAreTheCartesianProduct) {
+  const Automaton two_starts = Parse(R"(
+automaton a {
+  var x;
+  mode m { x' = 1; }
+  mode n { x' = 2; }
+  init m { x = 0; }
+  init n { x in [1, 2]; }
+})");
+  System s("s");
+  s.AddComponent("A", two_starts);
+  s.AddComponent("B", Toggle("b", "b", "y", ""));
+  const Automaton p = s.Product();
+  ASSERT_EQ(p.initial_states().size(), 2u);
+  EXPECT_EQ(p.mode(p.initial_states()[0].mode).name, "m__b0");
+  EXPECT_EQ(p.mode(p.initial_states()[1].mode).name, "n__b0");
+  EXPECT_FALSE(p.initial_states()[1].values[0].is_point);
+  EXPECT_EQ(p.num_modes(), 4);
+}
+
+TEST(Product, ModeCountAndLimit) {
+  System s("s");
+  s.AddComponent("A", Toggle("a", "a", "x", ""));
+  s.AddComponent("B", Toggle("b", "b", "y", ""));
+  s.AddComponent("C", Toggle("c", "c", "z", ""));
+  EXPECT_EQ(s.Product().num_modes(), 8);
+  EXPECT_EQ(s.Product(8).num_modes(), 8);
+  EXPECT_EQ(InvalidArgument([&] { s.Product(7); }), "System::Product: more than 7 product modes");
+  EXPECT_EQ(InvalidArgument([&] { s.Product(1); }), "System::Product: more than 1 product modes");
+}
+
+TEST(Product, OnlyReachableTuplesBecomeModes) {
+  // B cannot leave b0 (no transitions), so no tuple with b1 exists.
+  const Automaton stuck = Parse(R"(
+automaton b {
+  var y;
+  mode b0 { y' = 1; }
+  mode b1 { }
+  init b0 { y = 0; }
+})");
+  System s("s");
+  s.AddComponent("A", Toggle("a", "a", "x", ""));
+  s.AddComponent("B", stuck);
+  EXPECT_EQ(ModeNames(s.Product()), (std::set<std::string>{"a0__b0", "a1__b0"}));
+}
+
+TEST(Product, SingleComponentProductIsTheAutomaton) {
+  const System finger = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
+  const Automaton& a = finger.components()[0].automaton;
+  const Automaton p = finger.Product();
+  EXPECT_EQ(p.num_modes(), 30);
+  EXPECT_EQ(p.num_modes(), a.num_modes());
+  EXPECT_EQ(p.num_transitions(), a.num_transitions());
+  EXPECT_EQ(ModeNames(p), ModeNames(a));
+  EXPECT_EQ(SymbolNames(p.symbols()), SymbolNames(a.symbols()));
+  EXPECT_EQ(p.properties().size(), a.properties().size());
+  EXPECT_EQ(p.scenario(), a.scenario());
+}
+
+TEST(Product, PropertiesWithModeAtomsStayOnTheSystem) {
+  System s = ParseModel(R"(
+automaton a { var x; mode m { x' = 1; } mode n { } transition m -> n { } init m { x = 0; } }
+system s {
+  instance A = a;
+  instance B = a;
+  property both: reach in A.n and in B.n;
+  property small: always A.x <= 1;
+}
+)",
+                        "s.ha");
+  EXPECT_EQ(s.properties().size(), 2u);
+  const Automaton p = s.Product();
+  ASSERT_EQ(p.properties().size(), 1u);
+  EXPECT_EQ(p.properties()[0].name, "small");
+}
+
+// ---------------------------------------------------------------------------------------------
+// System properties and scenarios.
+
+TEST(System, AddPropertyChecksModesAndInputs) {
+  System s("s");
+  s.AddComponent("A", Parse(kTank));
+  Property bad_mode{"p", Property::Kind::kReach, Predicate::InMode("A.nowhere"), std::nullopt};
+  EXPECT_EQ(InvalidArgument([&] { s.AddProperty(bad_mode); }),
+            "System::AddProperty: property 'p': unknown mode 'A.nowhere'");
+  Property reads_input{"q", Property::Kind::kAlways,
+                       Predicate::Compare({Expression::Symbol("A.u", 3), Relation::kLessEqual,
+                                           Expression::Constant(1)}),
+                       std::nullopt};
+  EXPECT_EQ(InvalidArgument([&] { s.AddProperty(reads_input); }),
+            "System::AddProperty: property 'q': input 'A.u' is not allowed here");
+  Property good{"r", Property::Kind::kReach, Predicate::InMode("A.high"), std::nullopt};
+  s.AddProperty(good);
+  EXPECT_EQ(InvalidArgument([&] { s.AddProperty(good); }),
+            "System::AddProperty: duplicate property 'r'");
+}
+
+TEST(System, InputBounds) {
+  System s("s");
+  s.AddComponent("A", Parse(kTank));
+  EXPECT_EQ(s.InputBounds(3), std::make_pair(0.0, 1.0));
+  EXPECT_THROW(s.InputBounds(1), std::invalid_argument);
+  EXPECT_THROW(s.InputBounds(99), std::invalid_argument);
+}
+
+TEST(System, SetScenarioValidatesLikeAnAutomaton) {
+  System s("s");
+  s.AddComponent("A", Parse(kTank));
+  auto scenario = [](double until, std::vector<std::pair<double, double>> points) {
+    Scenario sc;
+    sc.until = until;
+    sc.inputs.push_back({3, InputSignal::Shape::kStep, std::move(points)});
+    return sc;
+  };
+  EXPECT_NO_THROW(s.SetScenario(scenario(10, {{0, 0}, {1, 1}})));
+  EXPECT_EQ(InvalidArgument([&] {
+              s.SetScenario(scenario(10, {{0, 0}, {1, 2}}));
+            }),
+            "System::SetScenario: signal for 'A.u' takes value 2 outside its bounds [0, 1]");
+  EXPECT_EQ(InvalidArgument([&] {
+              s.SetScenario(scenario(10, {{1, 0}, {1, 1}}));
+            }),
+            "System::SetScenario: signal for 'A.u': times must increase strictly");
+  EXPECT_EQ(InvalidArgument([&] { s.SetScenario(scenario(10, {})); }),
+            "System::SetScenario: signal for 'A.u' has no points");
+  EXPECT_EQ(InvalidArgument([&] {
+              s.SetScenario(scenario(0, {{0, 0}}));
+            }),
+            "System::SetScenario: 'until' must be positive and finite");
+  Scenario twice = scenario(10, {{0, 0}});
+  twice.inputs.push_back(twice.inputs[0]);
+  EXPECT_EQ(InvalidArgument([&] { s.SetScenario(twice); }),
+            "System::SetScenario: input 'A.u' driven twice");
+  Scenario not_input = scenario(10, {{0, 0}});
+  not_input.inputs[0].slot = 1;
+  EXPECT_EQ(InvalidArgument([&] { s.SetScenario(not_input); }),
+            "System::SetScenario: signal for something that is not an input");
+  // The product accepts whatever the system accepted.
+  s.SetScenario(scenario(10, {{0, 1}}));
+  EXPECT_EQ(s.Product().scenario(), s.scenario());
+}
+
+}  // namespace
+}  // namespace hybrid

@@ -1,0 +1,403 @@
+// Tests of the `hybrid` command line (HYBRID_BINARY): exit codes (0 success, 1 invalid model,
+// 2 usage error, 3 output error), FILE:LINE:COL: diagnostics for every malformed model, the
+// JSON of `hybrid info`, and the files `hybrid dot -o` writes.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "automaton/dot_writer.h"
+#include "automaton/parser.h"
+
+namespace hybrid {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSourceDir = HYBRID_SOURCE_DIR;
+const fs::path kFinger = kSourceDir / "spec" / "finger.ha";
+const fs::path kMalformedDir = kSourceDir / "tests" / "data" / "malformed";
+
+std::string Quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string ReadAll(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A fresh directory under the system temporary directory, removed by the destructor.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("hybrid_cli_test_" + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path Write(const std::string& name, const std::string& text) const {
+    const fs::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  std::vector<std::string> Files() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+ private:
+  fs::path path_;
+};
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+// Runs `hybrid ARGS` through the shell (arguments are passed as written: quote them), with
+// stdout redirected to `stdout_target` when given.
+Result RunHybrid(const std::string& args, const std::string& stdout_target = "") {
+  TempDir dir;
+  const fs::path out = dir.path() / "stdout", err = dir.path() / "stderr";
+  const std::string command = Quote(HYBRID_BINARY) + " " + args + " >" +
+                              (stdout_target.empty() ? Quote(out) : stdout_target) + " 2>" +
+                              Quote(err) + " </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  if (WIFEXITED(status)) {
+    r.exit_code = WEXITSTATUS(status);
+  } else {
+    ADD_FAILURE() << command << ": did not exit normally (status " << status << ")";
+  }
+  r.out = ReadAll(out);
+  r.err = ReadAll(err);
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Usage.
+
+TEST(HybridCli, HelpExitsZero) {
+  const Result r = RunHybrid("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("info"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dot"), std::string::npos);
+  EXPECT_NE(r.out.find("Exit codes"), std::string::npos);
+  EXPECT_EQ(RunHybrid("info --help").exit_code, 0);
+  EXPECT_EQ(RunHybrid("dot --help").exit_code, 0);
+}
+
+TEST(HybridCli, VersionExitsZero) {
+  const Result r = RunHybrid("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out, "hybrid 0.1.0\n");
+}
+
+TEST(HybridCli, UsageErrorsExitTwo) {
+  const std::string finger = Quote(kFinger);
+  for (const std::string& args : std::vector<std::string>{
+           "info --no-such-option " + finger,
+           "--no-such-option",
+           "",
+           "frobnicate " + finger,
+           "info",
+           "dot",
+           "dot " + finger + " -o",
+           "info " + finger + " extra_argument",
+       }) {
+    const Result r = RunHybrid(args);
+    EXPECT_EQ(r.exit_code, 2) << "hybrid " << args << "\n" << r.err;
+    EXPECT_FALSE(r.err.empty()) << "hybrid " << args;
+    EXPECT_EQ(r.out, "") << "hybrid " << args;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// info.
+
+TEST(HybridCli, InfoJsonOfTheFinger) {
+  const Result r = RunHybrid("info " + Quote(kFinger) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  nlohmann::json info;
+  ASSERT_NO_THROW(info = nlohmann::json::parse(r.out)) << r.out;
+  EXPECT_EQ(info["file"], kFinger.string());
+  EXPECT_EQ(info["name"], "finger");
+  ASSERT_EQ(info["components"].size(), 1u);
+  const auto& c = info["components"][0];
+  EXPECT_EQ(c["automaton"], "finger");
+  EXPECT_EQ(c["instance"], "");
+  EXPECT_EQ(c["modes"].size(), 30u);
+  EXPECT_EQ(c["reachable_modes"].size(), 30u);
+  EXPECT_TRUE(c["unreachable_modes"].empty());
+  EXPECT_EQ(c["variables"].size(), 4u);
+  EXPECT_EQ(c["variables"][0]["name"], "theta1");
+  EXPECT_EQ(c["variables"][0]["unit"], "deg");
+  EXPECT_EQ(c["variables"][0]["domain"], nlohmann::json::array({0.0, 70.0}));
+  EXPECT_EQ(c["discrete_variables"].size(), 6u);
+  EXPECT_EQ(c["inputs"][0]["bounds"], nlohmann::json::array({-1.0, 1.0}));
+  EXPECT_EQ(c["initial_states"][0]["mode"], "c000_l000");
+  EXPECT_EQ(c["properties"].size(), 8u);
+  EXPECT_TRUE(info["warnings"].empty());
+  EXPECT_EQ(info["scenario"]["until"], 530.0);
+  EXPECT_EQ(info["scenario"]["inputs"][0]["shape"], "step");
+  // Every transition names existing modes.
+  std::set<std::string> modes;
+  for (const auto& m : c["modes"]) modes.insert(m["name"].get<std::string>());
+  for (const auto& t : c["transitions"]) {
+    EXPECT_TRUE(modes.count(t["source"].get<std::string>())) << t;
+    EXPECT_TRUE(modes.count(t["target"].get<std::string>())) << t;
+  }
+}
+
+TEST(HybridCli, InfoTextOfTheFinger) {
+  const Result r = RunHybrid("info " + Quote(kFinger));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.starts_with("model finger (" + kFinger.string() + ")\n")) << r.out;
+  EXPECT_NE(r.out.find("modes (30): c000_l000, "), std::string::npos);
+  EXPECT_NE(r.out.find("reachable modes (30 of 30)"), std::string::npos);
+  EXPECT_NE(r.out.find("\nwarnings: none\n"), std::string::npos);
+}
+
+TEST(HybridCli, InfoOfAComposedSystemWithWarnings) {
+  TempDir dir;
+  const fs::path model = dir.Write("sys.ha", R"(
+automaton a {
+  var x;
+  mode m { x' = 1; }
+  mode orphan { }
+  transition m -> m { guard x >= 1; reset x := 0; }
+  init m { x = 0; }
+}
+system s {
+  instance A = a;
+  instance B = a;
+  property p: never in A.orphan;
+}
+)");
+  const Result r = RunHybrid("info " + Quote(model) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json info = nlohmann::json::parse(r.out);
+  EXPECT_EQ(info["name"], "s");
+  ASSERT_EQ(info["components"].size(), 2u);
+  EXPECT_EQ(info["components"][1]["instance"], "B");
+  EXPECT_EQ(info["components"][1]["unreachable_modes"], nlohmann::json::array({"B.orphan"}));
+  EXPECT_EQ(info["warnings"],
+            nlohmann::json::array({"A: mode 'orphan' is unreachable from the initial modes",
+                                   "B: mode 'orphan' is unreachable from the initial modes"}));
+  EXPECT_EQ(info["properties"][0]["predicate"], "in A.orphan");
+  // With --json the warnings also go to stderr, prefixed by the file.
+  EXPECT_EQ(r.err, model.string() +
+                       ": warning: A: mode 'orphan' is unreachable from the initial "
+                       "modes\n" +
+                       model.string() +
+                       ": warning: B: mode 'orphan' is unreachable from the initial modes\n");
+}
+
+TEST(HybridCli, InfoJsonOfAFileWhoseNameIsNotUtf8) {
+  TempDir dir;
+  const fs::path model = dir.Write("\xff\xfe.ha", ReadAll(kFinger));
+  const Result r = RunHybrid("info " + Quote(model) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json info;
+  ASSERT_NO_THROW(info = nlohmann::json::parse(r.out));
+  // Invalid bytes become U+FFFD.
+  EXPECT_EQ(info["file"], (dir.path() / "\xef\xbf\xbd\xef\xbf\xbd.ha").string());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Invalid models.
+
+struct Expectation {
+  std::string file;
+  std::string diagnostic;  // FILE:LINE:COL: message, the first line of stderr
+};
+
+// Test names and failure messages show the file.
+void PrintTo(const Expectation& x, std::ostream* os) { *os << x.file; }
+
+std::vector<Expectation> LoadExpectations() {
+  std::vector<Expectation> out;
+  std::ifstream in(kMalformedDir / "expected.txt");
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string field; std::getline(fields, field, '\t');) f.push_back(field);
+    if (f.size() < 4) continue;
+    const std::string reported = (kMalformedDir / (f.size() == 5 ? f[4] : f[0])).string();
+    out.push_back({f[0], reported + ":" + f[1] + ":" + f[2] + ": " + f[3]});
+  }
+  return out;
+}
+
+class MalformedModelTest : public ::testing::TestWithParam<Expectation> {};
+
+TEST_P(MalformedModelTest, ExitsOneWithLocatedDiagnostic) {
+  const Expectation& x = GetParam();
+  const std::string model = Quote(kMalformedDir / x.file);
+  for (const std::string command : {"info", "info --json", "dot", "dot --product"}) {
+    const Result r = RunHybrid(command + " " + model);
+    EXPECT_EQ(r.exit_code, 1) << command;
+    EXPECT_EQ(r.err, x.diagnostic + "\n") << command;
+    EXPECT_EQ(r.out, "") << command;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Malformed, MalformedModelTest, ::testing::ValuesIn(LoadExpectations()),
+                         [](const auto& info) {
+                           std::string name = fs::path(info.param.file).stem().string();
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+TEST(HybridCli, EveryMalformedFileIsCovered) { EXPECT_GE(LoadExpectations().size(), 20u); }
+
+TEST(HybridCli, BinaryModelExitsOne) {
+  TempDir dir;
+  const char raw[] = "automaton a {\n  var x;\0\n}\n";
+  const fs::path model = dir.Write("nul.ha", std::string(raw, sizeof(raw) - 1));
+  const Result r = RunHybrid("info " + Quote(model));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, model.string() + ":2:9: NUL byte in model file (binary file?)\n");
+  std::mt19937 rng(3);
+  std::string garbage(1 << 20, '\0');
+  for (char& c : garbage) c = static_cast<char>(rng());
+  const fs::path random = dir.Write("random.ha", garbage);
+  const Result g = RunHybrid("dot " + Quote(random));
+  EXPECT_EQ(g.exit_code, 1);
+  EXPECT_TRUE(g.err.starts_with(random.string() + ":1:")) << g.err;
+}
+
+TEST(HybridCli, MissingModelFileExitsOne) {
+  const fs::path missing = kMalformedDir / "no_such_model.ha";
+  const Result r = RunHybrid("info " + Quote(missing));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(r.err.starts_with(missing.string() + ":0:0: cannot read file: ")) << r.err;
+}
+
+TEST(HybridCli, ProductTooLargeToDrawExitsOne) {
+  TempDir dir;
+  std::string text =
+      "automaton t { var x; mode a { x' = 1; } mode b { } "
+      "transition a -> b { } transition b -> a { } init a { x = 0; } }\n"
+      "system s {\n";
+  for (int i = 0; i < 11; ++i) text += "  instance I" + std::to_string(i) + " = t;\n";  // 2^11
+  const fs::path model = dir.Write("big.ha", text + "}\n");
+  const Result r = RunHybrid("dot --product " + Quote(model));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("more than 2000 product modes"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(RunHybrid("dot " + Quote(model)).exit_code, 0);  // clusters are fine
+}
+
+// ---------------------------------------------------------------------------------------------
+// dot and output files.
+
+TEST(HybridCli, DotToStdoutIsTheLibraryOutput) {
+  const Result r = RunHybrid("dot " + Quote(kFinger));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, WriteDot(ParseModelFile(kFinger)));
+  const Result dash = RunHybrid("dot " + Quote(kFinger) + " -o -");
+  EXPECT_EQ(dash.out, r.out);
+}
+
+TEST(HybridCli, DotOutputFileIsComplete) {
+  TempDir dir;
+  const fs::path out = dir.path() / "finger.dot";
+  const Result r = RunHybrid("dot " + Quote(kFinger) + " -o " + Quote(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+  const std::string written = ReadAll(out);
+  EXPECT_EQ(written, WriteDot(ParseModelFile(kFinger)));
+  EXPECT_TRUE(written.ends_with("}\n"));
+  // Nothing else is left in the directory (no temporary file).
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"finger.dot"});
+  // Graphviz accepts it.
+  const fs::path svg = dir.path() / "finger.svg";
+  EXPECT_EQ(std::system(("dot -Tsvg " + Quote(out) + " -o " + Quote(svg)).c_str()), 0);
+  EXPECT_NE(ReadAll(svg).find("<svg"), std::string::npos);
+}
+
+TEST(HybridCli, DotProductOutputFile) {
+  TempDir dir;
+  const fs::path model = dir.Write("sys.ha", R"(
+automaton a { var x; mode m { x' = 1; } mode n { } transition m -> n { } init m { x = 0; } }
+system s { instance A = a; instance B = a; }
+)");
+  const fs::path out = dir.path() / "product.dot";
+  const Result r = RunHybrid("dot --product " + Quote(model) + " --output " + Quote(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string written = ReadAll(out);
+  EXPECT_EQ(written, WriteDot(ParseModelFile(model), {.product = true}));
+  EXPECT_NE(written.find("n__n"), std::string::npos);
+}
+
+TEST(HybridCli, UnwritableOutputExitsThreeAndLeavesNoFile) {
+  const Result r = RunHybrid("dot " + Quote(kFinger) + " -o /nonexistent_dir/x.dot");
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.err, "hybrid: cannot write '/nonexistent_dir/x.dot'\n");
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(fs::exists("/nonexistent_dir/x.dot"));
+  EXPECT_FALSE(fs::exists("/nonexistent_dir"));
+}
+
+TEST(HybridCli, OutputOntoADirectoryExitsThreeAndCleansUp) {
+  TempDir dir;
+  fs::create_directory(dir.path() / "target");
+  const Result r = RunHybrid("dot " + Quote(kFinger) + " -o " + Quote(dir.path() / "target"));
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_EQ(r.err, "hybrid: cannot write '" + (dir.path() / "target").string() + "'\n");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"target"});  // no temporary file left
+  EXPECT_TRUE(fs::is_empty(dir.path() / "target"));
+}
+
+TEST(HybridCli, FullStdoutExitsThree) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const Result dot = RunHybrid("dot " + Quote(kFinger), "/dev/full");
+  EXPECT_EQ(dot.exit_code, 3);
+  EXPECT_EQ(dot.err, "hybrid: cannot write to standard output\n");
+  EXPECT_EQ(RunHybrid("info " + Quote(kFinger), "/dev/full").exit_code, 3);
+}
+
+TEST(HybridCli, FailedRunLeavesAnExistingOutputUntouched) {
+  TempDir dir;
+  const fs::path out = dir.Write("keep.dot", "previous contents\n");
+  const Result r =
+      RunHybrid("dot " + Quote(kMalformedDir / "bad_operator.ha") + " -o " + Quote(out));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(ReadAll(out), "previous contents\n");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"keep.dot"});
+  // A successful run replaces it.
+  EXPECT_EQ(RunHybrid("dot " + Quote(kFinger) + " -o " + Quote(out)).exit_code, 0);
+  EXPECT_EQ(ReadAll(out), WriteDot(ParseModelFile(kFinger)));
+}
+
+}  // namespace
+}  // namespace hybrid
