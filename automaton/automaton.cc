@@ -30,14 +30,13 @@ void Automaton::CheckSlots(const Expression& e, std::string_view context, bool a
                            bool allow_state) const {
   for (int slot : e.Slots()) {
     if (slot >= symbols_.size()) {
-      Fail(context, "expression '" + e.ToString() + "' reads undeclared slot " +
-                        std::to_string(slot));
+      Fail(context,
+           "expression '" + e.ToString() + "' reads undeclared slot " + std::to_string(slot));
     }
     const Symbol& s = symbols_[slot];
-    const bool ok = s.kind == SymbolKind::kParameter ||
-                    (s.kind == SymbolKind::kInput && allow_inputs) ||
-                    ((s.kind == SymbolKind::kVariable || s.kind == SymbolKind::kDiscrete) &&
-                     allow_state);
+    const bool ok =
+        s.kind == SymbolKind::kParameter || (s.kind == SymbolKind::kInput && allow_inputs) ||
+        ((s.kind == SymbolKind::kVariable || s.kind == SymbolKind::kDiscrete) && allow_state);
     if (!ok) {
       Fail(context, std::string(KindName(s.kind)) + " '" + s.name + "' is not allowed here");
     }
@@ -116,11 +115,15 @@ ModeId Automaton::AddMode(Mode mode) {
   }
   for (const auto& [slot, rhs] : mode.flows) {
     if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kVariable) {
-      Fail(kApi, "mode '" + mode.name + "' has a flow for something that is not a continuous "
-                 "variable (slot " + std::to_string(slot) + ")");
+      Fail(kApi, "mode '" + mode.name +
+                     "' has a flow for something that is not a continuous "
+                     "variable (slot " +
+                     std::to_string(slot) + ")");
     }
-    CheckSlots(rhs, std::string(kApi) + ": flow of '" + symbols_[slot].name + "' in mode '" +
-                        mode.name + "'", true, true);
+    CheckSlots(
+        rhs,
+        std::string(kApi) + ": flow of '" + symbols_[slot].name + "' in mode '" + mode.name + "'",
+        true, true);
   }
   for (const Comparison& c : mode.invariant.comparisons) {
     CheckSlots(c.Residual(), std::string(kApi) + ": invariant of mode '" + mode.name + "'", true,
@@ -131,15 +134,17 @@ ModeId Automaton::AddMode(Mode mode) {
   }
   for (const auto& [slot, value] : mode.discrete_values) {
     if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kDiscrete) {
-      Fail(kApi, "mode '" + mode.name + "' sets a value for something that is not a discrete "
-                 "variable (slot " + std::to_string(slot) + ")");
+      Fail(kApi, "mode '" + mode.name +
+                     "' sets a value for something that is not a discrete "
+                     "variable (slot " +
+                     std::to_string(slot) + ")");
     }
   }
   if (mode.discrete_values.size() != discrete_.size()) {
     for (int d : discrete_) {
       if (!mode.DiscreteValueOf(d)) {
-        Fail(kApi, "mode '" + mode.name + "' does not set discrete variable '" +
-                       symbols_[d].name + "'");
+        Fail(kApi,
+             "mode '" + mode.name + "' does not set discrete variable '" + symbols_[d].name + "'");
       }
     }
   }
@@ -171,12 +176,12 @@ TransitionId Automaton::AddTransition(Transition t) {
     Fail(kApi, "transition '" + t.name + "' resets a variable twice");
   }
   for (const Reset& r : t.resets) {
-    if (r.slot < 0 || r.slot >= symbols_.size() ||
-        symbols_[r.slot].kind != SymbolKind::kVariable) {
+    if (r.slot < 0 || r.slot >= symbols_.size() || symbols_[r.slot].kind != SymbolKind::kVariable) {
       Fail(kApi, "transition '" + t.name + "' resets something that is not a continuous variable");
     }
-    CheckSlots(r.value, std::string(kApi) + ": reset of '" + symbols_[r.slot].name + "' in '" +
-                            t.name + "'", true, true);
+    CheckSlots(r.value,
+               std::string(kApi) + ": reset of '" + symbols_[r.slot].name + "' in '" + t.name + "'",
+               true, true);
   }
   transition_index_.emplace(t.name, num_transitions());
   transitions_.push_back(std::move(t));
@@ -191,10 +196,10 @@ void Automaton::AddInitialState(InitialState state) {
     Fail(kApi, "initial state in '" + mode_name + "' gives a variable twice");
   }
   for (const InitialValue& v : state.values) {
-    if (v.slot < 0 || v.slot >= symbols_.size() ||
-        symbols_[v.slot].kind != SymbolKind::kVariable) {
-      Fail(kApi, "initial state in '" + mode_name + "' sets something that is not a continuous "
-                 "variable");
+    if (v.slot < 0 || v.slot >= symbols_.size() || symbols_[v.slot].kind != SymbolKind::kVariable) {
+      Fail(kApi, "initial state in '" + mode_name +
+                     "' sets something that is not a continuous "
+                     "variable");
     }
     const std::string context =
         std::string(kApi) + ": initial value of '" + symbols_[v.slot].name + "'";
@@ -252,9 +257,9 @@ void Automaton::SetScenario(Scenario scenario) {
         Fail(kApi, "signal for '" + name + "': times must increase strictly");
       }
     }
-    const auto& bounds = std::find_if(inputs_.begin(), inputs_.end(),
-                                      [&](const InputInfo& in) { return in.slot == s.slot; })
-                             ->bounds;
+    const auto& bounds = std::find_if(inputs_.begin(), inputs_.end(), [&](const InputInfo& in) {
+                           return in.slot == s.slot;
+                         })->bounds;
     const double lo = EvaluateConstant(bounds.lo, kApi);
     const double hi = EvaluateConstant(bounds.hi, kApi);
     for (const auto& [t, v] : s.points) {

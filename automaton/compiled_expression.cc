@@ -47,31 +47,50 @@ using Code = CompiledExpression::Code;
 
 Code UnaryCode(Op op) {
   switch (op) {
-    case Op::kNeg: return Code::kNeg;
-    case Op::kSin: return Code::kSin;
-    case Op::kCos: return Code::kCos;
-    case Op::kTan: return Code::kTan;
-    case Op::kExp: return Code::kExp;
-    case Op::kLog: return Code::kLog;
-    case Op::kSqrt: return Code::kSqrt;
-    case Op::kAbs: return Code::kAbs;
-    case Op::kSign: return Code::kSign;
-    default: throw std::logic_error("CompiledExpression: not a unary op");
+    case Op::kNeg:
+      return Code::kNeg;
+    case Op::kSin:
+      return Code::kSin;
+    case Op::kCos:
+      return Code::kCos;
+    case Op::kTan:
+      return Code::kTan;
+    case Op::kExp:
+      return Code::kExp;
+    case Op::kLog:
+      return Code::kLog;
+    case Op::kSqrt:
+      return Code::kSqrt;
+    case Op::kAbs:
+      return Code::kAbs;
+    case Op::kSign:
+      return Code::kSign;
+    default:
+      throw std::logic_error("CompiledExpression: not a unary op");
   }
 }
 
 // The stack form of a binary op; the constant and symbol forms follow it.
 Code BinaryCode(Op op) {
   switch (op) {
-    case Op::kAdd: return Code::kAddS;
-    case Op::kSub: return Code::kSubS;
-    case Op::kMul: return Code::kMulS;
-    case Op::kDiv: return Code::kDivS;
-    case Op::kPow: return Code::kPowS;
-    case Op::kMin: return Code::kMinS;
-    case Op::kMax: return Code::kMaxS;
-    case Op::kAtan2: return Code::kAtan2S;
-    default: throw std::logic_error("CompiledExpression: not a binary op");
+    case Op::kAdd:
+      return Code::kAddS;
+    case Op::kSub:
+      return Code::kSubS;
+    case Op::kMul:
+      return Code::kMulS;
+    case Op::kDiv:
+      return Code::kDivS;
+    case Op::kPow:
+      return Code::kPowS;
+    case Op::kMin:
+      return Code::kMinS;
+    case Op::kMax:
+      return Code::kMaxS;
+    case Op::kAtan2:
+      return Code::kAtan2S;
+    default:
+      throw std::logic_error("CompiledExpression: not a binary op");
   }
 }
 
@@ -99,9 +118,14 @@ CompiledExpression::CompiledExpression(const Expression& expression) {
 void CompiledExpression::Emit(const Expression& e, int depth) {
   max_depth_ = std::max(max_depth_, depth);
   switch (e.op()) {
-    case Op::kConstant: code_.push_back({Code::kPushC, 0, e.constant()}); return;
-    case Op::kSymbol: code_.push_back({Code::kPushV, e.slot(), 0.0}); return;
-    default: break;
+    case Op::kConstant:
+      code_.push_back({Code::kPushC, 0, e.constant()});
+      return;
+    case Op::kSymbol:
+      code_.push_back({Code::kPushV, e.slot(), 0.0});
+      return;
+    default:
+      break;
   }
   Emit(e.args()[0], depth);
   if (Arity(e.op()) == 1) {
@@ -112,9 +136,12 @@ void CompiledExpression::Emit(const Expression& e, int depth) {
   if (e.op() == Op::kPow && rhs.is_constant() && std::nearbyint(rhs.constant()) == rhs.constant() &&
       std::abs(rhs.constant()) <= 4) {
     const int n = static_cast<int>(rhs.constant());
-    if (n == 2) code_.push_back({Code::kSquare, 0, 0.0});
-    else if (n == 3) code_.push_back({Code::kCube, 0, 0.0});
-    else code_.push_back({Code::kPowInt, n, 0.0});
+    if (n == 2)
+      code_.push_back({Code::kSquare, 0, 0.0});
+    else if (n == 3)
+      code_.push_back({Code::kCube, 0, 0.0});
+    else
+      code_.push_back({Code::kPowInt, n, 0.0});
     return;
   }
   const Code base = BinaryCode(e.op());
@@ -128,13 +155,21 @@ void CompiledExpression::Emit(const Expression& e, int depth) {
     Emit(rhs, depth);
     Code code;
     switch (e.op()) {
-      case Op::kAdd: code = lhs.is_constant() ? Code::kAddC : Code::kAddV; break;
-      case Op::kMul: code = lhs.is_constant() ? Code::kMulC : Code::kMulV; break;
-      case Op::kSub: code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV; break;
-      default: code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV; break;
+      case Op::kAdd:
+        code = lhs.is_constant() ? Code::kAddC : Code::kAddV;
+        break;
+      case Op::kMul:
+        code = lhs.is_constant() ? Code::kMulC : Code::kMulV;
+        break;
+      case Op::kSub:
+        code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV;
+        break;
+      default:
+        code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV;
+        break;
     }
-    code_.push_back({code, lhs.is_symbol() ? lhs.slot() : 0,
-                     lhs.is_constant() ? lhs.constant() : 0.0});
+    code_.push_back(
+        {code, lhs.is_symbol() ? lhs.slot() : 0, lhs.is_constant() ? lhs.constant() : 0.0});
     return;
   }
   if (rhs.is_constant()) {
@@ -159,12 +194,11 @@ double CompiledExpression::Evaluate(const double* env) const {
 double CompiledExpression::Run(const double* env, double* stack) const {
   // Direct threading (GCC/Clang "labels as values"): each handler jumps straight to the next.
   static const void* const kDispatch[] = {
-      &&push_c, &&push_v, &&neg,   &&sin_,  &&cos_,  &&tan_,   &&exp_,   &&log_,
-      &&sqrt_,  &&abs_,   &&sign_, &&sq,    &&cube,  &&powint, &&add_s,  &&add_c,
-      &&add_v,  &&sub_s,  &&sub_c, &&sub_v, &&mul_s, &&mul_c,  &&mul_v,  &&div_s,
-      &&div_c,  &&div_v,  &&pow_s, &&pow_c, &&pow_v, &&min_s,  &&min_c,  &&min_v,
-      &&max_s,  &&max_c,  &&max_v, &&atan2_s, &&atan2_c, &&atan2_v, &&rsub_c, &&rsub_v,
-      &&rdiv_c, &&rdiv_v, &&end};
+      &&push_c,  &&push_v,  &&neg,    &&sin_,   &&cos_,   &&tan_,   &&exp_,  &&log_,  &&sqrt_,
+      &&abs_,    &&sign_,   &&sq,     &&cube,   &&powint, &&add_s,  &&add_c, &&add_v, &&sub_s,
+      &&sub_c,   &&sub_v,   &&mul_s,  &&mul_c,  &&mul_v,  &&div_s,  &&div_c, &&div_v, &&pow_s,
+      &&pow_c,   &&pow_v,   &&min_s,  &&min_c,  &&min_v,  &&max_s,  &&max_c, &&max_v, &&atan2_s,
+      &&atan2_c, &&atan2_v, &&rsub_c, &&rsub_v, &&rdiv_c, &&rdiv_v, &&end};
   static_assert(sizeof(kDispatch) / sizeof(kDispatch[0]) ==
                 static_cast<std::size_t>(Code::kEnd) + 1);
   const Instruction* pc = code_.data();

@@ -6,11 +6,16 @@ namespace hybrid {
 
 std::string_view RelationSpelling(Relation r) {
   switch (r) {
-    case Relation::kLess: return "<";
-    case Relation::kLessEqual: return "<=";
-    case Relation::kGreater: return ">";
-    case Relation::kGreaterEqual: return ">=";
-    case Relation::kEqual: return "==";
+    case Relation::kLess:
+      return "<";
+    case Relation::kLessEqual:
+      return "<=";
+    case Relation::kGreater:
+      return ">";
+    case Relation::kGreaterEqual:
+      return ">=";
+    case Relation::kEqual:
+      return "==";
   }
   return "?";
 }
@@ -18,11 +23,16 @@ std::string_view RelationSpelling(Relation r) {
 bool Comparison::Holds(std::span<const double> env, double tol) const {
   const double r = lhs.Evaluate(env) - rhs.Evaluate(env);
   switch (relation) {
-    case Relation::kLess: return r < 0.0;
-    case Relation::kLessEqual: return r <= tol;
-    case Relation::kGreater: return r > 0.0;
-    case Relation::kGreaterEqual: return r >= -tol;
-    case Relation::kEqual: return std::abs(r) <= tol;
+    case Relation::kLess:
+      return r < 0.0;
+    case Relation::kLessEqual:
+      return r <= tol;
+    case Relation::kGreater:
+      return r > 0.0;
+    case Relation::kGreaterEqual:
+      return r >= -tol;
+    case Relation::kEqual:
+      return std::abs(r) <= tol;
   }
   return false;
 }

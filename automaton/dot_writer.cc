@@ -88,7 +88,8 @@ std::string WriteDot(const System& system, const DotOptions& options) {
       << "  edge [fontname=\"Helvetica\", fontsize=9];\n";
   const auto components = system.components();
   if (options.product || components.size() == 1) {
-    const Automaton a = options.product ? system.Product(options.max_product_modes) : components[0].automaton;
+    const Automaton a =
+        options.product ? system.Product(options.max_product_modes) : components[0].automaton;
     WriteAutomaton(a, "", "  ", out);
   } else {
     for (size_t c = 0; c < components.size(); ++c) {

@@ -24,39 +24,58 @@ struct FunctionSpelling {
 };
 
 constexpr FunctionSpelling kFunctions[] = {
-    {Op::kSin, "sin"},   {Op::kCos, "cos"},   {Op::kTan, "tan"}, {Op::kExp, "exp"},
-    {Op::kLog, "log"},   {Op::kSqrt, "sqrt"}, {Op::kAbs, "abs"}, {Op::kSign, "sign"},
-    {Op::kMin, "min"},   {Op::kMax, "max"},   {Op::kAtan2, "atan2"},
+    {Op::kSin, "sin"}, {Op::kCos, "cos"},   {Op::kTan, "tan"},     {Op::kExp, "exp"},
+    {Op::kLog, "log"}, {Op::kSqrt, "sqrt"}, {Op::kAbs, "abs"},     {Op::kSign, "sign"},
+    {Op::kMin, "min"}, {Op::kMax, "max"},   {Op::kAtan2, "atan2"},
 };
 
 double SignOf(double x) { return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0); }
 
 double ApplyUnary(Op op, double a) {
   switch (op) {
-    case Op::kNeg: return -a;
-    case Op::kSin: return std::sin(a);
-    case Op::kCos: return std::cos(a);
-    case Op::kTan: return std::tan(a);
-    case Op::kExp: return std::exp(a);
-    case Op::kLog: return std::log(a);
-    case Op::kSqrt: return std::sqrt(a);
-    case Op::kAbs: return std::abs(a);
-    case Op::kSign: return SignOf(a);
-    default: throw std::logic_error("ApplyUnary: not a unary op");
+    case Op::kNeg:
+      return -a;
+    case Op::kSin:
+      return std::sin(a);
+    case Op::kCos:
+      return std::cos(a);
+    case Op::kTan:
+      return std::tan(a);
+    case Op::kExp:
+      return std::exp(a);
+    case Op::kLog:
+      return std::log(a);
+    case Op::kSqrt:
+      return std::sqrt(a);
+    case Op::kAbs:
+      return std::abs(a);
+    case Op::kSign:
+      return SignOf(a);
+    default:
+      throw std::logic_error("ApplyUnary: not a unary op");
   }
 }
 
 double ApplyBinary(Op op, double a, double b) {
   switch (op) {
-    case Op::kAdd: return a + b;
-    case Op::kSub: return a - b;
-    case Op::kMul: return a * b;
-    case Op::kDiv: return a / b;
-    case Op::kPow: return std::pow(a, b);
-    case Op::kMin: return std::min(a, b);
-    case Op::kMax: return std::max(a, b);
-    case Op::kAtan2: return std::atan2(a, b);
-    default: throw std::logic_error("ApplyBinary: not a binary op");
+    case Op::kAdd:
+      return a + b;
+    case Op::kSub:
+      return a - b;
+    case Op::kMul:
+      return a * b;
+    case Op::kDiv:
+      return a / b;
+    case Op::kPow:
+      return std::pow(a, b);
+    case Op::kMin:
+      return std::min(a, b);
+    case Op::kMax:
+      return std::max(a, b);
+    case Op::kAtan2:
+      return std::atan2(a, b);
+    default:
+      throw std::logic_error("ApplyBinary: not a binary op");
   }
 }
 
@@ -64,24 +83,36 @@ double ApplyBinary(Op op, double a, double b) {
 int Precedence(const Expression& e) {
   switch (e.op()) {
     case Op::kAdd:
-    case Op::kSub: return 1;
+    case Op::kSub:
+      return 1;
     case Op::kMul:
-    case Op::kDiv: return 2;
-    case Op::kNeg: return 3;
-    case Op::kPow: return 4;
-    case Op::kConstant: return e.constant() < 0.0 || std::signbit(e.constant()) ? 3 : 5;
-    default: return 5;
+    case Op::kDiv:
+      return 2;
+    case Op::kNeg:
+      return 3;
+    case Op::kPow:
+      return 4;
+    case Op::kConstant:
+      return e.constant() < 0.0 || std::signbit(e.constant()) ? 3 : 5;
+    default:
+      return 5;
   }
 }
 
 std::string_view InfixSpelling(Op op) {
   switch (op) {
-    case Op::kAdd: return " + ";
-    case Op::kSub: return " - ";
-    case Op::kMul: return " * ";
-    case Op::kDiv: return " / ";
-    case Op::kPow: return "^";
-    default: return "?";
+    case Op::kAdd:
+      return " + ";
+    case Op::kSub:
+      return " - ";
+    case Op::kMul:
+      return " * ";
+    case Op::kDiv:
+      return " / ";
+    case Op::kPow:
+      return "^";
+    default:
+      return "?";
   }
 }
 
@@ -95,8 +126,12 @@ void PrintWrapped(const Expression& e, bool wrap, std::string* out) {
 
 void Print(const Expression& e, std::string* out) {
   switch (e.op()) {
-    case Op::kConstant: out->append(FormatNumber(e.constant())); return;
-    case Op::kSymbol: out->append(e.symbol_name()); return;
+    case Op::kConstant:
+      out->append(FormatNumber(e.constant()));
+      return;
+    case Op::kSymbol:
+      out->append(e.symbol_name());
+      return;
     case Op::kNeg:
       out->push_back('-');
       PrintWrapped(e.args()[0], Precedence(e.args()[0]) < 3, out);
@@ -198,9 +233,12 @@ AffineForm Combine(const AffineForm& a, const AffineForm& b, double sign) {
 /// result above it (`sign(log(0))`, `min(1 / 0, 2)`) folds like any other symbol-free subtree.
 std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e) {
   switch (e.op()) {
-    case Op::kConstant: return {e, e.constant()};
-    case Op::kSymbol: return {e, std::nullopt};
-    default: break;
+    case Op::kConstant:
+      return {e, e.constant()};
+    case Op::kSymbol:
+      return {e, std::nullopt};
+    default:
+      break;
   }
   std::vector<Expression> args;
   std::vector<double> values;
@@ -224,7 +262,8 @@ std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e) 
 int Arity(Op op) {
   switch (op) {
     case Op::kConstant:
-    case Op::kSymbol: return 0;
+    case Op::kSymbol:
+      return 0;
     case Op::kNeg:
     case Op::kSin:
     case Op::kCos:
@@ -233,8 +272,10 @@ int Arity(Op op) {
     case Op::kLog:
     case Op::kSqrt:
     case Op::kAbs:
-    case Op::kSign: return 1;
-    default: return 2;
+    case Op::kSign:
+      return 1;
+    default:
+      return 2;
   }
 }
 
@@ -311,45 +352,69 @@ std::span<const Expression> Expression::args() const { return node_->args; }
 double Expression::Evaluate(std::span<const double> env) const {
   const Node& n = *node_;
   switch (Arity(n.op)) {
-    case 0: return n.op == Op::kConstant ? n.value : env[n.slot];
-    case 1: return ApplyUnary(n.op, n.args[0].Evaluate(env));
-    default: return ApplyBinary(n.op, n.args[0].Evaluate(env), n.args[1].Evaluate(env));
+    case 0:
+      return n.op == Op::kConstant ? n.value : env[n.slot];
+    case 1:
+      return ApplyUnary(n.op, n.args[0].Evaluate(env));
+    default:
+      return ApplyBinary(n.op, n.args[0].Evaluate(env), n.args[1].Evaluate(env));
   }
 }
 
 Interval Expression::EvaluateInterval(std::span<const Interval> env) const {
   const Node& n = *node_;
   switch (n.op) {
-    case Op::kConstant: return Interval(n.value);
-    case Op::kSymbol: return env[n.slot];
-    default: break;
+    case Op::kConstant:
+      return Interval(n.value);
+    case Op::kSymbol:
+      return env[n.slot];
+    default:
+      break;
   }
   const Interval a = n.args[0].EvaluateInterval(env);
   switch (n.op) {
-    case Op::kNeg: return -a;
-    case Op::kSin: return Sin(a);
-    case Op::kCos: return Cos(a);
-    case Op::kTan: return Tan(a);
-    case Op::kExp: return Exp(a);
-    case Op::kLog: return Log(a);
-    case Op::kSqrt: return Sqrt(a);
-    case Op::kAbs: return Abs(a);
+    case Op::kNeg:
+      return -a;
+    case Op::kSin:
+      return Sin(a);
+    case Op::kCos:
+      return Cos(a);
+    case Op::kTan:
+      return Tan(a);
+    case Op::kExp:
+      return Exp(a);
+    case Op::kLog:
+      return Log(a);
+    case Op::kSqrt:
+      return Sqrt(a);
+    case Op::kAbs:
+      return Abs(a);
     case Op::kSign:
       return Interval(a.lo() > 0.0 ? 1.0 : (a.lo() < 0.0 ? -1.0 : 0.0),
                       a.hi() > 0.0 ? 1.0 : (a.hi() < 0.0 ? -1.0 : 0.0));
-    default: break;
+    default:
+      break;
   }
   const Interval b = n.args[1].EvaluateInterval(env);
   switch (n.op) {
-    case Op::kAdd: return a + b;
-    case Op::kSub: return a - b;
-    case Op::kMul: return a * b;
-    case Op::kDiv: return a / b;
-    case Op::kPow: return Pow(a, b);
-    case Op::kMin: return Min(a, b);
-    case Op::kMax: return Max(a, b);
-    case Op::kAtan2: return Atan2(a, b);
-    default: throw std::logic_error("Expression::EvaluateInterval: unknown op");
+    case Op::kAdd:
+      return a + b;
+    case Op::kSub:
+      return a - b;
+    case Op::kMul:
+      return a * b;
+    case Op::kDiv:
+      return a / b;
+    case Op::kPow:
+      return Pow(a, b);
+    case Op::kMin:
+      return Min(a, b);
+    case Op::kMax:
+      return Max(a, b);
+    case Op::kAtan2:
+      return Atan2(a, b);
+    default:
+      throw std::logic_error("Expression::EvaluateInterval: unknown op");
   }
 }
 
@@ -361,23 +426,36 @@ Expression Expression::Derivative(int slot) const {
   const Expression da = a.Derivative(slot);
   const auto half = Constant(0.5);
   switch (n.op) {
-    case Op::kNeg: return SNeg(da);
-    case Op::kSin: return SMul(Call(Op::kCos, a), da);
-    case Op::kCos: return SNeg(SMul(Call(Op::kSin, a), da));
-    case Op::kTan: return SDiv(da, Binary(Op::kPow, Call(Op::kCos, a), Constant(2.0)));
-    case Op::kExp: return SMul(*this, da);
-    case Op::kLog: return SDiv(da, a);
-    case Op::kSqrt: return SDiv(da, SMul(Constant(2.0), *this));
-    case Op::kAbs: return SMul(Call(Op::kSign, a), da);
-    case Op::kSign: return Constant(0.0);
-    default: break;
+    case Op::kNeg:
+      return SNeg(da);
+    case Op::kSin:
+      return SMul(Call(Op::kCos, a), da);
+    case Op::kCos:
+      return SNeg(SMul(Call(Op::kSin, a), da));
+    case Op::kTan:
+      return SDiv(da, Binary(Op::kPow, Call(Op::kCos, a), Constant(2.0)));
+    case Op::kExp:
+      return SMul(*this, da);
+    case Op::kLog:
+      return SDiv(da, a);
+    case Op::kSqrt:
+      return SDiv(da, SMul(Constant(2.0), *this));
+    case Op::kAbs:
+      return SMul(Call(Op::kSign, a), da);
+    case Op::kSign:
+      return Constant(0.0);
+    default:
+      break;
   }
   const Expression& b = n.args[1];
   const Expression db = b.Derivative(slot);
   switch (n.op) {
-    case Op::kAdd: return SAdd(da, db);
-    case Op::kSub: return SSub(da, db);
-    case Op::kMul: return SAdd(SMul(da, b), SMul(a, db));
+    case Op::kAdd:
+      return SAdd(da, db);
+    case Op::kSub:
+      return SSub(da, db);
+    case Op::kMul:
+      return SAdd(SMul(da, b), SMul(a, db));
     case Op::kDiv:
       return SDiv(SSub(SMul(da, b), SMul(a, db)), Binary(Op::kPow, b, Constant(2.0)));
     case Op::kPow:
@@ -394,7 +472,8 @@ Expression Expression::Derivative(int slot) const {
     case Op::kAtan2:  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
       return SDiv(SSub(SMul(b, da), SMul(a, db)),
                   Binary(Op::kPow, a, Constant(2.0)) + Binary(Op::kPow, b, Constant(2.0)));
-    default: throw std::logic_error("Expression::Derivative: unknown op");
+    default:
+      throw std::logic_error("Expression::Derivative: unknown op");
   }
 }
 
@@ -425,9 +504,12 @@ std::optional<AffineForm> Expression::AsAffine() const {
     return AffineForm{v, {}};
   }
   switch (n.op) {
-    case Op::kNeg: return Scale(parts[0], -1.0);
-    case Op::kAdd: return Combine(parts[0], parts[1], 1.0);
-    case Op::kSub: return Combine(parts[0], parts[1], -1.0);
+    case Op::kNeg:
+      return Scale(parts[0], -1.0);
+    case Op::kAdd:
+      return Combine(parts[0], parts[1], 1.0);
+    case Op::kSub:
+      return Combine(parts[0], parts[1], -1.0);
     case Op::kMul:
       if (parts[0].terms.empty()) return Scale(parts[1], parts[0].constant);
       if (parts[1].terms.empty()) return Scale(parts[0], parts[1].constant);
@@ -440,7 +522,8 @@ std::optional<AffineForm> Expression::AsAffine() const {
     case Op::kPow:
       if (parts[1].terms.empty() && parts[1].constant == 1.0) return parts[0];
       return std::nullopt;
-    default: return std::nullopt;
+    default:
+      return std::nullopt;
   }
 }
 

@@ -56,15 +56,20 @@ Interval::Interval(double lo, double hi) : lo_(lo), hi_(hi) {
 }
 
 double Interval::mid() const {
-  if (std::isinf(lo_) || std::isinf(hi_)) return std::isinf(lo_) && std::isinf(hi_) ? 0.0 : (std::isinf(lo_) ? hi_ : lo_);
+  if (std::isinf(lo_) || std::isinf(hi_))
+    return std::isinf(lo_) && std::isinf(hi_) ? 0.0 : (std::isinf(lo_) ? hi_ : lo_);
   return lo_ + 0.5 * (hi_ - lo_);
 }
 
 Interval Interval::Entire() { return {-kInf, kInf}; }
 
-Interval operator+(const Interval& a, const Interval& b) { return Outward(a.lo_ + b.lo_, a.hi_ + b.hi_); }
+Interval operator+(const Interval& a, const Interval& b) {
+  return Outward(a.lo_ + b.lo_, a.hi_ + b.hi_);
+}
 
-Interval operator-(const Interval& a, const Interval& b) { return Outward(a.lo_ - b.hi_, a.hi_ - b.lo_); }
+Interval operator-(const Interval& a, const Interval& b) {
+  return Outward(a.lo_ - b.hi_, a.hi_ - b.lo_);
+}
 
 Interval operator-(const Interval& a) { return {-a.hi_, -a.lo_}; }
 
@@ -164,9 +169,9 @@ Interval Max(const Interval& a, const Interval& b) {
 Interval Atan2(const Interval& y, const Interval& x) {
   constexpr double kPi = std::numbers::pi;
   auto atan_of = [](const Interval& r) { return Outward(std::atan(r.lo()), std::atan(r.hi())); };
-  if (x.lo() > 0.0) return atan_of(y / x);                              // right half plane
-  if (y.lo() > 0.0) return Interval(kPi / 2) - atan_of(x / y);           // upper half plane
-  if (y.hi() < 0.0) return Interval(-kPi / 2) - atan_of(x / y);          // lower half plane
+  if (x.lo() > 0.0) return atan_of(y / x);                       // right half plane
+  if (y.lo() > 0.0) return Interval(kPi / 2) - atan_of(x / y);   // upper half plane
+  if (y.hi() < 0.0) return Interval(-kPi / 2) - atan_of(x / y);  // lower half plane
   return Outward(-kPi, kPi);
 }
 

@@ -1,10 +1,9 @@
 #include "automaton/mode_graph.h"
 
 #include <algorithm>
-#include <map>
-
 #include <boost/graph/breadth_first_search.hpp>
 #include <boost/graph/strong_components.hpp>
+#include <map>
 
 namespace hybrid {
 
@@ -24,8 +23,8 @@ ModeGraph::ModeGraph(const Automaton& automaton)
 std::vector<ModeId> ModeGraph::ReachableModes() const {
   const auto n = boost::num_vertices(graph_);
   std::vector<boost::default_color_type> color(n, boost::white_color);
-  auto color_map = boost::make_iterator_property_map(color.begin(),
-                                                     boost::get(boost::vertex_index, graph_));
+  auto color_map =
+      boost::make_iterator_property_map(color.begin(), boost::get(boost::vertex_index, graph_));
   boost::queue<ModeGraphType::vertex_descriptor> queue;
   for (ModeId m : initial_) {
     if (color[m.value()] == boost::white_color) {
@@ -76,8 +75,7 @@ std::vector<std::vector<ModeId>> ModeGraph::StronglyConnectedComponents() const 
 std::vector<std::string> ModeGraph::Warnings() const {
   std::vector<std::string> out;
   for (ModeId m : UnreachableModes()) {
-    out.push_back("mode '" + graph_[m.value()].name +
-                  "' is unreachable from the initial modes");
+    out.push_back("mode '" + graph_[m.value()].name + "' is unreachable from the initial modes");
   }
   if (boost::num_edges(graph_) == 0 && boost::num_vertices(graph_) > 1) {
     out.push_back("automaton '" + automaton_name_ + "' has several modes but no transitions");

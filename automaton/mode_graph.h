@@ -1,9 +1,8 @@
 #pragma once
 
+#include <boost/graph/adjacency_list.hpp>
 #include <string>
 #include <vector>
-
-#include <boost/graph/adjacency_list.hpp>
 
 #include "automaton/automaton.h"
 #include "automaton/id.h"

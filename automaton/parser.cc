@@ -99,8 +99,8 @@ struct ident_tok : seq<identifier, sp> {};
 struct digits : plus<digit> {};
 struct exponent_digits : digits {};
 struct exponent : seq<one<'e', 'E'>, opt<one<'+', '-'>>, must<exponent_digits>> {};
-struct number : seq<sor<seq<digits, opt<one<'.'>, star<digit>>>, seq<one<'.'>, digits>>,
-                    opt<exponent>> {};
+struct number
+    : seq<sor<seq<digits, opt<one<'.'>, star<digit>>>, seq<one<'.'>, digits>>, opt<exponent>> {};
 struct number_tok : seq<number, sp> {};
 struct signed_number : seq<opt<one<'+', '-'>>, sp, number> {};
 struct signed_number_tok : seq<signed_number, sp> {};
@@ -140,7 +140,8 @@ struct sum : seq<product, star<sor<plus_op, minus_op>, must<product>>> {};
 struct expression : seq<sum> {};
 
 // Comparisons and predicates.
-struct relation : tok<sor<string<'<', '='>, string<'>', '='>, string<'=', '='>, one<'<'>, one<'>'>>> {};
+struct relation
+    : tok<sor<string<'<', '='>, string<'>', '='>, string<'=', '='>, one<'<'>, one<'>'>>> {};
 struct comparison : seq<expression, relation, must<expression>> {};
 struct no_or : not_at<kw_or> {};
 struct conjunction : sor<kw_true, seq<comparison, star<kw_and, must<comparison>>>> {};
@@ -159,20 +160,22 @@ struct unit : seq<lbracket, must<unit_text>, sp, must<rbracket>> {};
 struct range : seq<lbracket, must<expression>, must<comma>, must<expression>, must<rbracket>> {};
 struct var_item : seq<ident_tok, opt<unit>, opt<kw_in, must<range>>> {};
 struct var_decl : seq<kw_var, must<var_item>, star<comma, must<var_item>>, must<semi>> {};
-struct discrete_decl : seq<kw_discrete, must<ident_tok>, star<comma, must<ident_tok>>, must<semi>> {};
-struct param_decl : seq<kw_param, must<ident_tok>, opt<unit>, must<equals>, must<expression>,
-                        must<semi>> {};
-struct input_decl : seq<kw_input, must<ident_tok>, opt<unit>, must<kw_in>, must<range>, must<semi>> {};
+struct discrete_decl : seq<kw_discrete, must<ident_tok>, star<comma, must<ident_tok>>, must<semi>> {
+};
+struct param_decl
+    : seq<kw_param, must<ident_tok>, opt<unit>, must<equals>, must<expression>, must<semi>> {};
+struct input_decl
+    : seq<kw_input, must<ident_tok>, opt<unit>, must<kw_in>, must<range>, must<semi>> {};
 
 struct discrete_value : seq<ident_tok, must<equals>, must<signed_number_tok>> {};
-struct discrete_values : seq<lparen, must<discrete_value>, star<comma, must<discrete_value>>,
-                             must<rparen>> {};
+struct discrete_values
+    : seq<lparen, must<discrete_value>, star<comma, must<discrete_value>>, must<rparen>> {};
 struct flow : seq<ident_tok, prime, must<equals>, must<expression>, must<semi>> {};
 struct invariant : seq<kw_inv, must<conjunction>, must<no_or>, must<semi>> {};
 struct mode_item : sor<flow, invariant> {};
 struct mode_body_end : rbrace {};
-struct mode_decl : seq<kw_mode, must<ident_tok>, opt<discrete_values>, must<lbrace>, star<mode_item>,
-                       must<mode_body_end>> {};
+struct mode_decl : seq<kw_mode, must<ident_tok>, opt<discrete_values>, must<lbrace>,
+                       star<mode_item>, must<mode_body_end>> {};
 
 struct transition_name : seq<ident_tok, colon> {};
 struct source_mode : ident_tok {};
@@ -184,16 +187,17 @@ struct label : seq<kw_label, must<name_tok>, must<semi>> {};
 struct urgency : seq<sor<kw_urgent, kw_lazy>, must<semi>> {};
 struct transition_item : sor<guard, reset, label, urgency> {};
 struct transition_body_end : rbrace {};
-struct transition_decl : seq<kw_transition, opt<transition_name>, must<source_mode>, must<arrow>,
-                             must<target_mode>, must<lbrace>, star<transition_item>,
-                             must<transition_body_end>> {};
+struct transition_decl
+    : seq<kw_transition, opt<transition_name>, must<source_mode>, must<arrow>, must<target_mode>,
+          must<lbrace>, star<transition_item>, must<transition_body_end>> {};
 
 struct init_point : seq<equals, must<expression>> {};
 struct init_range : seq<kw_in, must<range>> {};
 struct init_value_kind : sor<init_point, init_range> {};
 struct init_item : seq<ident_tok, must<init_value_kind>, must<semi>> {};
 struct init_body_end : rbrace {};
-struct init_decl : seq<kw_init, must<ident_tok>, must<lbrace>, star<init_item>, must<init_body_end>> {};
+struct init_decl
+    : seq<kw_init, must<ident_tok>, must<lbrace>, star<init_item>, must<init_body_end>> {};
 
 struct point : seq<signed_number_tok, must<colon>, must<signed_number_tok>> {};
 struct points : seq<lparen, must<point>, star<comma, must<point>>, must<rparen>> {};
@@ -204,8 +208,8 @@ struct signal_item : seq<name_tok, must<equals>, must<signal>, must<semi>> {};
 struct until_item : seq<kw_until, must<signed_number_tok>, must<semi>> {};
 struct scenario_item : sor<until_item, signal_item> {};
 struct scenario_body_end : rbrace {};
-struct scenario_decl : seq<kw_scenario, must<lbrace>, star<scenario_item>,
-                           must<scenario_body_end>> {};
+struct scenario_decl
+    : seq<kw_scenario, must<lbrace>, star<scenario_item>, must<scenario_body_end>> {};
 
 struct property_kind : sor<kw_always, kw_never, kw_reach> {};
 struct horizon : seq<kw_within, must<signed_number_tok>> {};
@@ -223,8 +227,8 @@ struct instance_item : seq<kw_instance, must<ident_tok>, opt<instance_alias>, mu
 struct share_item : seq<kw_share, must<name_tok>, star<comma, must<name_tok>>, must<semi>> {};
 struct system_item : sor<instance_item, share_item, property_decl, scenario_decl> {};
 struct system_body_end : rbrace {};
-struct system_decl : seq<kw_system, must<ident_tok>, must<lbrace>, star<system_item>,
-                         must<system_body_end>> {};
+struct system_decl
+    : seq<kw_system, must<ident_tok>, must<lbrace>, star<system_item>, must<system_body_end>> {};
 
 struct string_body : star<not_one<'"', '\n', '\r'>> {};
 struct close_quote : one<'"'> {};
@@ -238,61 +242,106 @@ struct file : seq<sp, star<top_item>, must<end_of_file>> {};
 // Error messages for the rules under must<>.
 template <class Rule>
 inline constexpr const char* kMessage = nullptr;
-template <> inline constexpr auto kMessage<ident_tok> = "expected a name";
-template <> inline constexpr auto kMessage<name_tok> = "expected a name";
-template <> inline constexpr auto kMessage<source_mode> = "expected the source mode";
-template <> inline constexpr auto kMessage<target_mode> = "expected the target mode";
-template <> inline constexpr auto kMessage<exponent_digits> = "expected digits in the exponent";
-template <> inline constexpr auto kMessage<semi> = "expected ';'";
-template <> inline constexpr auto kMessage<comma> = "expected ','";
-template <> inline constexpr auto kMessage<colon> = "expected ':'";
-template <> inline constexpr auto kMessage<lbrace> = "expected '{'";
-template <> inline constexpr auto kMessage<rparen> = "expected ')'";
-template <> inline constexpr auto kMessage<rbracket> = "expected ']'";
-template <> inline constexpr auto kMessage<equals> = "expected '='";
-template <> inline constexpr auto kMessage<arrow> = "expected '->'";
-template <> inline constexpr auto kMessage<assign> = "expected ':='";
-template <> inline constexpr auto kMessage<expression> = "expected an expression";
-template <> inline constexpr auto kMessage<operand> = "expected an operand";
-template <> inline constexpr auto kMessage<product> = "expected an operand";
-template <> inline constexpr auto kMessage<comparison> =
+template <>
+inline constexpr auto kMessage<ident_tok> = "expected a name";
+template <>
+inline constexpr auto kMessage<name_tok> = "expected a name";
+template <>
+inline constexpr auto kMessage<source_mode> = "expected the source mode";
+template <>
+inline constexpr auto kMessage<target_mode> = "expected the target mode";
+template <>
+inline constexpr auto kMessage<exponent_digits> = "expected digits in the exponent";
+template <>
+inline constexpr auto kMessage<semi> = "expected ';'";
+template <>
+inline constexpr auto kMessage<comma> = "expected ','";
+template <>
+inline constexpr auto kMessage<colon> = "expected ':'";
+template <>
+inline constexpr auto kMessage<lbrace> = "expected '{'";
+template <>
+inline constexpr auto kMessage<rparen> = "expected ')'";
+template <>
+inline constexpr auto kMessage<rbracket> = "expected ']'";
+template <>
+inline constexpr auto kMessage<equals> = "expected '='";
+template <>
+inline constexpr auto kMessage<arrow> = "expected '->'";
+template <>
+inline constexpr auto kMessage<assign> = "expected ':='";
+template <>
+inline constexpr auto kMessage<expression> = "expected an expression";
+template <>
+inline constexpr auto kMessage<operand> = "expected an operand";
+template <>
+inline constexpr auto kMessage<product> = "expected an operand";
+template <>
+inline constexpr auto kMessage<comparison> =
     "expected a comparison (an expression, one of < <= > >= ==, an expression)";
-template <> inline constexpr auto kMessage<conjunction> =
+template <>
+inline constexpr auto kMessage<conjunction> =
     "expected a comparison, a conjunction of comparisons ('and'), or 'true'";
-template <> inline constexpr auto kMessage<no_or> =
-    "guards and invariants are conjunctions: 'or' is not allowed here (split the transition in two)";
-template <> inline constexpr auto kMessage<predicate> = "expected a predicate";
-template <> inline constexpr auto kMessage<not_predicate> = "expected a predicate";
-template <> inline constexpr auto kMessage<and_predicate> = "expected a predicate";
-template <> inline constexpr auto kMessage<unit_text> = "expected a unit such as [deg] or [m/s]";
-template <> inline constexpr auto kMessage<range> = "expected a range '[lo, hi]'";
-template <> inline constexpr auto kMessage<var_item> = "expected a variable name";
-template <> inline constexpr auto kMessage<kw_in> = "expected 'in'";
-template <> inline constexpr auto kMessage<discrete_value> = "expected 'name = integer'";
-template <> inline constexpr auto kMessage<signed_number_tok> = "expected a number";
-template <> inline constexpr auto kMessage<mode_body_end> =
+template <>
+inline constexpr auto kMessage<no_or> =
+    "guards and invariants are conjunctions: 'or' is not allowed here (split the transition in "
+    "two)";
+template <>
+inline constexpr auto kMessage<predicate> = "expected a predicate";
+template <>
+inline constexpr auto kMessage<not_predicate> = "expected a predicate";
+template <>
+inline constexpr auto kMessage<and_predicate> = "expected a predicate";
+template <>
+inline constexpr auto kMessage<unit_text> = "expected a unit such as [deg] or [m/s]";
+template <>
+inline constexpr auto kMessage<range> = "expected a range '[lo, hi]'";
+template <>
+inline constexpr auto kMessage<var_item> = "expected a variable name";
+template <>
+inline constexpr auto kMessage<kw_in> = "expected 'in'";
+template <>
+inline constexpr auto kMessage<discrete_value> = "expected 'name = integer'";
+template <>
+inline constexpr auto kMessage<signed_number_tok> = "expected a number";
+template <>
+inline constexpr auto kMessage<mode_body_end> =
     "expected a flow (x' = expression;), an invariant (inv ...;) or '}' closing the mode";
-template <> inline constexpr auto kMessage<transition_body_end> =
+template <>
+inline constexpr auto kMessage<transition_body_end> =
     "expected 'guard', 'reset', 'label', 'urgent', 'lazy' or '}' closing the transition";
-template <> inline constexpr auto kMessage<assignment> = "expected an assignment 'x := expression'";
-template <> inline constexpr auto kMessage<init_value_kind> = "expected '= value' or 'in [lo, hi]'";
-template <> inline constexpr auto kMessage<init_body_end> =
+template <>
+inline constexpr auto kMessage<assignment> = "expected an assignment 'x := expression'";
+template <>
+inline constexpr auto kMessage<init_value_kind> = "expected '= value' or 'in [lo, hi]'";
+template <>
+inline constexpr auto kMessage<init_body_end> =
     "expected an initial value (x = value; or x in [lo, hi];) or '}'";
-template <> inline constexpr auto kMessage<point> = "expected a point 'time: value'";
-template <> inline constexpr auto kMessage<points> = "expected '(' and points 'time: value'";
-template <> inline constexpr auto kMessage<signal> =
+template <>
+inline constexpr auto kMessage<point> = "expected a point 'time: value'";
+template <>
+inline constexpr auto kMessage<points> = "expected '(' and points 'time: value'";
+template <>
+inline constexpr auto kMessage<signal> =
     "expected a signal: a number, step(t: v, ...) or linear(t: v, ...)";
-template <> inline constexpr auto kMessage<scenario_body_end> =
+template <>
+inline constexpr auto kMessage<scenario_body_end> =
     "expected 'until T;', 'input = signal;' or '}' closing the scenario";
-template <> inline constexpr auto kMessage<property_kind> = "expected 'always', 'never' or 'reach'";
-template <> inline constexpr auto kMessage<automaton_body_end> =
+template <>
+inline constexpr auto kMessage<property_kind> = "expected 'always', 'never' or 'reach'";
+template <>
+inline constexpr auto kMessage<automaton_body_end> =
     "expected a declaration (var, discrete, param, input, mode, transition, init, scenario, "
     "property) or '}' closing the automaton";
-template <> inline constexpr auto kMessage<system_body_end> =
+template <>
+inline constexpr auto kMessage<system_body_end> =
     "expected 'instance', 'share', 'property', 'scenario' or '}' closing the system";
-template <> inline constexpr auto kMessage<string_literal> = "expected a quoted file name";
-template <> inline constexpr auto kMessage<close_quote> = "unterminated string";
-template <> inline constexpr auto kMessage<end_of_file> =
+template <>
+inline constexpr auto kMessage<string_literal> = "expected a quoted file name";
+template <>
+inline constexpr auto kMessage<close_quote> = "unterminated string";
+template <>
+inline constexpr auto kMessage<end_of_file> =
     "expected 'automaton', 'system' or 'import' at top level";
 
 // Messages are used only when a rule under must<> fails (raise_on_failure is false), so a rule
@@ -311,10 +360,10 @@ using control = must_if<errors, normal, false>::control<Rule>;
 template <class Rule>
 using selector = parse_tree::selector<
     Rule,
-    parse_tree::store_content::on<identifier, name, unit_text, number, signed_number, relation, plus_op,
-                                  minus_op, times_op, divide_op, string_body, kw_urgent, kw_lazy,
-                                  kw_step, kw_linear, kw_always, kw_never, kw_reach, kw_true,
-                                  kw_false>,
+    parse_tree::store_content::on<identifier, name, unit_text, number, signed_number, relation,
+                                  plus_op, minus_op, times_op, divide_op, string_body, kw_urgent,
+                                  kw_lazy, kw_step, kw_linear, kw_always, kw_never, kw_reach,
+                                  kw_true, kw_false>,
     parse_tree::remove_content::on<
         call, negation, comparison, conjunction, paren_predicate, in_mode, negated, unit, range,
         var_item, var_decl, discrete_decl, param_decl, input_decl, discrete_value, flow, invariant,
@@ -505,10 +554,14 @@ class Builder {
         const Node& op = *n.children[i];
         Expression rhs = Expr(*n.children[i + 1], scope, &d);
         *depth = Deeper(op, std::max(*depth, d));
-        if (op.is_type<plus_op>()) acc = acc + rhs;
-        else if (op.is_type<minus_op>()) acc = acc - rhs;
-        else if (op.is_type<times_op>()) acc = acc * rhs;
-        else acc = acc / rhs;
+        if (op.is_type<plus_op>())
+          acc = acc + rhs;
+        else if (op.is_type<minus_op>())
+          acc = acc - rhs;
+        else if (op.is_type<times_op>())
+          acc = acc * rhs;
+        else
+          acc = acc / rhs;
       }
       return acc;
     }
@@ -524,11 +577,16 @@ class Builder {
   Comparison Compare(const Node& n, const Scope& scope, int* depth) const {
     const std::string rel = Text(*n.children.at(1));
     Relation r = Relation::kEqual;
-    if (rel.starts_with("<=")) r = Relation::kLessEqual;
-    else if (rel.starts_with(">=")) r = Relation::kGreaterEqual;
-    else if (rel.starts_with("==")) r = Relation::kEqual;
-    else if (rel.starts_with("<")) r = Relation::kLess;
-    else if (rel.starts_with(">")) r = Relation::kGreater;
+    if (rel.starts_with("<="))
+      r = Relation::kLessEqual;
+    else if (rel.starts_with(">="))
+      r = Relation::kGreaterEqual;
+    else if (rel.starts_with("=="))
+      r = Relation::kEqual;
+    else if (rel.starts_with("<"))
+      r = Relation::kLess;
+    else if (rel.starts_with(">"))
+      r = Relation::kGreater;
     int lhs_depth = 0, rhs_depth = 0;
     Expression lhs = Expr(*n.children.at(0), scope, &lhs_depth);
     Expression rhs = Expr(*n.children.at(2), scope, &rhs_depth);
@@ -631,7 +689,7 @@ class Builder {
     const Node& kind = *n.children.at(1);
     p.kind = kind.is_type<grammar::kw_always>()  ? Property::Kind::kAlways
              : kind.is_type<grammar::kw_never>() ? Property::Kind::kNever
-                                                  : Property::Kind::kReach;
+                                                 : Property::Kind::kReach;
     p.predicate = Pred(*n.children.at(2), scope, is_mode);
     if (n.children.size() > 3) p.horizon = Number(*n.children.at(3)->children.at(0));
     return p;
@@ -948,10 +1006,10 @@ void ParseInto(std::string_view text, const std::string& file_name, Builder* bui
   int line = 1, column = 1;
   for (unsigned char c : text) {
     if (c == 0 || (c < 0x20 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v')) {
-      throw ParseError(file_name, line, column,
-                       c == 0 ? "NUL byte in model file (binary file?)"
-                              : "control character " + std::to_string(c) +
-                                    " in model file (binary file?)");
+      throw ParseError(
+          file_name, line, column,
+          c == 0 ? "NUL byte in model file (binary file?)"
+                 : "control character " + std::to_string(c) + " in model file (binary file?)");
     }
     if (c == '\n') {
       ++line;

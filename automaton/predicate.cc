@@ -63,11 +63,16 @@ std::span<const Predicate> Predicate::operands() const { return node_->operands;
 bool Predicate::Evaluate(std::span<const double> env, std::span<const std::string> modes,
                          double tol) const {
   switch (kind()) {
-    case Kind::kTrue: return true;
-    case Kind::kFalse: return false;
-    case Kind::kComparison: return node_->comparison.Holds(env, tol);
-    case Kind::kInMode: return std::find(modes.begin(), modes.end(), node_->mode) != modes.end();
-    case Kind::kNot: return !operands()[0].Evaluate(env, modes, tol);
+    case Kind::kTrue:
+      return true;
+    case Kind::kFalse:
+      return false;
+    case Kind::kComparison:
+      return node_->comparison.Holds(env, tol);
+    case Kind::kInMode:
+      return std::find(modes.begin(), modes.end(), node_->mode) != modes.end();
+    case Kind::kNot:
+      return !operands()[0].Evaluate(env, modes, tol);
     case Kind::kAnd:
       return operands()[0].Evaluate(env, modes, tol) && operands()[1].Evaluate(env, modes, tol);
     case Kind::kOr:
@@ -89,10 +94,14 @@ void Predicate::ForEachMode(const std::function<void(const std::string&)>& f) co
 namespace {
 int Level(Predicate::Kind k) {
   switch (k) {
-    case Predicate::Kind::kOr: return 1;
-    case Predicate::Kind::kAnd: return 2;
-    case Predicate::Kind::kNot: return 3;
-    default: return 4;
+    case Predicate::Kind::kOr:
+      return 1;
+    case Predicate::Kind::kAnd:
+      return 2;
+    case Predicate::Kind::kNot:
+      return 3;
+    default:
+      return 4;
   }
 }
 std::string Wrap(const Predicate& p, bool wrap) {
@@ -102,11 +111,16 @@ std::string Wrap(const Predicate& p, bool wrap) {
 
 std::string Predicate::ToString() const {
   switch (kind()) {
-    case Kind::kTrue: return "true";
-    case Kind::kFalse: return "false";
-    case Kind::kComparison: return node_->comparison.ToString();
-    case Kind::kInMode: return "in " + node_->mode;
-    case Kind::kNot: return "not " + Wrap(operands()[0], Level(operands()[0].kind()) < 3);
+    case Kind::kTrue:
+      return "true";
+    case Kind::kFalse:
+      return "false";
+    case Kind::kComparison:
+      return node_->comparison.ToString();
+    case Kind::kInMode:
+      return "in " + node_->mode;
+    case Kind::kNot:
+      return "not " + Wrap(operands()[0], Level(operands()[0].kind()) < 3);
     case Kind::kAnd:
     case Kind::kOr: {
       // Left-associative: an equal-level right operand keeps its parentheses.
@@ -123,9 +137,12 @@ bool operator==(const Predicate& a, const Predicate& b) {
   if (a.node_ == b.node_) return true;
   if (a.kind() != b.kind()) return false;
   switch (a.kind()) {
-    case Predicate::Kind::kComparison: return a.comparison() == b.comparison();
-    case Predicate::Kind::kInMode: return a.mode() == b.mode();
-    default: break;
+    case Predicate::Kind::kComparison:
+      return a.comparison() == b.comparison();
+    case Predicate::Kind::kInMode:
+      return a.mode() == b.mode();
+    default:
+      break;
   }
   return std::equal(a.operands().begin(), a.operands().end(), b.operands().begin(),
                     b.operands().end());

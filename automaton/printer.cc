@@ -58,7 +58,9 @@ std::string PrintAutomaton(const Automaton& a) {
         out << ";\n";
         break;
       }
-      case SymbolKind::kDiscrete: out << "  discrete " << sym.name << ";\n"; break;
+      case SymbolKind::kDiscrete:
+        out << "  discrete " << sym.name << ";\n";
+        break;
       case SymbolKind::kInput:
         out << "  input " << sym.name << UnitSuffix(sym) << " in "
             << RangeText(a.inputs()[input++].bounds) << ";\n";

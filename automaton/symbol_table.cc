@@ -6,10 +6,14 @@ namespace hybrid {
 
 std::string_view KindName(SymbolKind kind) {
   switch (kind) {
-    case SymbolKind::kVariable: return "variable";
-    case SymbolKind::kDiscrete: return "discrete variable";
-    case SymbolKind::kInput: return "input";
-    case SymbolKind::kParameter: return "parameter";
+    case SymbolKind::kVariable:
+      return "variable";
+    case SymbolKind::kDiscrete:
+      return "discrete variable";
+    case SymbolKind::kInput:
+      return "input";
+    case SymbolKind::kParameter:
+      return "parameter";
   }
   return "symbol";
 }

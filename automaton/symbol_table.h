@@ -10,10 +10,10 @@ namespace hybrid {
 
 /// What a name in a model denotes.
 enum class SymbolKind {
-  kVariable,  ///< continuous state variable, evolves by the mode's flow
-  kDiscrete,  ///< discrete state variable: a constant integer in each mode
-  kInput,     ///< bounded external input, set by the scenario or the caller
-  kParameter, ///< named constant, defined by an expression over earlier parameters
+  kVariable,   ///< continuous state variable, evolves by the mode's flow
+  kDiscrete,   ///< discrete state variable: a constant integer in each mode
+  kInput,      ///< bounded external input, set by the scenario or the caller
+  kParameter,  ///< named constant, defined by an expression over earlier parameters
 };
 
 /// Human-readable kind ("variable", "discrete variable", "input", "parameter").

@@ -41,16 +41,20 @@ Constraint Remap(const Constraint& c, const std::vector<int>& m, const SymbolTab
 Predicate Remap(const Predicate& p, const std::vector<int>& m, const SymbolTable& n,
                 const std::function<std::string(const std::string&)>& mode_name) {
   switch (p.kind()) {
-    case Predicate::Kind::kComparison: return Predicate::Compare(Remap(p.comparison(), m, n));
-    case Predicate::Kind::kInMode: return Predicate::InMode(mode_name(p.mode()));
-    case Predicate::Kind::kNot: return Predicate::Not(Remap(p.operands()[0], m, n, mode_name));
+    case Predicate::Kind::kComparison:
+      return Predicate::Compare(Remap(p.comparison(), m, n));
+    case Predicate::Kind::kInMode:
+      return Predicate::InMode(mode_name(p.mode()));
+    case Predicate::Kind::kNot:
+      return Predicate::Not(Remap(p.operands()[0], m, n, mode_name));
     case Predicate::Kind::kAnd:
       return Predicate::And(Remap(p.operands()[0], m, n, mode_name),
                             Remap(p.operands()[1], m, n, mode_name));
     case Predicate::Kind::kOr:
       return Predicate::Or(Remap(p.operands()[0], m, n, mode_name),
                            Remap(p.operands()[1], m, n, mode_name));
-    default: return p;
+    default:
+      return p;
   }
 }
 
@@ -76,7 +80,9 @@ Automaton Renamed(const Automaton& a, const std::function<std::string(const std:
         out.AddVariable(sym.name, sym.unit, domain);
         break;
       }
-      case SymbolKind::kDiscrete: out.AddDiscreteVariable(sym.name); break;
+      case SymbolKind::kDiscrete:
+        out.AddDiscreteVariable(sym.name);
+        break;
       case SymbolKind::kInput:
         out.AddInput(sym.name, range(a.inputs()[next_input++].bounds), sym.unit);
         break;
@@ -189,8 +195,9 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
       if (it == other.global_slot.end()) continue;
       const int other_slot = static_cast<int>(it - other.global_slot.begin());
       auto other_has_flow = [other_slot](const Automaton& a) {
-        return std::any_of(a.modes().begin(), a.modes().end(),
-                           [other_slot](const Mode& m) { return m.FlowOf(other_slot).has_value(); });
+        return std::any_of(a.modes().begin(), a.modes().end(), [other_slot](const Mode& m) {
+          return m.FlowOf(other_slot).has_value();
+        });
       };
       if (other_has_flow(other.automaton)) {
         Fail(kApi, "shared variable '" + local[s].name + "' has flows in two components");
@@ -316,7 +323,9 @@ Automaton System::Product(int max_modes) const {
           out.AddVariable(sym.name, sym.unit, domain);
           break;
         }
-        case SymbolKind::kDiscrete: out.AddDiscreteVariable(sym.name); break;
+        case SymbolKind::kDiscrete:
+          out.AddDiscreteVariable(sym.name);
+          break;
         case SymbolKind::kInput:
           for (const InputInfo& in : a.inputs()) {
             if (in.slot == local) {
@@ -387,7 +396,8 @@ Automaton System::Product(int max_modes) const {
         auto v = values;
         for (const InitialValue& iv : s.values) {
           const int g = c.global_slot[iv.slot];
-          if (std::none_of(v.begin(), v.end(), [g](const InitialValue& x) { return x.slot == g; })) {
+          if (std::none_of(v.begin(), v.end(),
+                           [g](const InitialValue& x) { return x.slot == g; })) {
             v.push_back({g, {global(c, iv.range.lo), global(c, iv.range.hi)}, iv.is_point});
           }
         }

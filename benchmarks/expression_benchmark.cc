@@ -20,7 +20,9 @@ hybrid::Expression Parse(const std::string& rhs) {
       "automaton b {\n"
       "  param theta3_min = -55; param theta3_max = 43;\n"
       "  var g; input u in [-1, 1]; var x; var y; param m1 = 0.5;\n"
-      "  mode m { x' = " + rhs + "; }\n"
+      "  mode m { x' = " +
+      rhs +
+      "; }\n"
       "  init m { g = 0; x = 0; y = 0; }\n"
       "}\n";
   return *hybrid::ParseAutomaton(text, "benchmark.ha").modes()[0].FlowOf(kX);

@@ -4,6 +4,8 @@
 // Exit codes (docs/cli.md): 0 success, 1 invalid model (parse or validation error, reported as
 // FILE:LINE:COL: message), 2 usage error (bad options), 3 output error (cannot write a file).
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -11,7 +13,6 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <unistd.h>
 
 #include "automaton/dot_writer.h"
 #include "automaton/mode_graph.h"
@@ -149,9 +150,9 @@ json Info(const System& s, const std::string& file) {
     for (const auto& init : a.initial_states()) {
       json values = json::object();
       for (const auto& v : init.values) {
-        values[sym[v.slot].name] =
-            v.is_point ? json(v.range.lo.Evaluate(env))
-                       : json({v.range.lo.Evaluate(env), v.range.hi.Evaluate(env)});
+        values[sym[v.slot].name] = v.is_point
+                                       ? json(v.range.lo.Evaluate(env))
+                                       : json({v.range.lo.Evaluate(env), v.range.hi.Evaluate(env)});
       }
       initial.push_back({{"mode", a.mode(init.mode).name}, {"values", values}});
     }
@@ -201,7 +202,8 @@ json Info(const System& s, const std::string& file) {
 std::string Join(const json& array, const std::string& sep = ", ") {
   std::string out;
   for (size_t i = 0; i < array.size(); ++i) {
-    out += (i > 0 ? sep : "") + (array[i].is_string() ? array[i].get<std::string>() : array[i].dump());
+    out +=
+        (i > 0 ? sep : "") + (array[i].is_string() ? array[i].get<std::string>() : array[i].dump());
   }
   return out;
 }
@@ -213,7 +215,8 @@ std::string InfoText(const json& info) {
   if (!info["shared"].empty()) out << "shared: " << Join(info["shared"]) << "\n";
   for (const auto& c : info["components"]) {
     const std::string instance = c["instance"].get<std::string>();
-    out << "\n" << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
+    out << "\n"
+        << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
         << c["automaton"].get<std::string>() << "\n";
     out << "  variables (" << c["variables"].size() << "):";
     for (const auto& v : c["variables"]) {
@@ -242,7 +245,8 @@ std::string InfoText(const json& info) {
     for (const auto& t : c["transitions"]) {
       out << "    " << t["name"].get<std::string>() << ": " << t["source"].get<std::string>()
           << " -> " << t["target"].get<std::string>();
-      if (!t["label"].get<std::string>().empty()) out << " [" << t["label"].get<std::string>() << "]";
+      if (!t["label"].get<std::string>().empty())
+        out << " [" << t["label"].get<std::string>() << "]";
       out << " when " << t["guard"].get<std::string>();
       if (t["urgency"] == "lazy") out << " (lazy)";
       out << "\n";
@@ -253,8 +257,8 @@ std::string InfoText(const json& info) {
     }
     out << "  reachable modes (" << c["reachable_modes"].size() << " of " << c["modes"].size()
         << "): " << Join(c["reachable_modes"]) << "\n";
-    out << "  terminal modes: " << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"]))
-        << "\n";
+    out << "  terminal modes: "
+        << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"])) << "\n";
     out << "  cycles (strongly connected components with more than one mode): "
         << c["cycles"].size() << "\n";
     for (const auto& p : c["properties"]) {
@@ -275,7 +279,8 @@ std::string InfoText(const json& info) {
     }
     out << "\n";
   }
-  out << "\nwarnings: " << (info["warnings"].empty() ? "none" : std::to_string(info["warnings"].size())) << "\n";
+  out << "\nwarnings: "
+      << (info["warnings"].empty() ? "none" : std::to_string(info["warnings"].size())) << "\n";
   for (const auto& w : info["warnings"]) out << "  warning: " << w.get<std::string>() << "\n";
   return out.str();
 }
@@ -292,15 +297,17 @@ int main(int argc, char** argv) {
 
   std::string model;
   bool as_json = false;
-  auto* info = app.add_subcommand("info", "Summarise a model: variables, modes, transitions, "
-                                          "reachable modes, cycles, warnings");
+  auto* info = app.add_subcommand("info",
+                                  "Summarise a model: variables, modes, transitions, "
+                                  "reachable modes, cycles, warnings");
   info->add_option("MODEL", model, "Model file (.ha)")->required();
   info->add_flag("--json", as_json, "Machine-readable output");
 
   std::string output;
   bool product = false;
-  auto* dot = app.add_subcommand("dot", "Write the mode graph in Graphviz DOT (render with "
-                                        "`dot -Tsvg`)");
+  auto* dot = app.add_subcommand("dot",
+                                 "Write the mode graph in Graphviz DOT (render with "
+                                 "`dot -Tsvg`)");
   dot->add_option("MODEL", model, "Model file (.ha)")->required();
   dot->add_option("-o,--output", output, "Output file (default: standard output)");
   dot->add_flag("--product", product,

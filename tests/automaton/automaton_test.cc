@@ -64,8 +64,8 @@ TEST_F(AutomatonTest, ParameterEnvironmentEvaluatesInOrder) {
 
 TEST_F(AutomatonTest, RejectsDuplicateNames) {
   ExpectInvalid([&] { a_.AddVariable("h"); }, "Automaton::AddVariable", "duplicate name 'h'");
-  ExpectInvalid([&] { a_.AddParameter("v", Expression::Constant(1)); },
-                "Automaton::AddParameter", "already declared as variable");
+  ExpectInvalid([&] { a_.AddParameter("v", Expression::Constant(1)); }, "Automaton::AddParameter",
+                "already declared as variable");
 }
 
 TEST_F(AutomatonTest, ParametersReadOnlyEarlierParameters) {
@@ -124,18 +124,20 @@ TEST_F(AutomatonTest, TransitionsNeedKnownModesAndResetVariables) {
 
 TEST_F(AutomatonTest, InitialStatesGiveEveryVariable) {
   InitialState s{falling_, {{Slot("h"), {Expression::Constant(1), Expression::Constant(1)}, true}}};
-  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState",
-                "no value for 'v'");
+  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState", "no value for 'v'");
   s.values.push_back({Slot("v"), {Expression::Constant(2), Expression::Constant(1)}, false});
-  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState", "empty initial range");
+  ExpectInvalid([&] { a_.AddInitialState(s); }, "Automaton::AddInitialState",
+                "empty initial range");
   s.values[1].range = {Expression::Constant(0), Expression::Constant(1)};
   EXPECT_NO_THROW(a_.AddInitialState(s));
   EXPECT_EQ(a_.initial_states().size(), 1u);
 }
 
 TEST_F(AutomatonTest, PropertiesMayNotReadInputsOrUnknownModes) {
-  Property p{"p", Property::Kind::kAlways,
-             Predicate::Compare({Sym(a_, "u"), Relation::kLess, Expression::Constant(0)}), {}};
+  Property p{"p",
+             Property::Kind::kAlways,
+             Predicate::Compare({Sym(a_, "u"), Relation::kLess, Expression::Constant(0)}),
+             {}};
   ExpectInvalid([&] { a_.AddProperty(p); }, "Automaton::AddProperty", "input 'u' is not allowed");
   p.predicate = Predicate::InMode("nowhere");
   ExpectInvalid([&] { a_.AddProperty(p); }, "Automaton::AddProperty", "unknown mode 'nowhere'");

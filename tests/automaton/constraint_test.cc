@@ -7,9 +7,7 @@
 namespace hybrid {
 namespace {
 
-Comparison XRel(Relation r) {
-  return {Expression::Symbol("x", 0), r, Expression::Constant(1)};
-}
+Comparison XRel(Relation r) { return {Expression::Symbol("x", 0), r, Expression::Constant(1)}; }
 
 // On the boundary (x = 1) and within / beyond the tolerance.
 TEST(ConstraintTest, StrictAndNonStrictDifferOnlyOnTheBoundary) {

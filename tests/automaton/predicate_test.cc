@@ -15,14 +15,17 @@ Predicate X(Relation r, double v) {
 TEST(PredicateTest, EvaluatesConnectivesAndModes) {
   const std::vector<double> env = {2.0};
   const std::vector<std::string> modes = {"on"};
-  EXPECT_TRUE(Predicate::And(X(Relation::kGreater, 1), Predicate::InMode("on")).Evaluate(env, modes));
-  EXPECT_FALSE(Predicate::And(X(Relation::kGreater, 1), Predicate::InMode("off")).Evaluate(env, modes));
+  EXPECT_TRUE(
+      Predicate::And(X(Relation::kGreater, 1), Predicate::InMode("on")).Evaluate(env, modes));
+  EXPECT_FALSE(
+      Predicate::And(X(Relation::kGreater, 1), Predicate::InMode("off")).Evaluate(env, modes));
   EXPECT_TRUE(Predicate::Or(X(Relation::kLess, 1), Predicate::True()).Evaluate(env, modes));
   EXPECT_TRUE(Predicate::Not(Predicate::False()).Evaluate(env, modes));
 }
 
 TEST(PredicateTest, PrintsWithMinimalParentheses) {
-  const Predicate a = X(Relation::kLess, 1), b = X(Relation::kGreater, 2), c = Predicate::InMode("m");
+  const Predicate a = X(Relation::kLess, 1), b = X(Relation::kGreater, 2),
+                  c = Predicate::InMode("m");
   EXPECT_EQ(Predicate::Or(Predicate::And(a, b), c).ToString(), "x < 1 and x > 2 or in m");
   EXPECT_EQ(Predicate::And(Predicate::Or(a, b), c).ToString(), "(x < 1 or x > 2) and in m");
   EXPECT_EQ(Predicate::Not(Predicate::And(a, b)).ToString(), "not (x < 1 and x > 2)");
