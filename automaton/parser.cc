@@ -238,6 +238,8 @@ struct import_decl : seq<kw_import, must<string_literal>, must<semi>> {};
 struct top_item : sor<import_decl, automaton_decl, system_decl> {};
 struct end_of_file : eof {};
 struct file : seq<sp, star<top_item>, must<end_of_file>> {};
+struct signal_end : eof {};
+struct signal_text : seq<sp, must<signal>, must<signal_end>> {};
 
 // Error messages for the rules under must<>.
 template <class Rule>
@@ -340,6 +342,8 @@ template <>
 inline constexpr auto kMessage<string_literal> = "expected a quoted file name";
 template <>
 inline constexpr auto kMessage<close_quote> = "unterminated string";
+template <>
+inline constexpr auto kMessage<signal_end> = "unexpected text after the signal";
 template <>
 inline constexpr auto kMessage<end_of_file> =
     "expected 'automaton', 'system' or 'import' at top level";
@@ -696,6 +700,37 @@ class Builder {
   }
 
   // `bounds(slot)` gives the evaluated bounds of the input at `slot`.
+  // The shape and points of a `signal` node; `check_value` is called on every value.
+  InputSignal SignalOf(const Node& value,
+                       const std::function<void(const Node&, double)>& check_value) const {
+    InputSignal sig;
+    if (value.is_type<grammar::signed_number>()) {
+      sig.points = {{0.0, Number(value)}};
+      check_value(value, sig.points[0].second);
+      return sig;
+    }
+    sig.shape = value.children.at(0)->is_type<grammar::kw_linear>() ? InputSignal::Shape::kLinear
+                                                                    : InputSignal::Shape::kStep;
+    for (size_t i = 1; i < value.children.size(); ++i) {
+      const Node& p = *value.children[i];
+      const double t = Number(*p.children.at(0));
+      if (!sig.points.empty() && !(sig.points.back().first < t)) {
+        Fail(p, "signal times must increase strictly");
+      }
+      const Node& v = *p.children.at(1);
+      sig.points.emplace_back(t, Number(v));
+      check_value(v, sig.points.back().second);
+    }
+    return sig;
+  }
+
+ public:
+  // A signal alone (command-line `--input NAME=SIGNAL`).
+  InputSignal StandaloneSignal(const Node& root) const {
+    return SignalOf(*root.children.at(0), [](const Node&, double) {});
+  }
+
+ private:
   Scenario ScenarioOf(const Node& n, const SymbolTable& symbols,
                       const std::function<std::pair<double, double>(int)>& bounds) const {
     Scenario s;
@@ -722,30 +757,15 @@ class Builder {
       }
       sig.slot = *slot;
       const auto [lo, hi] = bounds(*slot);
-      auto check_bounds = [&](const Node& v, double x) {
+      const Node& value = *item->children.at(1);
+      InputSignal shaped = SignalOf(value, [&](const Node& v, double x) {
         if (x < lo || x > hi) {
           Fail(v, "signal for '" + Text(input) + "' takes value " + FormatNumber(x) +
                       " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
         }
-        return x;
-      };
-      const Node& value = *item->children.at(1);
-      if (value.is_type<grammar::signed_number>()) {
-        sig.points = {{0.0, check_bounds(value, Number(value))}};
-      } else {
-        sig.shape = value.children.at(0)->is_type<grammar::kw_linear>()
-                        ? InputSignal::Shape::kLinear
-                        : InputSignal::Shape::kStep;
-        for (size_t i = 1; i < value.children.size(); ++i) {
-          const Node& p = *value.children[i];
-          const double t = Number(*p.children.at(0));
-          if (!sig.points.empty() && !(sig.points.back().first < t)) {
-            Fail(p, "signal times must increase strictly");
-          }
-          const Node& v = *p.children.at(1);
-          sig.points.emplace_back(t, check_bounds(v, Number(v)));
-        }
-      }
+      });
+      sig.shape = shaped.shape;
+      sig.points = std::move(shaped.points);
       s.inputs.push_back(std::move(sig));
     }
     if (!has_until) Fail(n, "scenario needs 'until T;'");
@@ -999,9 +1019,9 @@ std::string ReadFile(const std::filesystem::path& path) {
   return buffer.str();
 }
 
-// Parses `text` into a parse tree and builds it with `builder`.
-void ParseInto(std::string_view text, const std::string& file_name, Builder* builder,
-               std::unique_ptr<Node>* tree) {
+// Parses `text` with grammar rule `Rule` into a parse tree; every failure is a ParseError.
+template <class Rule>
+std::unique_ptr<Node> ParseTree(std::string_view text, const std::string& file_name) {
   // Binary input: report the first NUL or control byte precisely instead of a grammar error.
   int line = 1, column = 1;
   for (unsigned char c : text) {
@@ -1019,9 +1039,10 @@ void ParseInto(std::string_view text, const std::string& file_name, Builder* bui
     }
   }
   pegtl::memory_input<> in(text.data(), text.size(), file_name);
+  std::unique_ptr<Node> tree;
   try {
-    *tree = pegtl::parse_tree::parse<grammar::file, grammar::selector, grammar::depth_action,
-                                     grammar::control>(in);
+    tree = pegtl::parse_tree::parse<Rule, grammar::selector, grammar::depth_action,
+                                    grammar::control>(in);
   } catch (const pegtl::parse_error& e) {
     const auto& pos = e.positions().front();
     std::string message(e.message());
@@ -1032,7 +1053,14 @@ void ParseInto(std::string_view text, const std::string& file_name, Builder* bui
     }
     throw ParseError(file_name, static_cast<int>(pos.line), static_cast<int>(pos.column), message);
   }
-  if (!*tree) throw ParseError(file_name, 1, 1, "syntax error");
+  if (!tree) throw ParseError(file_name, 1, 1, "syntax error");
+  return tree;
+}
+
+// Parses `text` into a parse tree and builds it with `builder`.
+void ParseInto(std::string_view text, const std::string& file_name, Builder* builder,
+               std::unique_ptr<Node>* tree) {
+  *tree = ParseTree<grammar::file>(text, file_name);
   builder->File(**tree);
 }
 
@@ -1098,6 +1126,13 @@ Automaton ParseAutomaton(std::string_view text, const std::string& file_name) {
     throw ParseError(file_name, 1, 1, "expected exactly one automaton and no system");
   }
   return builder.automata().at(builder.local_automata().front());
+}
+
+InputSignal ParseSignal(std::string_view text, const std::string& source_name) {
+  const std::unique_ptr<Node> tree = ParseTree<grammar::signal_text>(text, source_name);
+  std::set<std::filesystem::path> none;
+  const Builder builder(source_name, &none);
+  return builder.StandaloneSignal(*tree);
 }
 
 }  // namespace hybrid

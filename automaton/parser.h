@@ -51,4 +51,10 @@ System ParseModelFile(const std::filesystem::path& path);
 /// tools that want the automaton itself). Throws ParseError otherwise.
 Automaton ParseAutomaton(std::string_view text, const std::string& file_name);
 
+/// Parses a signal written as in a scenario: a number (constant), `step(t: v, ...)` or
+/// `linear(t: v, ...)`, e.g. from the command line. The result has slot -1. Throws ParseError
+/// (named `source_name`, line 1, the column of the problem) for malformed text or non-increasing
+/// times; values are not checked against any bounds here.
+InputSignal ParseSignal(std::string_view text, const std::string& source_name);
+
 }  // namespace hybrid

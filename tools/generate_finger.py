@@ -17,13 +17,20 @@ LINK = [(0, 0), (1, 0), (0, 1)]
 
 def phase(s):
     c1, c2, c3, l1, l2, l3 = s
-    if c3 == 1 or l3 == 1:
+    if c3 == 1 or l3 == 1 or is_palm(s):
         return "4"
     if c2 == 1 or l2 == 1:
         return "3"
     if c1 == 1 or l1 == 1:
         return "2'" if l3 == -1 else "2"
     return "1'" if l3 == -1 else "1"
+
+
+def is_palm(s):
+    """Free space fully closed: links 1 and 2 at their limits, link 3 at its lower limit. Table 4.1
+    of the report: the finger stops at g = 240 by self-collision with the palm (decision D3)."""
+    c1, c2, c3, l1, l2, l3 = s
+    return l1 == 1 and l2 == 1 and l3 == -1 and not c1 and not c2 and not c3
 
 
 def states():
@@ -39,6 +46,7 @@ def states():
         out.append((c1, c2, 0, l1, l2, 1))                          # phase 4, link 3 at its limit
     for c1, l1 in LINK:
         out.append((c1, 0, 1, l1, 0, -1))                           # phase 4, contact at lower limit
+    out.append((0, 0, 0, 1, 1, -1))                                 # phase 4, against the palm
     return out
 
 
@@ -65,9 +73,17 @@ def normalise(s):
     """A link-2 block with l3 = -1 is not a state of the table: transition 6 (l3: -1 -> 0, guard
     theta3 + u > theta3_min) is enabled at once for u > 0, so the target is the l3 = 0 state."""
     c1, c2, c3, l1, l2, l3 = s
-    if (c2 or l2) and l3 == -1 and not c3:
+    if (c2 or l2) and l3 == -1 and not c3 and not is_palm(s):
         return (c1, c2, c3, l1, l2, 0)
     return s
+
+
+M3 = "(theta3_min + (theta3_max - theta3_min) / (255 - g)) * u"
+
+
+def rate(flow):
+    """A flow right-hand side as written in the model (m3 expanded)."""
+    return M3 if flow == "m3 * u" else flow
 
 
 def transitions(all_states):
@@ -88,33 +104,43 @@ def transitions(all_states):
             ci, li = c[i - 1], l[i - 1]
             theta = f"theta{i}"
             # 1. c_i: 0 -> 1, an object is hit by link i (at motor position gob_i).
+            #    Only while closing (u > 0): an opening finger moves away from the object.
             if ci == 0 and li != 1 and i in MOVING[p]:
                 t = c + l
                 t[i - 1] = 1
-                emit(1, i, t, f"g >= gob{i}", f"contact{i}")
+                emit(1, i, t, f"g >= gob{i} and u > 0", f"contact{i}")
             # 2. c_i: 1 -> 0 when theta_{i+1} = theta_{i+1,min} and u < 0 (link 3: u < 0).
             if ci == 1:
                 t = c + l
                 t[i - 1] = 0
                 guard = (f"theta{i + 1} == theta{i + 1}_min and u < 0" if i < 3 else "u < 0")
                 emit(2, i, t, guard, f"release{i}")
-            # 3. l_i: 0 -> 1 when theta_i reaches its upper limit.
+            # 3. l_i: 0 -> 1 when theta_i + dtheta_i >= theta_i,max: in continuous time, theta_i
+            #    at its limit and its rate pushing further (otherwise the finger moving away from
+            #    the limit would be caught again at once).
             if li == 0 and ci == 0 and theta in flows:
                 t = c + l
                 t[3 + i - 1] = 1
-                emit(3, i, t, f"{theta} >= {theta}_max", "")
-            # 4. l_i: 1 -> 0 when theta_i + u < theta_i,max.
+                emit(3, i, t, f"{theta} >= {theta}_max and {rate(flows[theta])} > 0", "")
+            # 4. l_i: 1 -> 0 when the motor reverses. Decision D2: like transition 2, links 1 and 2
+            #    leave their limits only once the next link is back at its minimum
+            #    (theta_{i+1} = theta_{i+1,min}), so that opening retraces table 4.1.
             if li == 1:
                 t = c + l
                 t[3 + i - 1] = 0
-                emit(4, i, t, f"{theta} + u < {theta}_max", "")
+                guard = (f"theta{i + 1} == theta{i + 1}_min and u < 0" if i < 3 else "u < 0")
+                emit(4, i, t, guard, "")
         # 5. l3: 0 -> -1 when theta3 reaches its lower limit (phases 1 and 2, where the table has a
         #    primed phase to go to).
         if l[2] == 0 and c[2] == 0 and "theta3" in flows and p in ("1", "2"):
-            emit(5, 3, c + l[:2] + [-1], "theta3 <= theta3_min", "")
-        # 6. l3: -1 -> 0 when theta3 + u > theta3,min.
+            emit(5, 3, c + l[:2] + [-1],
+                 f"theta3 <= theta3_min and {rate(flows['theta3'])} < 0", "")
+        # 6. l3: -1 -> 0. Decision D1: when the motor reverses and the vertical-orientation
+        #    coupling theta3 = -(theta1 + theta2) of phases 1 and 2 lifts theta3 off its limit,
+        #    i.e. theta1 + theta2 <= -theta3_min. (The report's "theta3 + u > theta3_min" holds at
+        #    once for u > 0 and would chatter between phases 1 and 1' at g = 110.)
         if l[2] == -1:
-            emit(6, 3, c + l[:2] + [0], "theta3 + u > theta3_min", "")
+            emit(6, 3, c + l[:2] + [0], "theta1 + theta2 <= -theta3_min and u < 0", "")
     return out
 
 
@@ -164,9 +190,8 @@ automaton finger {
         for var in ("theta1", "theta2", "theta3", "g"):
             if var in FLOWS[p]:
                 rhs = FLOWS[p][var]
-                if rhs == "m3 * u":
-                    # m3(g) = theta3_min + (theta3_max - theta3_min) / (255 - g), section 3.
-                    rhs = "(theta3_min + (theta3_max - theta3_min) / (255 - g)) * u"
+                # m3(g) = theta3_min + (theta3_max - theta3_min) / (255 - g), section 3.
+                rhs = rate(rhs)
                 print(f"    {var}' = {rhs};")
         print(f"    inv {invariant};")
         print("  }")
@@ -179,10 +204,11 @@ automaton finger {
     print("""
   init c000_l000 { theta1 = 0; theta2 = 0; theta3 = 0; g = 0; }
 
-  # Close at full speed, hold for 10 s, open at full speed (the controller's position request).
+  # Close at full speed for 255 s (the finger stops against the palm at g = 240), hold, then open
+  # at full speed back to g = 0 (the controller's position request: close, hold, open).
   scenario {
     until 530;
-    u = step(0: 1, 255: 0, 265: -1);
+    u = step(0: 1, 255: 0, 265: -1, 505: 0);
   }
 
   # The report: no reachable state has c_i = l_i = 1.

@@ -18,9 +18,13 @@
 #include "automaton/mode_graph.h"
 #include "automaton/parser.h"
 #include "automaton/system.h"
+#include "tools/output.h"
+#include "tools/simulate_command.h"
 
 namespace {
 
+using hybrid::cli::OutputError;
+using hybrid::cli::WriteOutput;
 using hybrid::Automaton;
 using hybrid::ModeGraph;
 using hybrid::ModeId;
@@ -31,41 +35,6 @@ constexpr int kExitModelError = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitOutput = 3;
 
-struct OutputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// Writes `text` to `path` atomically (temporary file in the same directory, then rename), so a
-// failed run never leaves a half-written file; "-" or empty writes to stdout. Throws OutputError
-// when the text cannot be written (also to stdout, e.g. a full disk).
-void WriteOutput(const std::string& path, const std::string& text) {
-  if (path.empty() || path == "-") {
-    std::cout << text;
-    std::cout.flush();
-    if (!std::cout) throw OutputError("cannot write to standard output");
-    return;
-  }
-  const std::filesystem::path target(path);
-  const std::filesystem::path temp =
-      target.string() + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OutputError("cannot write '" + path + "'");
-    out << text;
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temp, ignored);
-      throw OutputError("cannot write '" + path + "'");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, target, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    throw OutputError("cannot write '" + path + "'");
-  }
-}
 
 json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
   json out = json::array();
@@ -314,6 +283,27 @@ int main(int argc, char** argv) {
                 "Draw a composed model as its product automaton instead of one cluster per "
                 "component");
 
+  hybrid::cli::SimulateArgs sim_args;
+  double until = 0.0;
+  auto* simulate = app.add_subcommand(
+      "simulate", "Simulate a model with exact event location (CVODE); default: its scenario");
+  simulate->add_option("MODEL", sim_args.model, "Model file (.ha)")->required();
+  simulate->add_option("--input", sim_args.inputs,
+                       "NAME=SIGNAL, SIGNAL a number, step(t: v, ...) or linear(t: v, ...); "
+                       "repeatable; overrides the scenario's signal for NAME");
+  simulate->add_option("--input-csv", sim_args.input_csv,
+                       "CSV with a 'time' column and one column per input");
+  simulate->add_option("--csv-shape", sim_args.csv_shape,
+                       "How CSV rows are joined: step (default) or linear");
+  auto* until_option =
+      simulate->add_option("--until", until, "Horizon (default: the scenario's 'until')");
+  simulate->add_option("--sample", sim_args.sample,
+                       "Also record the state every DT (default: only the start, the end and "
+                       "both sides of each event)");
+  simulate->add_option("--out", sim_args.out, "Trajectory CSV: time, kind, mode, variables");
+  simulate->add_option("--events", sim_args.events, "Event log CSV");
+  simulate->add_flag("--json", sim_args.json, "JSON summary with every event on standard output");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -322,6 +312,11 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (simulate->parsed()) {
+      if (until_option->count() > 0) sim_args.until = until;
+      model = sim_args.model;
+      return hybrid::cli::RunSimulate(sim_args);
+    }
     const System system = hybrid::ParseModelFile(model);
     if (info->parsed()) {
       const json report = Info(system, model);

@@ -195,7 +195,7 @@ TEST(DotWriter, ProductLimitIsPassedOn) {
 TEST(DotWriter, FingerRendersWithGraphviz) {
   const System finger = Finger();
   const std::string dot = WriteDot(finger);
-  EXPECT_EQ(Count(dot, "[shape=box"), 30u);
+  EXPECT_EQ(Count(dot, "[shape=box"), 31u);
   EXPECT_EQ(Count(dot, " -> m"),
             static_cast<size_t>(finger.components()[0].automaton.num_transitions()) + 1);
   EXPECT_NE(dot.find("label=\"c000_l000 (c1=0, c2=0, c3=0, l1=0, l2=0, l3=0)\\l"
@@ -205,7 +205,7 @@ TEST(DotWriter, FingerRendersWithGraphviz) {
   const std::string svg = RenderSvg(dot);
   EXPECT_NE(svg.find("<svg"), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
-  EXPECT_EQ(Count(svg, "class=\"node\""), 31u);  // 30 modes and the initial point
+  EXPECT_EQ(Count(svg, "class=\"node\""), 32u);  // 31 modes and the initial point
 }
 
 TEST(DotWriter, FingerProductIsTheSameDrawing) {
@@ -213,7 +213,7 @@ TEST(DotWriter, FingerProductIsTheSameDrawing) {
   // transition names differ.
   const System finger = Finger();
   const std::string product = WriteDot(finger, {.product = true});
-  EXPECT_EQ(Count(product, "[shape=box"), 30u);
+  EXPECT_EQ(Count(product, "[shape=box"), 31u);
   EXPECT_NE(product.find("label=\"c000_l000 (c1=0, c2=0, c3=0, l1=0, l2=0, l3=0)\\l"),
             std::string::npos);
   EXPECT_NE(RenderSvg(product).find("<svg"), std::string::npos);

@@ -471,7 +471,7 @@ TEST(Parser, FingerModel) {
   const Automaton& a = s.components()[0].automaton;
   EXPECT_EQ(a.name(), "finger");
   EXPECT_EQ(s.components()[0].instance, "");
-  EXPECT_EQ(a.num_modes(), 30);
+  EXPECT_EQ(a.num_modes(), 31);
   EXPECT_EQ(a.variables().size(), 4u);
   EXPECT_EQ(a.discrete_variables().size(), 6u);
   EXPECT_EQ(a.inputs().size(), 1u);

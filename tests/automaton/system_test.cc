@@ -457,7 +457,7 @@ TEST(Product, SingleComponentProductIsTheAutomaton) {
   const System finger = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
   const Automaton& a = finger.components()[0].automaton;
   const Automaton p = finger.Product();
-  EXPECT_EQ(p.num_modes(), 30);
+  EXPECT_EQ(p.num_modes(), 31);
   EXPECT_EQ(p.num_modes(), a.num_modes());
   EXPECT_EQ(p.num_transitions(), a.num_transitions());
   EXPECT_EQ(ModeNames(p), ModeNames(a));

@@ -51,10 +51,10 @@ TEST(FingerSpecTest, CommittedFileIsTheGeneratorOutput) {
 
 TEST(FingerSpecTest, SizeAndReachability) {
   const Automaton a = Finger();
-  EXPECT_EQ(a.num_modes(), 30);
-  EXPECT_EQ(a.num_transitions(), 91);
+  EXPECT_EQ(a.num_modes(), 31);
+  EXPECT_EQ(a.num_transitions(), 94);
   const ModeGraph graph(a);
-  EXPECT_EQ(graph.ReachableModes().size(), 30u);
+  EXPECT_EQ(graph.ReachableModes().size(), 31u);
   EXPECT_TRUE(graph.Warnings().empty());
   EXPECT_TRUE(graph.TerminalModes().empty());  // every state can be left when the motor reverses
 }
@@ -113,7 +113,7 @@ TEST(FingerSpecTest, LimitTransitionsSetTheirLimitFlag) {
   for (const Transition& t : a.transitions()) {
     if (t.name.rfind("t3_", 0) != 0) continue;
     ++count;
-    ASSERT_EQ(t.guard.comparisons.size(), 1u);
+    ASSERT_EQ(t.guard.comparisons.size(), 2u);  // theta_i >= theta_i_max and rate > 0
     const std::string joint = t.guard.comparisons[0].lhs.symbol_name();  // theta_i
     const std::string flag = "l" + joint.substr(5);
     EXPECT_EQ(a.mode(t.source).DiscreteValueOf(Slot(a, flag)), 0) << t.name;

@@ -150,8 +150,8 @@ TEST(HybridCli, InfoJsonOfTheFinger) {
   const auto& c = info["components"][0];
   EXPECT_EQ(c["automaton"], "finger");
   EXPECT_EQ(c["instance"], "");
-  EXPECT_EQ(c["modes"].size(), 30u);
-  EXPECT_EQ(c["reachable_modes"].size(), 30u);
+  EXPECT_EQ(c["modes"].size(), 31u);
+  EXPECT_EQ(c["reachable_modes"].size(), 31u);
   EXPECT_TRUE(c["unreachable_modes"].empty());
   EXPECT_EQ(c["variables"].size(), 4u);
   EXPECT_EQ(c["variables"][0]["name"], "theta1");
@@ -177,8 +177,8 @@ TEST(HybridCli, InfoTextOfTheFinger) {
   const Result r = RunHybrid("info " + Quote(kFinger));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.starts_with("model finger (" + kFinger.string() + ")\n")) << r.out;
-  EXPECT_NE(r.out.find("modes (30): c000_l000, "), std::string::npos);
-  EXPECT_NE(r.out.find("reachable modes (30 of 30)"), std::string::npos);
+  EXPECT_NE(r.out.find("modes (31): c000_l000, "), std::string::npos);
+  EXPECT_NE(r.out.find("reachable modes (31 of 31)"), std::string::npos);
   EXPECT_NE(r.out.find("\nwarnings: none\n"), std::string::npos);
 }
 

@@ -1,0 +1,154 @@
+#include "solvers/cvode_integrator.h"
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace hybrid {
+
+struct CvodeIntegrator::Handles {
+  OdeSystem* system = nullptr;
+  int dimension = 0;
+  int num_roots = 0;
+  SUNContext context = nullptr;
+  N_Vector y = nullptr;
+  SUNMatrix matrix = nullptr;
+  SUNLinearSolver solver = nullptr;
+  void* cvode = nullptr;
+  bool initialised = false;
+  Options options;
+
+  ~Handles() {
+    if (cvode) CVodeFree(&cvode);
+    if (solver) SUNLinSolFree(solver);
+    if (matrix) SUNMatDestroy(matrix);
+    if (y) N_VDestroy(y);
+    if (context) SUNContext_Free(&context);
+  }
+};
+
+namespace {
+
+int Rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
+  auto* h = static_cast<OdeSystem*>(user_data);
+  h->Derivatives(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+  return 0;
+}
+
+int RootFunctions(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data) {
+  static_cast<OdeSystem*>(user_data)->Roots(t, N_VGetArrayPointer(y), gout);
+  return 0;
+}
+
+void Check(int flag, const char* call) {
+  if (flag < 0) {
+    throw std::runtime_error(std::string("CvodeIntegrator: ") + call + " failed: " +
+                             CVodeGetReturnFlagName(flag));
+  }
+}
+
+}  // namespace
+
+CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options& options)
+    : h_(std::make_unique<Handles>()) {
+  if (system == nullptr || dimension < 1) {
+    throw std::invalid_argument("CvodeIntegrator: null system or dimension < 1");
+  }
+  h_->system = system;
+  h_->dimension = dimension;
+  h_->options = options;
+  if (SUNContext_Create(nullptr, &h_->context) != 0) {
+    throw std::runtime_error("CvodeIntegrator: SUNContext_Create failed");
+  }
+  h_->y = N_VNew_Serial(dimension, h_->context);
+  h_->matrix = SUNDenseMatrix(dimension, dimension, h_->context);
+  h_->solver = SUNLinSol_Dense(h_->y, h_->matrix, h_->context);
+  h_->cvode = CVodeCreate(CV_ADAMS, h_->context);
+  if (!h_->y || !h_->matrix || !h_->solver || !h_->cvode) {
+    throw std::runtime_error("CvodeIntegrator: cannot allocate SUNDIALS objects");
+  }
+}
+
+CvodeIntegrator::~CvodeIntegrator() = default;
+CvodeIntegrator::CvodeIntegrator(CvodeIntegrator&&) noexcept = default;
+CvodeIntegrator& CvodeIntegrator::operator=(CvodeIntegrator&&) noexcept = default;
+
+void CvodeIntegrator::Restart(double t0, const Eigen::VectorXd& x0,
+                              std::span<const int> directions) {
+  double* y = N_VGetArrayPointer(h_->y);
+  for (int i = 0; i < h_->dimension; ++i) y[i] = i < x0.size() ? x0[i] : 0.0;
+  if (!h_->initialised) {
+    Check(CVodeInit(h_->cvode, Rhs, t0, h_->y), "CVodeInit");
+    Check(CVodeSetUserData(h_->cvode, h_->system), "CVodeSetUserData");
+    Check(CVodeSStolerances(h_->cvode, h_->options.relative_tolerance,
+                            h_->options.absolute_tolerance),
+          "CVodeSStolerances");
+    Check(CVodeSetLinearSolver(h_->cvode, h_->solver, h_->matrix), "CVodeSetLinearSolver");
+    Check(CVodeSetMaxNumSteps(h_->cvode, h_->options.max_steps), "CVodeSetMaxNumSteps");
+    if (h_->options.max_step > 0.0 && std::isfinite(h_->options.max_step)) {
+      Check(CVodeSetMaxStep(h_->cvode, h_->options.max_step), "CVodeSetMaxStep");
+    }
+    Check(CVodeSetNoInactiveRootWarn(h_->cvode), "CVodeSetNoInactiveRootWarn");
+    h_->initialised = true;
+  } else {
+    Check(CVodeReInit(h_->cvode, t0, h_->y), "CVodeReInit");
+  }
+  h_->num_roots = static_cast<int>(directions.size());
+  Check(CVodeRootInit(h_->cvode, h_->num_roots, h_->num_roots > 0 ? RootFunctions : nullptr),
+        "CVodeRootInit");
+  if (h_->num_roots > 0) {
+    std::vector<int> dirs(directions.begin(), directions.end());
+    Check(CVodeSetRootDirection(h_->cvode, dirs.data()), "CVodeSetRootDirection");
+  }
+  root_info_.assign(h_->num_roots, 0);
+}
+
+CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen::VectorXd* x) {
+  const int stop_flag = CVodeSetStopTime(h_->cvode, t_stop);
+  if (stop_flag < 0) {
+    message_ = std::string("CVodeSetStopTime: ") + CVodeGetReturnFlagName(stop_flag);
+    return Status::kFailure;
+  }
+  sunrealtype reached = 0.0;
+  const int flag = CVode(h_->cvode, t_stop, h_->y, &reached, CV_ONE_STEP);
+  *t = reached;
+  x->resize(h_->dimension);
+  const double* y = N_VGetArrayPointer(h_->y);
+  for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
+  if (flag == CV_ROOT_RETURN) {
+    CVodeGetRootInfo(h_->cvode, root_info_.data());
+    return Status::kRoot;
+  }
+  if (flag < 0) {
+    message_ = std::string("CVode: ") + CVodeGetReturnFlagName(flag);
+    return Status::kFailure;
+  }
+  return flag == CV_TSTOP_RETURN || reached >= t_stop ? Status::kReachedTime : Status::kStep;
+}
+
+bool CvodeIntegrator::Interpolate(double t, Eigen::VectorXd* x) {
+  N_Vector out = N_VNew_Serial(h_->dimension, h_->context);
+  const int flag = CVodeGetDky(h_->cvode, t, 0, out);
+  if (flag == CV_SUCCESS) {
+    x->resize(h_->dimension);
+    const double* y = N_VGetArrayPointer(out);
+    for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
+  }
+  N_VDestroy(out);
+  return flag == CV_SUCCESS;
+}
+
+long CvodeIntegrator::steps() const {
+  long n = 0;
+  if (h_->initialised) CVodeGetNumSteps(h_->cvode, &n);
+  return n;
+}
+
+}  // namespace hybrid

@@ -1,0 +1,703 @@
+#include "solvers/simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+#include "automaton/compiled_expression.h"
+#include "solvers/cvode_integrator.h"
+
+namespace hybrid {
+
+std::string_view StatusName(SimulationStatus status) {
+  switch (status) {
+    case SimulationStatus::kCompleted: return "completed";
+    case SimulationStatus::kZeno: return "zeno";
+    case SimulationStatus::kInvariantViolated: return "invariant_violated";
+    case SimulationStatus::kSolverFailure: return "solver_failure";
+    case SimulationStatus::kEventLimit: return "event_limit";
+  }
+  return "?";
+}
+
+namespace {
+
+struct CompiledComparison {
+  CompiledExpression residual;  // lhs - rhs over System slots
+  Relation relation;
+  std::string text;
+};
+
+struct CompiledTransition {
+  std::string name;  // qualified
+  std::string label;
+  int source = 0;
+  int target = 0;
+  Urgency urgency = Urgency::kUrgent;
+  std::vector<CompiledComparison> guard;
+  std::vector<std::pair<int, CompiledExpression>> resets;  // (index in x, value)
+};
+
+struct CompiledMode {
+  std::vector<std::pair<int, CompiledExpression>> flows;  // (index in x, rhs)
+  std::vector<CompiledComparison> invariant;
+  std::vector<int> outgoing;                          // transition indices
+  std::vector<std::pair<int, double>> discrete;       // (System slot, value)
+};
+
+struct CompiledComponent {
+  std::string instance;
+  std::vector<std::string> mode_names;
+  std::vector<CompiledMode> modes;
+  std::vector<CompiledTransition> transitions;
+  std::set<std::string> alphabet;
+  int initial_mode = 0;
+  std::vector<std::pair<int, double>> initial_values;  // (index in x, value)
+};
+
+// Residual semantics. `closure`: strict comparisons are taken as non-strict.
+bool Holds(Relation relation, double r, double tol, bool closure) {
+  switch (relation) {
+    case Relation::kLess: return closure ? r <= tol : r < 0.0;
+    case Relation::kLessEqual: return r <= tol;
+    case Relation::kGreater: return closure ? r >= -tol : r > 0.0;
+    case Relation::kGreaterEqual: return r >= -tol;
+    case Relation::kEqual: return std::abs(r) <= tol;
+  }
+  return false;
+}
+
+// Crossing direction that makes a guard comparison become true.
+int GuardDirection(Relation r) {
+  switch (r) {
+    case Relation::kLess:
+    case Relation::kLessEqual: return -1;
+    case Relation::kGreater:
+    case Relation::kGreaterEqual: return 1;
+    case Relation::kEqual: return 0;
+  }
+  return 0;
+}
+
+}  // namespace
+
+struct Simulator::Compiled {
+  const System* system = nullptr;
+  std::vector<std::string> variable_names;
+  std::vector<int> variable_slots;  // index in x -> System slot
+  std::vector<CompiledComponent> components;
+  std::vector<double> parameter_env;  // System slots, parameters filled
+};
+
+Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
+  c_->system = &system;
+  const SymbolTable& symbols = system.symbols();
+  std::vector<int> x_index(symbols.size(), -1);
+  for (int s = 0; s < symbols.size(); ++s) {
+    if (symbols[s].kind == SymbolKind::kVariable) {
+      x_index[s] = static_cast<int>(c_->variable_slots.size());
+      c_->variable_slots.push_back(s);
+      c_->variable_names.push_back(symbols[s].name);
+    }
+  }
+  c_->parameter_env.assign(symbols.size(), 0.0);
+  for (const Component& comp : system.components()) {
+    const Automaton& a = comp.automaton;
+    const std::vector<double> local_env = a.ParameterEnvironment();
+    for (const auto& [slot, value] : a.parameters()) {
+      c_->parameter_env[comp.global_slot[slot]] = local_env[slot];
+    }
+  }
+  for (const Component& comp : system.components()) {
+    const Automaton& a = comp.automaton;
+    auto global = [&](const Expression& e) {
+      return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
+        const int g = comp.global_slot[slot];
+        return Expression::Symbol(symbols[g].name, g);
+      });
+    };
+    auto comparison = [&](const Comparison& c) {
+      return CompiledComparison{CompiledExpression(global(c.Residual())), c.relation,
+                                c.ToString()};
+    };
+    CompiledComponent cc;
+    cc.instance = comp.instance;
+    for (const Mode& m : a.modes()) {
+      CompiledMode cm;
+      for (const auto& [slot, rhs] : m.flows) {
+        cm.flows.emplace_back(x_index[comp.global_slot[slot]], CompiledExpression(global(rhs)));
+      }
+      for (const Comparison& c : m.invariant.comparisons) cm.invariant.push_back(comparison(c));
+      for (const auto& [slot, value] : m.discrete_values) {
+        cm.discrete.emplace_back(comp.global_slot[slot], value);
+      }
+      cc.mode_names.push_back(m.name);
+      cc.modes.push_back(std::move(cm));
+    }
+    for (int t = 0; t < a.num_transitions(); ++t) {
+      const Transition& tr = a.transitions()[t];
+      CompiledTransition ct;
+      ct.name = comp.instance.empty() ? tr.name : comp.instance + "." + tr.name;
+      ct.label = tr.label;
+      ct.source = tr.source.value();
+      ct.target = tr.target.value();
+      ct.urgency = tr.urgency;
+      for (const Comparison& c : tr.guard.comparisons) ct.guard.push_back(comparison(c));
+      for (const Reset& r : tr.resets) {
+        ct.resets.emplace_back(x_index[comp.global_slot[r.slot]],
+                               CompiledExpression(global(r.value)));
+      }
+      if (!tr.label.empty()) cc.alphabet.insert(tr.label);
+      cc.modes[ct.source].outgoing.push_back(t);
+      cc.transitions.push_back(std::move(ct));
+    }
+    if (a.initial_states().empty()) {
+      throw std::invalid_argument("Simulator: component '" + a.name() + "' has no initial state");
+    }
+    const InitialState& init = a.initial_states().front();
+    cc.initial_mode = init.mode.value();
+    const std::vector<double> env = a.ParameterEnvironment();
+    for (const InitialValue& v : init.values) {
+      const double lo = v.range.lo.Evaluate(env);
+      const double hi = v.range.hi.Evaluate(env);
+      cc.initial_values.emplace_back(x_index[comp.global_slot[v.slot]], 0.5 * (lo + hi));
+    }
+    c_->components.push_back(std::move(cc));
+  }
+}
+
+Simulator::~Simulator() = default;
+Simulator::Simulator(Simulator&&) noexcept = default;
+
+const std::vector<std::string>& Simulator::variable_names() const { return c_->variable_names; }
+const System& Simulator::system() const { return *c_->system; }
+
+std::string Simulator::ModeName(int component, int mode) const {
+  const CompiledComponent& cc = c_->components.at(component);
+  return cc.instance.empty() ? cc.mode_names.at(mode) : cc.instance + "." + cc.mode_names.at(mode);
+}
+
+std::string Simulator::ModeLabel(std::span<const int> modes) const {
+  std::string out;
+  for (size_t c = 0; c < modes.size(); ++c) {
+    out += (c > 0 ? "|" : "") + ModeName(static_cast<int>(c), modes[c]);
+  }
+  return out;
+}
+
+namespace {
+
+// One root function of the current modes.
+struct RootRef {
+  bool invariant = false;
+  int component = 0;
+  int index = 0;       // transition index (guard) or unused (invariant)
+  int comparison = 0;  // comparison index within the guard or invariant
+  int direction = 0;
+};
+
+// The state of one run; also the OdeSystem CVODE calls back.
+class Run final : public OdeSystem {
+ public:
+  Run(const std::vector<CompiledComponent>& components, const std::vector<int>& variable_slots,
+      std::vector<double> env, std::vector<InputSignal> signals, const SimulationOptions& options)
+      : components_(components),
+        variable_slots_(variable_slots),
+        env_(std::move(env)),
+        signals_(std::move(signals)),
+        options_(options) {}
+
+  void Derivatives(double t, const double* x, double* dxdt) override {
+    Load(t, x);
+    for (size_t i = 0; i < x_size(); ++i) dxdt[i] = 0.0;
+    for (const auto& [index, rhs] : active_flows_) dxdt[index] = rhs->Evaluate(env_.data());
+  }
+
+  void Roots(double t, const double* x, double* g) override {
+    Load(t, x);
+    for (size_t i = 0; i < roots_.size(); ++i) g[i] = Residual(roots_[i]);
+  }
+
+  size_t x_size() const { return variable_slots_.size(); }
+
+  // Puts (t, x) into the environment; linear inputs follow t, step inputs stay at their segment
+  // value (set by SetStepInputs) so that a step at a stop time does not leak into the segment.
+  void Load(double t, const double* x) {
+    for (size_t i = 0; i < variable_slots_.size(); ++i) env_[variable_slots_[i]] = x[i];
+    for (const InputSignal& s : signals_) {
+      if (s.shape == InputSignal::Shape::kLinear) env_[s.slot] = s.ValueAt(t);
+    }
+  }
+  void SetStepInputs(double t) {
+    for (const InputSignal& s : signals_) {
+      if (s.shape == InputSignal::Shape::kStep) env_[s.slot] = s.ValueAt(t);
+    }
+  }
+
+  void SetModes(const std::vector<int>& modes) {
+    modes_ = modes;
+    active_flows_.clear();
+    roots_.clear();
+    directions_.clear();
+    for (size_t c = 0; c < components_.size(); ++c) {
+      const CompiledMode& m = components_[c].modes[modes_[c]];
+      for (const auto& [index, rhs] : m.flows) active_flows_.emplace_back(index, &rhs);
+      for (const auto& [slot, value] : m.discrete) env_[slot] = value;
+      for (int t : m.outgoing) {
+        const CompiledTransition& tr = components_[c].transitions[t];
+        for (size_t k = 0; k < tr.guard.size(); ++k) {
+          roots_.push_back({false, static_cast<int>(c), t, static_cast<int>(k),
+                            GuardDirection(tr.guard[k].relation)});
+        }
+      }
+      for (size_t k = 0; k < m.invariant.size(); ++k) {
+        if (m.invariant[k].relation == Relation::kEqual) continue;
+        roots_.push_back({true, static_cast<int>(c), 0, static_cast<int>(k),
+                          -GuardDirection(m.invariant[k].relation)});
+      }
+    }
+    for (const RootRef& r : roots_) directions_.push_back(r.direction);
+  }
+
+  double Residual(const RootRef& r) const {
+    const CompiledComponent& cc = components_[r.component];
+    const CompiledComparison& cmp =
+        r.invariant ? cc.modes[modes_[r.component]].invariant[r.comparison]
+                    : cc.transitions[r.index].guard[r.comparison];
+    return cmp.residual.Evaluate(env_.data());
+  }
+
+  bool GuardHolds(int component, int t, bool closure) const {
+    for (const CompiledComparison& c : components_[component].transitions[t].guard) {
+      if (!Holds(c.relation, c.residual.Evaluate(env_.data()), options_.event_tolerance, closure)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // The first comparison of the current modes' invariants violated beyond tolerance, as text.
+  std::optional<std::string> ViolatedInvariant() const {
+    for (size_t c = 0; c < components_.size(); ++c) {
+      for (const CompiledComparison& cmp : components_[c].modes[modes_[c]].invariant) {
+        if (!Holds(cmp.relation, cmp.residual.Evaluate(env_.data()), options_.event_tolerance,
+                   true)) {
+          return cmp.text;
+        }
+      }
+    }
+    return std::nullopt;
+  }
+
+  const std::vector<int>& modes() const { return modes_; }
+  const std::vector<RootRef>& roots() const { return roots_; }
+  const std::vector<int>& directions() const { return directions_; }
+  std::vector<double>& env() { return env_; }
+  const std::vector<CompiledComponent>& components() const { return components_; }
+
+ private:
+  const std::vector<CompiledComponent>& components_;
+  const std::vector<int>& variable_slots_;
+  std::vector<double> env_;
+  std::vector<InputSignal> signals_;
+  const SimulationOptions& options_;
+  std::vector<int> modes_;
+  std::vector<std::pair<int, const CompiledExpression*>> active_flows_;
+  std::vector<RootRef> roots_;
+  std::vector<int> directions_;
+};
+
+// A candidate jump: the participating (component, transition) pairs.
+using Jump = std::vector<std::pair<int, int>>;
+
+}  // namespace
+
+SimulationResult Simulator::Run(const SimulationOptions& options,
+                                std::span<const InputSignal> signals) const {
+  constexpr std::string_view kApi = "Simulator::Run: ";
+  const System& system = *c_->system;
+  const SymbolTable& symbols = system.symbols();
+  auto fail = [&](const std::string& message) {
+    throw std::invalid_argument(std::string(kApi) + message);
+  };
+
+  // Horizon and inputs.
+  double until = 0.0;
+  if (options.until) {
+    until = *options.until;
+  } else if (system.scenario()) {
+    until = system.scenario()->until;
+  } else {
+    fail("no horizon: give one (--until) or declare a scenario in the model");
+  }
+  if (!std::isfinite(until) || !(until > 0.0)) {
+    fail("the horizon must be positive and finite, got " + FormatNumber(until));
+  }
+  std::vector<InputSignal> inputs;
+  if (system.scenario()) inputs = system.scenario()->inputs;
+  for (const InputSignal& s : signals) {
+    if (s.slot < 0 || s.slot >= symbols.size() || symbols[s.slot].kind != SymbolKind::kInput) {
+      fail("a signal drives something that is not an input");
+    }
+    std::erase_if(inputs, [&](const InputSignal& x) { return x.slot == s.slot; });
+    inputs.push_back(s);
+  }
+  for (const InputSignal& s : inputs) {
+    const std::string& name = symbols[s.slot].name;
+    if (s.points.empty()) fail("signal for '" + name + "' has no points");
+    for (size_t i = 0; i < s.points.size(); ++i) {
+      if (!std::isfinite(s.points[i].first) || !std::isfinite(s.points[i].second)) {
+        fail("signal for '" + name + "' has a non-finite point");
+      }
+      if (i > 0 && !(s.points[i - 1].first < s.points[i].first)) {
+        fail("signal for '" + name + "': times must increase strictly");
+      }
+    }
+    const auto [lo, hi] = system.InputBounds(s.slot);
+    for (const auto& [t, v] : s.points) {
+      if (v < lo || v > hi) {
+        fail("input '" + name + "' = " + FormatNumber(v) + " at t = " + FormatNumber(t) +
+             " lies outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+      }
+    }
+  }
+  for (int s : symbols.SlotsOfKind(SymbolKind::kInput)) {
+    const bool driven = std::any_of(inputs.begin(), inputs.end(),
+                                    [s](const InputSignal& x) { return x.slot == s; });
+    const auto [lo, hi] = system.InputBounds(s);
+    if (!driven && (lo > 0.0 || hi < 0.0)) {
+      fail("input '" + symbols[s].name + "' has no signal and 0 lies outside its bounds");
+    }
+  }
+
+  // Breakpoints of the inputs: integration restarts there.
+  std::vector<double> breakpoints;
+  for (const InputSignal& s : inputs) {
+    for (const auto& [t, v] : s.points) {
+      if (t > 0.0 && t < until) breakpoints.push_back(t);
+    }
+  }
+  std::sort(breakpoints.begin(), breakpoints.end());
+  breakpoints.erase(std::unique(breakpoints.begin(), breakpoints.end()), breakpoints.end());
+
+  // Initial state.
+  const int n = static_cast<int>(c_->variable_slots.size());
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(std::max(n, 1));
+  std::vector<int> modes;
+  for (const CompiledComponent& cc : c_->components) {
+    modes.push_back(cc.initial_mode);
+    for (const auto& [index, value] : cc.initial_values) x[index] = value;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(x[i])) fail("initial value of '" + c_->variable_names[i] + "' is not finite");
+  }
+
+  hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env, inputs, options);
+  double t = 0.0;
+  run.SetStepInputs(t);
+  run.SetModes(modes);
+  run.Load(t, x.data());
+  if (auto violated = run.ViolatedInvariant()) {
+    fail("the initial state violates the invariant '" + *violated + "' of mode " +
+         ModeLabel(modes));
+  }
+
+  SimulationResult result;
+  auto record = [&](StateSample::Kind kind) {
+    result.samples.push_back({t, kind, run.modes(), x.head(n)});
+  };
+  record(StateSample::Kind::kStart);
+
+  // The transitions that can fire now, best first. `crossed`: root functions that fired (empty
+  // for entry checks); `at_invariant`: an invariant boundary was reached (lazy ones may fire).
+  auto candidates = [&](const std::vector<int>& crossed, bool at_invariant) {
+    std::vector<Jump> jumps;
+    for (int pass = 0; pass < 2; ++pass) {  // urgent first, then lazy
+      const Urgency urgency = pass == 0 ? Urgency::kUrgent : Urgency::kLazy;
+      if (urgency == Urgency::kLazy && !at_invariant) break;
+      for (size_t c = 0; c < c_->components.size(); ++c) {
+        const CompiledComponent& cc = c_->components[c];
+        for (int ti : cc.modes[run.modes()[c]].outgoing) {
+          const CompiledTransition& tr = cc.transitions[ti];
+          if (tr.urgency != urgency) continue;
+          bool crossed_now = false;
+          for (int r : crossed) {
+            const RootRef& ref = run.roots()[r];
+            crossed_now |= !ref.invariant && ref.component == static_cast<int>(c) && ref.index == ti;
+          }
+          const bool enabled =
+              urgency == Urgency::kLazy
+                  ? run.GuardHolds(static_cast<int>(c), ti, true)
+                  : (crossed_now ? run.GuardHolds(static_cast<int>(c), ti, true)
+                                 : run.GuardHolds(static_cast<int>(c), ti, false));
+          if (!enabled) continue;
+          // Synchronisation partners.
+          Jump jump = {{static_cast<int>(c), ti}};
+          bool blocked = false;
+          if (!tr.label.empty()) {
+            for (size_t d = 0; d < c_->components.size() && !blocked; ++d) {
+              if (d == c || !c_->components[d].alphabet.count(tr.label)) continue;
+              const CompiledComponent& dc = c_->components[d];
+              bool found = false;
+              for (int ui : dc.modes[run.modes()[d]].outgoing) {
+                if (dc.transitions[ui].label == tr.label &&
+                    run.GuardHolds(static_cast<int>(d), ui, true)) {
+                  jump.emplace_back(static_cast<int>(d), ui);
+                  found = true;
+                  break;
+                }
+              }
+              blocked = !found;
+            }
+          }
+          if (!blocked) jumps.push_back(std::move(jump));
+        }
+      }
+    }
+    return jumps;
+  };
+
+  auto fire = [&](const Jump& jump, EventRecord::Cause cause) {
+    EventRecord e;
+    e.time = t;
+    e.cause = cause;
+    e.modes_before = run.modes();
+    e.before = x.head(n);
+    record(StateSample::Kind::kBeforeEvent);
+    std::vector<int> modes_after = run.modes();
+    Eigen::VectorXd x_after = x;
+    for (const auto& [c, ti] : jump) {
+      const CompiledTransition& tr = c_->components[c].transitions[ti];
+      e.transitions.push_back(tr.name);
+      if (e.label.empty()) e.label = tr.label;
+      for (const auto& [index, value] : tr.resets) x_after[index] = value.Evaluate(run.env().data());
+      modes_after[c] = tr.target;
+    }
+    x = x_after;
+    run.SetModes(modes_after);
+    run.Load(t, x.data());
+    e.modes_after = run.modes();
+    e.after = x.head(n);
+    record(StateSample::Kind::kAfterEvent);
+    result.events.push_back(std::move(e));
+  };
+
+  // Fires `first` and then whatever becomes enabled at the same instant. Returns false when the
+  // run must stop (status set).
+  auto jump_and_iterate = [&](std::vector<Jump> jumps, EventRecord::Cause cause) {
+    for (int iteration = 0; !jumps.empty(); ++iteration) {
+      if (iteration >= options.max_event_iterations) {
+        result.status = SimulationStatus::kZeno;
+        result.message = "more than " + std::to_string(options.max_event_iterations) +
+                         " jumps at t = " + FormatNumber(t) + " (event iteration does not settle)";
+        ZenoReport z;
+        z.accumulation_time = t;
+        const size_t k = std::min<size_t>(result.events.size(), 8);
+        for (size_t i = result.events.size() - k; i < result.events.size(); ++i) {
+          for (const auto& name : result.events[i].transitions) z.cycle.push_back(name);
+        }
+        result.zeno = z;
+        return false;
+      }
+      if (static_cast<long>(result.events.size()) >= options.max_events) {
+        result.status = SimulationStatus::kEventLimit;
+        result.message = "more than " + std::to_string(options.max_events) + " events";
+        return false;
+      }
+      fire(jumps.front(), cause);
+      if (auto violated = run.ViolatedInvariant()) {
+        // Still allowed if an urgent transition leaves at once.
+        jumps = candidates({}, false);
+        if (jumps.empty()) {
+          result.status = SimulationStatus::kInvariantViolated;
+          result.message = "after the jump at t = " + FormatNumber(t) + " the state violates '" +
+                           *violated + "' of mode " + ModeLabel(run.modes());
+          return false;
+        }
+      } else {
+        jumps = candidates({}, false);
+      }
+      cause = EventRecord::Cause::kEnabled;
+    }
+    return true;
+  };
+
+  // Zeno across time: many events in a vanishing window.
+  auto zeno_check = [&]() {
+    const size_t k = static_cast<size_t>(std::max(options.zeno_events, 3));
+    const auto& ev = result.events;
+    if (ev.size() < k) return false;
+    const double first = ev[ev.size() - k].time;
+    const double last = ev.back().time;
+    if (last - first >= options.zeno_window * std::max(1.0, std::abs(last))) return false;
+    ZenoReport z;
+    const double d1 = ev[ev.size() - 1].time - ev[ev.size() - 2].time;
+    const double d0 = ev[ev.size() - 2].time - ev[ev.size() - 3].time;
+    const double r = d0 > 0.0 ? d1 / d0 : 0.0;
+    z.accumulation_time = (r > 0.0 && r < 1.0) ? last + d1 * r / (1.0 - r) : last;
+    // The shortest cycle of transition names that repeats over the last k events.
+    std::vector<std::string> names;
+    for (size_t i = ev.size() - k; i < ev.size(); ++i) {
+      std::string joined;
+      for (const auto& s : ev[i].transitions) joined += (joined.empty() ? "" : "+") + s;
+      names.push_back(joined);
+    }
+    for (size_t p = 1; p <= names.size() / 2; ++p) {
+      bool periodic = true;
+      for (size_t i = p; i < names.size() && periodic; ++i) periodic = names[i] == names[i - p];
+      if (periodic) {
+        z.cycle.assign(names.end() - static_cast<long>(p), names.end());
+        break;
+      }
+    }
+    if (z.cycle.empty()) z.cycle = names;
+    result.status = SimulationStatus::kZeno;
+    result.message = std::to_string(k) + " events within " + FormatNumber(last - first) +
+                     " time units before t = " + FormatNumber(last) +
+                     "; events accumulate near t = " + FormatNumber(z.accumulation_time);
+    result.zeno = std::move(z);
+    return true;
+  };
+
+  CvodeIntegrator::Options io;
+  io.relative_tolerance = options.relative_tolerance;
+  io.absolute_tolerance = options.absolute_tolerance;
+  io.max_step = options.max_step;
+  CvodeIntegrator integrator(&run, std::max(n, 1), io);
+
+  bool running = jump_and_iterate(candidates({}, false), EventRecord::Cause::kEnabled);
+  if (running && zeno_check()) running = false;
+  integrator.Restart(t, x, run.directions());
+  size_t next_break = 0;
+  double next_sample = options.sample_step > 0.0 ? options.sample_step : until;
+  std::vector<double> g_prev(run.roots().size()), g_now, g_mid;
+  auto evaluate_roots = [&](double time, const Eigen::VectorXd& state, std::vector<double>* g) {
+    g->resize(run.roots().size());
+    if (!g->empty()) run.Roots(time, state.data(), g->data());
+  };
+  evaluate_roots(t, x, &g_prev);
+  Eigen::VectorXd x_new, x_mid;
+
+  while (running && t < until) {
+    while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
+    const double t_stop = std::min({until, next_sample,
+                                    next_break < breakpoints.size() ? breakpoints[next_break]
+                                                                    : until});
+    const double t_prev = t;
+    double t_new = t;
+    const auto status = integrator.Advance(t_stop, &t_new, &x_new);
+    if (status == CvodeIntegrator::Status::kFailure) {
+      result.status = SimulationStatus::kSolverFailure;
+      result.message = integrator.message() + " at t = " + FormatNumber(t_new) + " in mode " +
+                       ModeLabel(run.modes());
+      break;
+    }
+    // Roots CVODE reports, or a double crossing inside the step found on the interpolant.
+    std::vector<int> crossed;
+    if (status == CvodeIntegrator::Status::kRoot) {
+      for (size_t i = 0; i < integrator.root_info().size(); ++i) {
+        if (integrator.root_info()[i] != 0) crossed.push_back(static_cast<int>(i));
+      }
+    }
+    // A guard that crosses and crosses back inside one step leaves the step ends with the same
+    // sign, so CVODE cannot see it: look at interior points of the step's interpolant.
+    bool interior = false;
+    if (options.dense_checks > 0 && !run.roots().empty() && t_new > t_prev) {
+      std::vector<double> ga = g_prev;
+      double a = t_prev;
+      for (int j = 1; j <= options.dense_checks && !interior; ++j) {
+        const double b = t_prev + (t_new - t_prev) * j / (options.dense_checks + 1);
+        if (!integrator.Interpolate(b, &x_mid)) break;
+        evaluate_roots(b, x_mid, &g_mid);
+        for (size_t i = 0; i < g_mid.size() && !interior; ++i) {
+          const int dir = run.roots()[i].direction;
+          const bool change = (ga[i] > 0.0 && g_mid[i] <= 0.0 && dir <= 0) ||
+                              (ga[i] < 0.0 && g_mid[i] >= 0.0 && dir >= 0);
+          if (!change) continue;
+          // Bisection on the interpolant: g keeps the sign of ga[i] at lo and not at hi.
+          double lo = a, hi = b;
+          std::vector<double> gm;
+          while (hi - lo > 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(hi))) {
+            const double mid = 0.5 * (lo + hi);
+            if (!integrator.Interpolate(mid, &x_mid)) break;
+            evaluate_roots(mid, x_mid, &gm);
+            if (gm[i] != 0.0 && (gm[i] > 0.0) == (ga[i] > 0.0)) lo = mid; else hi = mid;
+          }
+          t_new = hi;
+          integrator.Interpolate(t_new, &x_new);
+          crossed = {static_cast<int>(i)};
+          interior = true;
+        }
+        a = b;
+        ga = g_mid;
+      }
+    }
+    t = t_new;
+    x = x_new;
+    run.Load(t, x.data());
+    ++result.steps;
+    bool restart = interior;
+
+    if (status == CvodeIntegrator::Status::kRoot || interior) {
+      bool at_invariant = false;
+      for (int r : crossed) at_invariant |= run.roots()[r].invariant;
+      std::vector<Jump> jumps = candidates(crossed, at_invariant);
+      if (!jumps.empty()) {
+        const EventRecord::Cause cause = jumps.front().size() > 0 &&
+                                                 c_->components[jumps.front()[0].first]
+                                                         .transitions[jumps.front()[0].second]
+                                                         .urgency == Urgency::kLazy
+                                             ? EventRecord::Cause::kInvariant
+                                             : EventRecord::Cause::kCrossing;
+        running = jump_and_iterate(std::move(jumps), cause);
+        if (running && zeno_check()) running = false;
+        restart = true;
+      } else if (at_invariant) {
+        std::string which;
+        for (int r : crossed) {
+          const RootRef& ref = run.roots()[r];
+          if (ref.invariant) {
+            which = c_->components[ref.component].modes[run.modes()[ref.component]]
+                        .invariant[ref.comparison]
+                        .text;
+          }
+        }
+        result.status = SimulationStatus::kInvariantViolated;
+        result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" +
+                         which + "' of mode " + ModeLabel(run.modes()) +
+                         " and no transition is enabled";
+        running = false;
+      }
+    }
+    if (!running) break;
+    if (status == CvodeIntegrator::Status::kReachedTime && !interior) {
+      if (t >= next_sample && options.sample_step > 0.0 && t < until) {
+        record(StateSample::Kind::kSample);
+        next_sample = std::min(until, next_sample + options.sample_step);
+        // Avoid drift: the k-th sample is at k * sample_step.
+        next_sample = std::min(
+            until, options.sample_step * (std::floor(t / options.sample_step + 0.5) + 1.0));
+      }
+      if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
+        run.SetStepInputs(t);
+        run.Load(t, x.data());
+        running = jump_and_iterate(candidates({}, false), EventRecord::Cause::kEnabled);
+        if (running && zeno_check()) running = false;
+        restart = true;
+      }
+    }
+    if (!running) break;
+    if (restart) integrator.Restart(t, x, run.directions());
+    evaluate_roots(t, x, &g_prev);
+  }
+  if (result.status == SimulationStatus::kCompleted && t < until) {
+    result.status = SimulationStatus::kSolverFailure;
+    result.message = "stopped before the horizon";
+  }
+  record(StateSample::Kind::kEnd);
+  return result;
+}
+
+}  // namespace hybrid

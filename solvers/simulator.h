@@ -1,0 +1,161 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "automaton/scenario.h"
+#include "automaton/system.h"
+
+namespace hybrid {
+
+/// Settings of one simulation run. Defaults suit models whose time scale is between 1e-3 and
+/// 1e4 (seconds, or any unit).
+struct SimulationOptions {
+  /// Horizon; nullopt uses the model's scenario (Run throws if there is none).
+  std::optional<double> until;
+  /// > 0: also record the state every `sample_step` (from the start); 0: only the start, the end
+  /// and both sides of every event.
+  double sample_step = 0.0;
+  double relative_tolerance = 1e-10;
+  double absolute_tolerance = 1e-12;
+  /// A residual within this of 0 counts as on the boundary (non-strict guards hold, invariants
+  /// are not violated).
+  double event_tolerance = 1e-9;
+  /// Interior points of every integration step at which the root functions are also evaluated on
+  /// the step's interpolating polynomial, to find a guard that crosses twice inside one step (CVODE
+  /// looks only at step ends). 0 disables the check.
+  int dense_checks = 4;
+  /// Largest internal step (0: unlimited).
+  double max_step = 0.0;
+  /// Jumps allowed at one instant before the run stops as Zeno (event iteration bound).
+  int max_event_iterations = 100;
+  /// Zeno detection: the run stops when `zeno_events` consecutive events fall inside a window
+  /// shorter than `zeno_window` times the time scale max(1, |t|).
+  int zeno_events = 20;
+  double zeno_window = 1e-6;
+  /// Total number of events allowed.
+  long max_events = 1000000;
+};
+
+/// How a run ended. Only kCompleted reaches the horizon.
+enum class SimulationStatus {
+  kCompleted,
+  /// Events accumulate (or iterate at one instant): see SimulationResult::zeno.
+  kZeno,
+  /// The state reached a mode invariant's boundary, moving out, with no transition to take.
+  kInvariantViolated,
+  /// CVODE failed (see message).
+  kSolverFailure,
+  /// More than SimulationOptions::max_events events.
+  kEventLimit,
+};
+
+/// "completed", "zeno", "invariant_violated", "solver_failure", "event_limit".
+std::string_view StatusName(SimulationStatus status);
+
+/// One recorded state.
+struct StateSample {
+  enum class Kind { kStart, kSample, kBeforeEvent, kAfterEvent, kEnd };
+  double time = 0.0;
+  Kind kind = Kind::kSample;
+  /// Mode index of each component.
+  std::vector<int> modes;
+  /// Continuous variables, in the order of Simulator::variable_names().
+  Eigen::VectorXd x;
+};
+
+/// One discrete jump (several transitions when synchronised).
+struct EventRecord {
+  enum class Cause {
+    kCrossing,   ///< a guard comparison crossed zero (an urgent transition)
+    kInvariant,  ///< an invariant was about to be violated (a lazy transition)
+    kEnabled,    ///< the guard already held on entering the mode or when an input jumped
+  };
+  double time = 0.0;
+  Cause cause = Cause::kCrossing;
+  /// Qualified transition names ("A.t1" for instance A), one per participating component.
+  std::vector<std::string> transitions;
+  std::string label;
+  std::vector<int> modes_before;
+  std::vector<int> modes_after;
+  Eigen::VectorXd before;
+  Eigen::VectorXd after;
+};
+
+/// Why and where a run stopped as Zeno.
+struct ZenoReport {
+  /// Estimated accumulation time: for geometrically shrinking intervals (ratio r of the last two)
+  /// t_last + d_last * r / (1 - r); the last event time when events iterate at one instant.
+  double accumulation_time = 0.0;
+  /// The repeating cycle of transitions among the last events (qualified names, in order).
+  std::vector<std::string> cycle;
+};
+
+struct SimulationResult {
+  SimulationStatus status = SimulationStatus::kCompleted;
+  /// Human-readable detail for every status but kCompleted.
+  std::string message;
+  std::vector<StateSample> samples;
+  std::vector<EventRecord> events;
+  std::optional<ZenoReport> zeno;
+  /// CVODE internal steps.
+  long steps = 0;
+};
+
+/// Simulates a System with exact event location on CVODE.
+///
+/// The state is one mode per component plus the System's continuous variables. Between events the
+/// flows of the current modes are integrated (a variable without a flow is constant). Every
+/// comparison of every outgoing guard is a CVODE root function with its crossing direction
+/// (`<`, `<=`: falling; `>`, `>=`: rising; `==`: both), and so is every invariant comparison
+/// (in the direction that leaves the invariant). At a root:
+/// - an urgent transition fires when its guard holds in its closure (strict comparisons taken as
+///   non-strict, each within event_tolerance) and one of its comparisons crossed or it holds
+///   strictly;
+/// - at an invariant boundary, lazy transitions whose guards hold may fire too; if none can, the
+///   run stops with kInvariantViolated.
+/// Priority among enabled transitions: urgent before lazy, then component order, then declaration
+/// order. A labelled transition of a composed system fires only together with one enabled
+/// transition of the same label in every other component that uses the label (lowest declaration
+/// order first); resets of all participants are evaluated in the state before the jump.
+/// After a jump the new modes' urgent guards are checked (strictly): if one holds it fires at the
+/// same instant (event iteration, at most max_event_iterations times). The same check runs when a
+/// step input jumps. Input breakpoints and sample times are integration stop times, and CVODE is
+/// restarted (CVodeReInit) after every jump and input jump.
+class Simulator {
+ public:
+  /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument
+  /// ("Simulator: ...") if some component has no initial state.
+  explicit Simulator(const System& system);
+  ~Simulator();
+  Simulator(Simulator&&) noexcept;
+
+  /// Runs from the first initial state of each component (interval initial values start at
+  /// their midpoint). Inputs: `signals` (System input slots) override the scenario's signals;
+  /// inputs with neither are 0. Throws std::invalid_argument ("Simulator::Run: ...") for misuse:
+  /// a non-positive or non-finite horizon, no horizon and no scenario, a signal for a
+  /// non-input, a signal value outside the input's bounds, non-finite signal points, an initial
+  /// state that violates its mode's invariant or is not finite. Run-time outcomes (Zeno, invariant
+  /// violation, solver failure) are statuses in the result.
+  SimulationResult Run(const SimulationOptions& options,
+                       std::span<const InputSignal> signals = {}) const;
+
+  /// Names of the continuous variables, the order of StateSample::x.
+  const std::vector<std::string>& variable_names() const;
+  /// Name of mode `mode` of component `component`, qualified by the instance.
+  std::string ModeName(int component, int mode) const;
+  /// Names of the current modes of `modes`, joined with "|" for several components.
+  std::string ModeLabel(std::span<const int> modes) const;
+  const System& system() const;
+
+ private:
+  struct Compiled;
+  std::unique_ptr<Compiled> c_;
+};
+
+}  // namespace hybrid

@@ -1,0 +1,40 @@
+#include "tools/output.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace hybrid::cli {
+
+void WriteOutput(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::cout << text;
+    std::cout.flush();
+    if (!std::cout) throw OutputError("cannot write to standard output");
+    return;
+  }
+  const std::filesystem::path target(path);
+  const std::filesystem::path temp =
+      target.string() + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) throw OutputError("cannot write '" + path + "'");
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temp, ignored);
+      throw OutputError("cannot write '" + path + "'");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, target, ec);
+  if (ec) {
+    std::filesystem::remove(temp, ec);
+    throw OutputError("cannot write '" + path + "'");
+  }
+}
+
+}  // namespace hybrid::cli
