@@ -49,8 +49,8 @@ int RootFunctions(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data)
 
 void Check(int flag, const char* call) {
   if (flag < 0) {
-    throw std::runtime_error(std::string("CvodeIntegrator: ") + call + " failed: " +
-                             CVodeGetReturnFlagName(flag));
+    throw std::runtime_error(std::string("CvodeIntegrator: ") + call +
+                             " failed: " + CVodeGetReturnFlagName(flag));
   }
 }
 

@@ -57,7 +57,8 @@ class CvodeIntegrator {
   /// The state at `t` from the interpolating polynomial of the last step (CVodeGetDky); `t` must
   /// lie in the last step [t_n - h_last, t_n]. Returns false otherwise.
   bool Interpolate(double t, Eigen::VectorXd* x);
-  /// After kRoot: which root functions crossed (+1 rising, -1 falling, 0 not), per CVodeGetRootInfo.
+  /// After kRoot: which root functions crossed (+1 rising, -1 falling, 0 not), per
+  /// CVodeGetRootInfo.
   const std::vector<int>& root_info() const { return root_info_; }
   /// The CVODE error message of the last failure.
   const std::string& message() const { return message_; }

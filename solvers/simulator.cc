@@ -13,11 +13,16 @@ namespace hybrid {
 
 std::string_view StatusName(SimulationStatus status) {
   switch (status) {
-    case SimulationStatus::kCompleted: return "completed";
-    case SimulationStatus::kZeno: return "zeno";
-    case SimulationStatus::kInvariantViolated: return "invariant_violated";
-    case SimulationStatus::kSolverFailure: return "solver_failure";
-    case SimulationStatus::kEventLimit: return "event_limit";
+    case SimulationStatus::kCompleted:
+      return "completed";
+    case SimulationStatus::kZeno:
+      return "zeno";
+    case SimulationStatus::kInvariantViolated:
+      return "invariant_violated";
+    case SimulationStatus::kSolverFailure:
+      return "solver_failure";
+    case SimulationStatus::kEventLimit:
+      return "event_limit";
   }
   return "?";
 }
@@ -43,8 +48,8 @@ struct CompiledTransition {
 struct CompiledMode {
   std::vector<std::pair<int, CompiledExpression>> flows;  // (index in x, rhs)
   std::vector<CompiledComparison> invariant;
-  std::vector<int> outgoing;                          // transition indices
-  std::vector<std::pair<int, double>> discrete;       // (System slot, value)
+  std::vector<int> outgoing;                     // transition indices
+  std::vector<std::pair<int, double>> discrete;  // (System slot, value)
 };
 
 struct CompiledComponent {
@@ -60,11 +65,16 @@ struct CompiledComponent {
 // Residual semantics. `closure`: strict comparisons are taken as non-strict.
 bool Holds(Relation relation, double r, double tol, bool closure) {
   switch (relation) {
-    case Relation::kLess: return closure ? r <= tol : r < 0.0;
-    case Relation::kLessEqual: return r <= tol;
-    case Relation::kGreater: return closure ? r >= -tol : r > 0.0;
-    case Relation::kGreaterEqual: return r >= -tol;
-    case Relation::kEqual: return std::abs(r) <= tol;
+    case Relation::kLess:
+      return closure ? r <= tol : r < 0.0;
+    case Relation::kLessEqual:
+      return r <= tol;
+    case Relation::kGreater:
+      return closure ? r >= -tol : r > 0.0;
+    case Relation::kGreaterEqual:
+      return r >= -tol;
+    case Relation::kEqual:
+      return std::abs(r) <= tol;
   }
   return false;
 }
@@ -73,10 +83,13 @@ bool Holds(Relation relation, double r, double tol, bool closure) {
 int GuardDirection(Relation r) {
   switch (r) {
     case Relation::kLess:
-    case Relation::kLessEqual: return -1;
+    case Relation::kLessEqual:
+      return -1;
     case Relation::kGreater:
-    case Relation::kGreaterEqual: return 1;
-    case Relation::kEqual: return 0;
+    case Relation::kGreaterEqual:
+      return 1;
+    case Relation::kEqual:
+      return 0;
   }
   return 0;
 }
@@ -119,8 +132,7 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
       });
     };
     auto comparison = [&](const Comparison& c) {
-      return CompiledComparison{CompiledExpression(global(c.Residual())), c.relation,
-                                c.ToString()};
+      return CompiledComparison{CompiledExpression(global(c.Residual())), c.relation, c.ToString()};
     };
     CompiledComponent cc;
     cc.instance = comp.instance;
@@ -263,9 +275,9 @@ class Run final : public OdeSystem {
 
   double Residual(const RootRef& r) const {
     const CompiledComponent& cc = components_[r.component];
-    const CompiledComparison& cmp =
-        r.invariant ? cc.modes[modes_[r.component]].invariant[r.comparison]
-                    : cc.transitions[r.index].guard[r.comparison];
+    const CompiledComparison& cmp = r.invariant
+                                        ? cc.modes[modes_[r.component]].invariant[r.comparison]
+                                        : cc.transitions[r.index].guard[r.comparison];
     return cmp.residual.Evaluate(env_.data());
   }
 
@@ -391,7 +403,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     for (const auto& [index, value] : cc.initial_values) x[index] = value;
   }
   for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(x[i])) fail("initial value of '" + c_->variable_names[i] + "' is not finite");
+    if (!std::isfinite(x[i]))
+      fail("initial value of '" + c_->variable_names[i] + "' is not finite");
   }
 
   hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env, inputs, options);
@@ -425,13 +438,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           bool crossed_now = false;
           for (int r : crossed) {
             const RootRef& ref = run.roots()[r];
-            crossed_now |= !ref.invariant && ref.component == static_cast<int>(c) && ref.index == ti;
+            crossed_now |=
+                !ref.invariant && ref.component == static_cast<int>(c) && ref.index == ti;
           }
-          const bool enabled =
-              urgency == Urgency::kLazy
-                  ? run.GuardHolds(static_cast<int>(c), ti, true)
-                  : (crossed_now ? run.GuardHolds(static_cast<int>(c), ti, true)
-                                 : run.GuardHolds(static_cast<int>(c), ti, false));
+          const bool enabled = urgency == Urgency::kLazy
+                                   ? run.GuardHolds(static_cast<int>(c), ti, true)
+                                   : (crossed_now ? run.GuardHolds(static_cast<int>(c), ti, true)
+                                                  : run.GuardHolds(static_cast<int>(c), ti, false));
           if (!enabled) continue;
           // Synchronisation partners.
           Jump jump = {{static_cast<int>(c), ti}};
@@ -472,7 +485,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       const CompiledTransition& tr = c_->components[c].transitions[ti];
       e.transitions.push_back(tr.name);
       if (e.label.empty()) e.label = tr.label;
-      for (const auto& [index, value] : tr.resets) x_after[index] = value.Evaluate(run.env().data());
+      for (const auto& [index, value] : tr.resets)
+        x_after[index] = value.Evaluate(run.env().data());
       modes_after[c] = tr.target;
     }
     x = x_after;
@@ -524,19 +538,32 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     return true;
   };
 
-  // Zeno across time: many events in a vanishing window.
+  // Zeno across time: many events in a vanishing window, or geometrically shrinking intervals
+  // close to their accumulation point.
   auto zeno_check = [&]() {
-    const size_t k = static_cast<size_t>(std::max(options.zeno_events, 3));
+    const size_t k = static_cast<size_t>(std::max(options.zeno_events, 4));
     const auto& ev = result.events;
     if (ev.size() < k) return false;
     const double first = ev[ev.size() - k].time;
     const double last = ev.back().time;
-    if (last - first >= options.zeno_window * std::max(1.0, std::abs(last))) return false;
+    const double scale = std::max(1.0, std::abs(last));
+    std::vector<double> d;  // the k - 1 intervals
+    for (size_t i = ev.size() - k + 1; i < ev.size(); ++i) d.push_back(ev[i].time - ev[i - 1].time);
+    bool geometric = std::all_of(d.begin(), d.end(), [](double x) { return x > 0.0; });
+    double r = 0.0;
+    if (geometric) {
+      r = std::pow(d.back() / d.front(), 1.0 / static_cast<double>(d.size() - 1));
+      for (size_t i = 1; i < d.size() && geometric; ++i) {
+        geometric = std::abs(d[i] / d[i - 1] - r) <= 0.01 * r;
+      }
+      geometric = geometric && r < 1.0;
+    }
+    const double remaining = geometric ? d.back() * r / (1.0 - r) : 0.0;
+    const bool chattering = last - first < options.zeno_window * scale;
+    const bool accumulating = geometric && remaining < options.zeno_horizon * scale;
+    if (!chattering && !accumulating) return false;
     ZenoReport z;
-    const double d1 = ev[ev.size() - 1].time - ev[ev.size() - 2].time;
-    const double d0 = ev[ev.size() - 2].time - ev[ev.size() - 3].time;
-    const double r = d0 > 0.0 ? d1 / d0 : 0.0;
-    z.accumulation_time = (r > 0.0 && r < 1.0) ? last + d1 * r / (1.0 - r) : last;
+    z.accumulation_time = geometric ? last + remaining : last;
     // The shortest cycle of transition names that repeats over the last k events.
     std::vector<std::string> names;
     for (size_t i = ev.size() - k; i < ev.size(); ++i) {
@@ -582,9 +609,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
 
   while (running && t < until) {
     while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
-    const double t_stop = std::min({until, next_sample,
-                                    next_break < breakpoints.size() ? breakpoints[next_break]
-                                                                    : until});
+    const double t_stop = std::min(
+        {until, next_sample, next_break < breakpoints.size() ? breakpoints[next_break] : until});
     const double t_prev = t;
     double t_new = t;
     const auto status = integrator.Advance(t_stop, &t_new, &x_new);
@@ -619,11 +645,15 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           // Bisection on the interpolant: g keeps the sign of ga[i] at lo and not at hi.
           double lo = a, hi = b;
           std::vector<double> gm;
-          while (hi - lo > 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(hi))) {
+          while (hi - lo >
+                 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(hi))) {
             const double mid = 0.5 * (lo + hi);
             if (!integrator.Interpolate(mid, &x_mid)) break;
             evaluate_roots(mid, x_mid, &gm);
-            if (gm[i] != 0.0 && (gm[i] > 0.0) == (ga[i] > 0.0)) lo = mid; else hi = mid;
+            if (gm[i] != 0.0 && (gm[i] > 0.0) == (ga[i] > 0.0))
+              lo = mid;
+            else
+              hi = mid;
           }
           t_new = hi;
           integrator.Interpolate(t_new, &x_new);
@@ -645,12 +675,12 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       for (int r : crossed) at_invariant |= run.roots()[r].invariant;
       std::vector<Jump> jumps = candidates(crossed, at_invariant);
       if (!jumps.empty()) {
-        const EventRecord::Cause cause = jumps.front().size() > 0 &&
-                                                 c_->components[jumps.front()[0].first]
-                                                         .transitions[jumps.front()[0].second]
-                                                         .urgency == Urgency::kLazy
-                                             ? EventRecord::Cause::kInvariant
-                                             : EventRecord::Cause::kCrossing;
+        const EventRecord::Cause cause =
+            jumps.front().size() > 0 && c_->components[jumps.front()[0].first]
+                                                .transitions[jumps.front()[0].second]
+                                                .urgency == Urgency::kLazy
+                ? EventRecord::Cause::kInvariant
+                : EventRecord::Cause::kCrossing;
         running = jump_and_iterate(std::move(jumps), cause);
         if (running && zeno_check()) running = false;
         restart = true;
@@ -659,15 +689,15 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         for (int r : crossed) {
           const RootRef& ref = run.roots()[r];
           if (ref.invariant) {
-            which = c_->components[ref.component].modes[run.modes()[ref.component]]
+            which = c_->components[ref.component]
+                        .modes[run.modes()[ref.component]]
                         .invariant[ref.comparison]
                         .text;
           }
         }
         result.status = SimulationStatus::kInvariantViolated;
-        result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" +
-                         which + "' of mode " + ModeLabel(run.modes()) +
-                         " and no transition is enabled";
+        result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" + which +
+                         "' of mode " + ModeLabel(run.modes()) + " and no transition is enabled";
         running = false;
       }
     }

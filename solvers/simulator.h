@@ -34,10 +34,14 @@ struct SimulationOptions {
   double max_step = 0.0;
   /// Jumps allowed at one instant before the run stops as Zeno (event iteration bound).
   int max_event_iterations = 100;
-  /// Zeno detection: the run stops when `zeno_events` consecutive events fall inside a window
-  /// shorter than `zeno_window` times the time scale max(1, |t|).
-  int zeno_events = 20;
+  /// Zeno detection over the last `zeno_events` events (time scale s = max(1, |t|)):
+  /// (a) chattering: they all fall inside a window shorter than `zeno_window` * s;
+  /// (b) accumulation: their intervals shrink geometrically (every ratio of consecutive
+  ///     intervals within 1% of their mean r < 1) and the predicted remaining time to the
+  ///     accumulation point, d_last * r / (1 - r), is below `zeno_horizon` * s.
+  int zeno_events = 10;
   double zeno_window = 1e-6;
+  double zeno_horizon = 1e-4;
   /// Total number of events allowed.
   long max_events = 1000000;
 };
@@ -89,8 +93,9 @@ struct EventRecord {
 
 /// Why and where a run stopped as Zeno.
 struct ZenoReport {
-  /// Estimated accumulation time: for geometrically shrinking intervals (ratio r of the last two)
-  /// t_last + d_last * r / (1 - r); the last event time when events iterate at one instant.
+  /// Estimated accumulation time: for geometrically shrinking intervals with ratio
+  /// r = (d_last / d_first)^(1 / (k - 2)) over the last k events, t_last + d_last * r / (1 - r);
+  /// otherwise the last event time.
   double accumulation_time = 0.0;
   /// The repeating cycle of transitions among the last events (qualified names, in order).
   std::vector<std::string> cycle;

@@ -23,18 +23,17 @@
 
 namespace {
 
-using hybrid::cli::OutputError;
-using hybrid::cli::WriteOutput;
 using hybrid::Automaton;
 using hybrid::ModeGraph;
 using hybrid::ModeId;
 using hybrid::System;
+using hybrid::cli::OutputError;
+using hybrid::cli::WriteOutput;
 using json = nlohmann::ordered_json;
 
 constexpr int kExitModelError = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitOutput = 3;
-
 
 json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
   json out = json::array();

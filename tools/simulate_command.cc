@@ -68,7 +68,8 @@ std::vector<InputSignal> ReadInputCsv(const std::string& path, InputSignal::Shap
     }
     for (size_t d = 1; d < c; ++d) {
       if (header[d] == header[c]) {
-        throw ParseError(path, row, static_cast<int>(c + 1), "duplicate column '" + header[c] + "'");
+        throw ParseError(path, row, static_cast<int>(c + 1),
+                         "duplicate column '" + header[c] + "'");
       }
     }
     signals.push_back({*slot, shape, {}});
@@ -97,20 +98,28 @@ std::vector<InputSignal> ReadInputCsv(const std::string& path, InputSignal::Shap
 
 std::string CauseName(EventRecord::Cause cause) {
   switch (cause) {
-    case EventRecord::Cause::kCrossing: return "crossing";
-    case EventRecord::Cause::kInvariant: return "invariant";
-    case EventRecord::Cause::kEnabled: return "enabled";
+    case EventRecord::Cause::kCrossing:
+      return "crossing";
+    case EventRecord::Cause::kInvariant:
+      return "invariant";
+    case EventRecord::Cause::kEnabled:
+      return "enabled";
   }
   return "?";
 }
 
 std::string KindName(StateSample::Kind kind) {
   switch (kind) {
-    case StateSample::Kind::kStart: return "start";
-    case StateSample::Kind::kSample: return "sample";
-    case StateSample::Kind::kBeforeEvent: return "before_event";
-    case StateSample::Kind::kAfterEvent: return "after_event";
-    case StateSample::Kind::kEnd: return "end";
+    case StateSample::Kind::kStart:
+      return "start";
+    case StateSample::Kind::kSample:
+      return "sample";
+    case StateSample::Kind::kBeforeEvent:
+      return "before_event";
+    case StateSample::Kind::kAfterEvent:
+      return "after_event";
+    case StateSample::Kind::kEnd:
+      return "end";
   }
   return "?";
 }
@@ -143,8 +152,8 @@ std::string EventsCsv(const Simulator& sim, const SimulationResult& r) {
   for (const auto& v : sim.variable_names()) out << "," << v << "_after";
   out << "\n";
   for (const EventRecord& e : r.events) {
-    out << e.time << "," << CauseName(e.cause) << "," << Join(e.transitions, "+") << ","
-        << e.label << "," << sim.ModeLabel(e.modes_before) << "," << sim.ModeLabel(e.modes_after);
+    out << e.time << "," << CauseName(e.cause) << "," << Join(e.transitions, "+") << "," << e.label
+        << "," << sim.ModeLabel(e.modes_before) << "," << sim.ModeLabel(e.modes_after);
     for (int i = 0; i < e.before.size(); ++i) out << "," << e.before[i];
     for (int i = 0; i < e.after.size(); ++i) out << "," << e.after[i];
     out << "\n";
@@ -171,13 +180,14 @@ json ResultJson(const Simulator& sim, const SimulationResult& r, double until) {
                       {"after", State(sim, e.after)}});
   }
   const StateSample& last = r.samples.back();
-  json out = {{"status", std::string(StatusName(r.status))},
-              {"message", r.message},
-              {"until", until},
-              {"final", {{"time", last.time}, {"mode", sim.ModeLabel(last.modes)},
-                         {"state", State(sim, last.x)}}},
-              {"steps", r.steps},
-              {"events", events}};
+  json out = {
+      {"status", std::string(StatusName(r.status))},
+      {"message", r.message},
+      {"until", until},
+      {"final",
+       {{"time", last.time}, {"mode", sim.ModeLabel(last.modes)}, {"state", State(sim, last.x)}}},
+      {"steps", r.steps},
+      {"events", events}};
   if (r.zeno) {
     out["zeno"] = {{"accumulation_time", r.zeno->accumulation_time}, {"cycle", r.zeno->cycle}};
   }
@@ -221,10 +231,10 @@ int RunSimulate(const SimulateArgs& args) {
     if (args.csv_shape != "step" && args.csv_shape != "linear") {
       throw std::invalid_argument("--csv-shape must be 'step' or 'linear'");
     }
-    signals = ReadInputCsv(args.input_csv,
-                           args.csv_shape == "step" ? InputSignal::Shape::kStep
-                                                    : InputSignal::Shape::kLinear,
-                           symbols);
+    signals = ReadInputCsv(
+        args.input_csv,
+        args.csv_shape == "step" ? InputSignal::Shape::kStep : InputSignal::Shape::kLinear,
+        symbols);
   }
   for (const std::string& spec : args.inputs) {
     const auto eq = spec.find('=');
