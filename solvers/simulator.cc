@@ -424,13 +424,18 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   record(StateSample::Kind::kStart);
 
   // The transitions that can fire now, best first. `crossed`: root functions that fired (empty
-  // for entry checks); `at_invariant`: an invariant boundary was reached (lazy ones may fire).
-  auto candidates = [&](const std::vector<int>& crossed, bool at_invariant) {
+  // for entry checks). Lazy transitions of a component are candidates only when one of its own
+  // invariant root functions crossed (its invariant boundary was reached).
+  auto candidates = [&](const std::vector<int>& crossed) {
+    std::vector<bool> at_invariant(c_->components.size(), false);
+    for (int r : crossed) {
+      if (run.roots()[r].invariant) at_invariant[run.roots()[r].component] = true;
+    }
     std::vector<Jump> jumps;
     for (int pass = 0; pass < 2; ++pass) {  // urgent first, then lazy
       const Urgency urgency = pass == 0 ? Urgency::kUrgent : Urgency::kLazy;
-      if (urgency == Urgency::kLazy && !at_invariant) break;
       for (size_t c = 0; c < c_->components.size(); ++c) {
+        if (urgency == Urgency::kLazy && !at_invariant[c]) continue;
         const CompiledComponent& cc = c_->components[c];
         for (int ti : cc.modes[run.modes()[c]].outgoing) {
           const CompiledTransition& tr = cc.transitions[ti];
@@ -523,7 +528,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       fire(jumps.front(), cause);
       if (auto violated = run.ViolatedInvariant()) {
         // Still allowed if an urgent transition leaves at once.
-        jumps = candidates({}, false);
+        jumps = candidates({});
         if (jumps.empty()) {
           result.status = SimulationStatus::kInvariantViolated;
           result.message = "after the jump at t = " + FormatNumber(t) + " the state violates '" +
@@ -531,7 +536,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           return false;
         }
       } else {
-        jumps = candidates({}, false);
+        jumps = candidates({});
       }
       cause = EventRecord::Cause::kEnabled;
     }
@@ -594,7 +599,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   io.max_step = options.max_step;
   CvodeIntegrator integrator(&run, std::max(n, 1), io);
 
-  bool running = jump_and_iterate(candidates({}, false), EventRecord::Cause::kEnabled);
+  bool running = jump_and_iterate(candidates({}), EventRecord::Cause::kEnabled);
   if (running && zeno_check()) running = false;
   integrator.Restart(t, x, run.directions());
   size_t next_break = 0;
@@ -673,7 +678,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     if (status == CvodeIntegrator::Status::kRoot || interior) {
       bool at_invariant = false;
       for (int r : crossed) at_invariant |= run.roots()[r].invariant;
-      std::vector<Jump> jumps = candidates(crossed, at_invariant);
+      std::vector<Jump> jumps = candidates(crossed);
       if (!jumps.empty()) {
         const EventRecord::Cause cause =
             jumps.front().size() > 0 && c_->components[jumps.front()[0].first]
@@ -713,7 +718,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
         run.SetStepInputs(t);
         run.Load(t, x.data());
-        running = jump_and_iterate(candidates({}, false), EventRecord::Cause::kEnabled);
+        running = jump_and_iterate(candidates({}), EventRecord::Cause::kEnabled);
         if (running && zeno_check()) running = false;
         restart = true;
       }
