@@ -19,16 +19,22 @@ struct CvodeIntegrator::Handles {
   int num_roots = 0;
   SUNContext context = nullptr;
   N_Vector y = nullptr;
+  N_Vector dky = nullptr;  // Interpolate's output, allocated once
   SUNMatrix matrix = nullptr;
   SUNLinearSolver solver = nullptr;
   void* cvode = nullptr;
   bool initialised = false;
   Options options;
+  // Steps taken towards `stop` since the last Restart or change of stop time (Options::max_steps).
+  double stop = std::numeric_limits<double>::quiet_NaN();
+  long steps_towards_stop = 0;
+  double last_t = 0.0;  // the time of the state in `y`
 
   ~Handles() {
     if (cvode) CVodeFree(&cvode);
     if (solver) SUNLinSolFree(solver);
     if (matrix) SUNMatDestroy(matrix);
+    if (dky) N_VDestroy(dky);
     if (y) N_VDestroy(y);
     if (context) SUNContext_Free(&context);
   }
@@ -68,10 +74,11 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options
     throw std::runtime_error("CvodeIntegrator: SUNContext_Create failed");
   }
   h_->y = N_VNew_Serial(dimension, h_->context);
+  h_->dky = N_VNew_Serial(dimension, h_->context);
   h_->matrix = SUNDenseMatrix(dimension, dimension, h_->context);
   h_->solver = SUNLinSol_Dense(h_->y, h_->matrix, h_->context);
   h_->cvode = CVodeCreate(CV_ADAMS, h_->context);
-  if (!h_->y || !h_->matrix || !h_->solver || !h_->cvode) {
+  if (!h_->y || !h_->dky || !h_->matrix || !h_->solver || !h_->cvode) {
     throw std::runtime_error("CvodeIntegrator: cannot allocate SUNDIALS objects");
   }
 }
@@ -108,6 +115,8 @@ void CvodeIntegrator::Restart(double t0, const Eigen::VectorXd& x0,
     Check(CVodeSetRootDirection(h_->cvode, dirs.data()), "CVodeSetRootDirection");
   }
   root_info_.assign(h_->num_roots, 0);
+  h_->steps_towards_stop = 0;
+  h_->last_t = t0;
 }
 
 CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen::VectorXd* x) {
@@ -116,9 +125,23 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
     message_ = std::string("CVodeSetStopTime: ") + CVodeGetReturnFlagName(stop_flag);
     return Status::kFailure;
   }
+  if (!(t_stop == h_->stop)) {
+    h_->stop = t_stop;
+    h_->steps_towards_stop = 0;
+  }
+  if (++h_->steps_towards_stop > h_->options.max_steps) {
+    message_ = "CVode: CV_TOO_MUCH_WORK (more than " + std::to_string(h_->options.max_steps) +
+               " steps towards t = " + std::to_string(t_stop) + ")";
+    *t = h_->last_t;
+    x->resize(h_->dimension);
+    const double* y = N_VGetArrayPointer(h_->y);
+    for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
+    return Status::kFailure;
+  }
   sunrealtype reached = 0.0;
   const int flag = CVode(h_->cvode, t_stop, h_->y, &reached, CV_ONE_STEP);
   *t = reached;
+  h_->last_t = reached;
   x->resize(h_->dimension);
   const double* y = N_VGetArrayPointer(h_->y);
   for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
@@ -134,14 +157,12 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
 }
 
 bool CvodeIntegrator::Interpolate(double t, Eigen::VectorXd* x) {
-  N_Vector out = N_VNew_Serial(h_->dimension, h_->context);
-  const int flag = CVodeGetDky(h_->cvode, t, 0, out);
+  const int flag = CVodeGetDky(h_->cvode, t, 0, h_->dky);
   if (flag == CV_SUCCESS) {
     x->resize(h_->dimension);
-    const double* y = N_VGetArrayPointer(out);
+    const double* y = N_VGetArrayPointer(h_->dky);
     for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
   }
-  N_VDestroy(out);
   return flag == CV_SUCCESS;
 }
 

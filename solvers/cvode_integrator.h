@@ -30,6 +30,10 @@ class CvodeIntegrator {
     double absolute_tolerance = 1e-12;
     /// Largest internal step; infinity for none.
     double max_step = 0.0;
+    /// Most internal steps towards one stop time (counted from the last Restart or the last
+    /// change of `t_stop`), as CVODE's mxstep in normal mode; more make Advance report kFailure
+    /// ("CV_TOO_MUCH_WORK"), so that a run whose steps collapse (a sliding mode such as
+    /// x' = -sign(x), or a flow that turns NaN) ends instead of crawling on for ever.
     int max_steps = 100000;
   };
   /// Outcome of Advance.
@@ -52,7 +56,8 @@ class CvodeIntegrator {
   /// Takes one internal step towards `t_stop` (never past it, CV_ONE_STEP mode), truncated at the
   /// first root of any root function. On return `*t` and `*x` hold the time and state reached:
   /// kStep (an internal step ended before t_stop), kReachedTime (t == t_stop), kRoot, or
-  /// kFailure (with `message()` set). Never throws for run-time failures.
+  /// kFailure (with `message()` set; also after more than Options::max_steps steps towards the
+  /// same `t_stop`). Never throws for run-time failures.
   Status Advance(double t_stop, double* t, Eigen::VectorXd* x);
   /// The state at `t` from the interpolating polynomial of the last step (CVodeGetDky); `t` must
   /// lie in the last step [t_n - h_last, t_n]. Returns false otherwise.

@@ -229,7 +229,9 @@ class Run final : public OdeSystem {
 
   void Roots(double t, const double* x, double* g) override {
     Load(t, x);
-    for (size_t i = 0; i < roots_.size(); ++i) g[i] = Residual(roots_[i]);
+    for (size_t i = 0; i < root_residuals_.size(); ++i) {
+      g[i] = root_residuals_[i]->Evaluate(env_.data());
+    }
   }
 
   size_t x_size() const { return variable_slots_.size(); }
@@ -271,14 +273,15 @@ class Run final : public OdeSystem {
       }
     }
     for (const RootRef& r : roots_) directions_.push_back(r.direction);
+    // Resolved once per mode change: Roots runs at every step and inside CVODE's root search.
+    root_residuals_.clear();
+    for (const RootRef& r : roots_) root_residuals_.push_back(&ComparisonOf(r).residual);
   }
 
-  double Residual(const RootRef& r) const {
+  const CompiledComparison& ComparisonOf(const RootRef& r) const {
     const CompiledComponent& cc = components_[r.component];
-    const CompiledComparison& cmp = r.invariant
-                                        ? cc.modes[modes_[r.component]].invariant[r.comparison]
-                                        : cc.transitions[r.index].guard[r.comparison];
-    return cmp.residual.Evaluate(env_.data());
+    return r.invariant ? cc.modes[modes_[r.component]].invariant[r.comparison]
+                       : cc.transitions[r.index].guard[r.comparison];
   }
 
   bool GuardHolds(int component, int t, bool closure) const {
@@ -318,6 +321,7 @@ class Run final : public OdeSystem {
   std::vector<int> modes_;
   std::vector<std::pair<int, const CompiledExpression*>> active_flows_;
   std::vector<RootRef> roots_;
+  std::vector<const CompiledExpression*> root_residuals_;  // roots_[i]'s residual
   std::vector<int> directions_;
 };
 
@@ -423,29 +427,51 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   };
   record(StateSample::Kind::kStart);
 
-  // The transitions that can fire now, best first. `crossed`: root functions that fired (empty
-  // for entry checks). Lazy transitions of a component are candidates only when one of its own
-  // invariant root functions crossed (its invariant boundary was reached).
-  auto candidates = [&](const std::vector<int>& crossed) {
-    std::vector<bool> at_invariant(c_->components.size(), false);
+  // What the current instant reached and no jump has acted on yet, per component: the text of
+  // an invariant comparison whose boundary it reached (empty: none) and the transitions whose
+  // guard comparisons crossed. Set from the root functions that fired; kept through the event
+  // iteration at that instant for the components that have not jumped, so that one component's
+  // jump does not discard what another one reached at the same instant; forgotten when time
+  // advances.
+  std::vector<std::string> reached_invariant(c_->components.size());
+  std::vector<std::vector<int>> reached_guards(c_->components.size());
+  auto forget_reached = [&]() {
+    for (auto& s : reached_invariant) s.clear();
+    for (auto& g : reached_guards) g.clear();
+  };
+  auto note_reached = [&](const std::vector<int>& crossed) {
     for (int r : crossed) {
-      if (run.roots()[r].invariant) at_invariant[run.roots()[r].component] = true;
+      const RootRef& ref = run.roots()[r];
+      if (ref.invariant) {
+        reached_invariant[ref.component] = c_->components[ref.component]
+                                               .modes[run.modes()[ref.component]]
+                                               .invariant[ref.comparison]
+                                               .text;
+      } else {
+        reached_guards[ref.component].push_back(ref.index);
+      }
     }
+  };
+  auto guard_reached = [&](int c, int ti) {
+    return std::find(reached_guards[c].begin(), reached_guards[c].end(), ti) !=
+           reached_guards[c].end();
+  };
+
+  // The transitions that can fire now, best first. Urgent transitions whose guard crossed at this
+  // instant (reached_guards) are enabled when their guard holds in its closure, others when it
+  // holds strictly. Lazy transitions of a component are candidates only when its invariant
+  // boundary was reached (reached_invariant).
+  auto candidates = [&]() {
     std::vector<Jump> jumps;
     for (int pass = 0; pass < 2; ++pass) {  // urgent first, then lazy
       const Urgency urgency = pass == 0 ? Urgency::kUrgent : Urgency::kLazy;
       for (size_t c = 0; c < c_->components.size(); ++c) {
-        if (urgency == Urgency::kLazy && !at_invariant[c]) continue;
+        if (urgency == Urgency::kLazy && reached_invariant[c].empty()) continue;
         const CompiledComponent& cc = c_->components[c];
         for (int ti : cc.modes[run.modes()[c]].outgoing) {
           const CompiledTransition& tr = cc.transitions[ti];
           if (tr.urgency != urgency) continue;
-          bool crossed_now = false;
-          for (int r : crossed) {
-            const RootRef& ref = run.roots()[r];
-            crossed_now |=
-                !ref.invariant && ref.component == static_cast<int>(c) && ref.index == ti;
-          }
+          const bool crossed_now = guard_reached(static_cast<int>(c), ti);
           const bool enabled = urgency == Urgency::kLazy
                                    ? run.GuardHolds(static_cast<int>(c), ti, true)
                                    : (crossed_now ? run.GuardHolds(static_cast<int>(c), ti, true)
@@ -526,9 +552,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         return false;
       }
       fire(jumps.front(), cause);
+      for (const auto& [c, ti] : jumps.front()) {  // these components are in new modes now
+        reached_invariant[c].clear();
+        reached_guards[c].clear();
+      }
       if (auto violated = run.ViolatedInvariant()) {
         // Still allowed if an urgent transition leaves at once.
-        jumps = candidates({});
+        jumps = candidates();
         if (jumps.empty()) {
           result.status = SimulationStatus::kInvariantViolated;
           result.message = "after the jump at t = " + FormatNumber(t) + " the state violates '" +
@@ -536,9 +566,21 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           return false;
         }
       } else {
-        jumps = candidates({});
+        jumps = candidates();
       }
+      // What remains at this instant: a lazy transition at its invariant boundary, an urgent one
+      // whose guard crossed together with the one just taken, or one the jump enabled.
       cause = EventRecord::Cause::kEnabled;
+      if (!jumps.empty()) {
+        const auto [c0, t0] = jumps.front().front();
+        if (c_->components[c0].transitions[t0].urgency == Urgency::kLazy) {
+          cause = EventRecord::Cause::kInvariant;
+        } else {
+          for (const auto& [c, ti] : jumps.front()) {
+            if (guard_reached(c, ti)) cause = EventRecord::Cause::kCrossing;
+          }
+        }
+      }
     }
     return true;
   };
@@ -563,14 +605,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       }
       geometric = geometric && r < 1.0;
     }
-    const double remaining = geometric ? d.back() * r / (1.0 - r) : 0.0;
-    const bool chattering = last - first < options.zeno_window * scale;
-    const bool accumulating = geometric && remaining < options.zeno_horizon * scale;
-    if (!chattering && !accumulating) return false;
-    ZenoReport z;
-    z.accumulation_time = geometric ? last + remaining : last;
     // The shortest cycle of transition names that repeats over the last k events.
-    std::vector<std::string> names;
+    std::vector<std::string> names, cycle;
     for (size_t i = ev.size() - k; i < ev.size(); ++i) {
       std::string joined;
       for (const auto& s : ev[i].transitions) joined += (joined.empty() ? "" : "+") + s;
@@ -580,11 +616,20 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       bool periodic = true;
       for (size_t i = p; i < names.size() && periodic; ++i) periodic = names[i] == names[i - p];
       if (periodic) {
-        z.cycle.assign(names.end() - static_cast<long>(p), names.end());
+        cycle.assign(names.end() - static_cast<long>(p), names.end());
         break;
       }
     }
-    if (z.cycle.empty()) z.cycle = names;
+    const double remaining = geometric ? d.back() * r / (1.0 - r) : 0.0;
+    const bool chattering = last - first < options.zeno_window * scale;
+    // Accumulation needs the events to repeat a cycle: a last event that breaks the pattern (the
+    // ball's `stop` into `resting`) ends the sequence instead of continuing it.
+    const bool accumulating =
+        geometric && !cycle.empty() && remaining < options.zeno_horizon * scale;
+    if (!chattering && !accumulating) return false;
+    ZenoReport z;
+    z.accumulation_time = geometric ? last + remaining : last;
+    z.cycle = cycle.empty() ? names : cycle;
     result.status = SimulationStatus::kZeno;
     result.message = std::to_string(k) + " events within " + FormatNumber(last - first) +
                      " time units before t = " + FormatNumber(last) +
@@ -599,7 +644,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   io.max_step = options.max_step;
   CvodeIntegrator integrator(&run, std::max(n, 1), io);
 
-  bool running = jump_and_iterate(candidates({}), EventRecord::Cause::kEnabled);
+  bool running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
   if (running && zeno_check()) running = false;
   integrator.Restart(t, x, run.directions());
   size_t next_break = 0;
@@ -611,6 +656,9 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   };
   evaluate_roots(t, x, &g_prev);
   Eigen::VectorXd x_new, x_mid;
+  // Per-step buffers, reused so that a step allocates nothing.
+  std::vector<double> ga, gm;
+  std::vector<int> crossed;
 
   while (running && t < until) {
     while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
@@ -626,39 +674,72 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       break;
     }
     // Roots CVODE reports, or a double crossing inside the step found on the interpolant.
-    std::vector<int> crossed;
+    crossed.clear();
     if (status == CvodeIntegrator::Status::kRoot) {
       for (size_t i = 0; i < integrator.root_info().size(); ++i) {
         if (integrator.root_info()[i] != 0) crossed.push_back(static_cast<int>(i));
       }
     }
-    // A guard that crosses and crosses back inside one step leaves the step ends with the same
-    // sign, so CVODE cannot see it: look at interior points of the step's interpolant.
+    // Crossings CVODE cannot see, found on the step's interpolating polynomial:
+    // - a guard that crosses and crosses back inside one step leaves the step ends with the same
+    //   sign: look at `dense_checks` interior points;
+    // - CVODE ignores a root function that is exactly 0 where it was (re)started (it takes its
+    //   sign from just after the start), and one already past its boundary (within
+    //   event_tolerance) has no crossing left to report. So a root function that starts on its
+    //   boundary and moves on in its direction would never be reported: a strict guard `x > 0`
+    //   entered at x = 0, or an invariant left right after a jump onto its boundary. Look at the
+    //   step end too for those (root functions exactly 0, and invariants past their boundary
+    //   within event_tolerance).
+    auto on_boundary = [&](size_t i) {
+      const RootRef& ref = run.roots()[i];
+      return ref.direction != 0 &&
+             (g_prev[i] == 0.0 || (ref.invariant && ref.direction * g_prev[i] > 0.0 &&
+                                   std::abs(g_prev[i]) <= options.event_tolerance));
+    };
     bool interior = false;
-    if (options.dense_checks > 0 && !run.roots().empty() && t_new > t_prev) {
-      std::vector<double> ga = g_prev;
+    bool any_on_boundary = false;
+    for (size_t i = 0; i < g_prev.size() && !any_on_boundary; ++i) {
+      any_on_boundary = on_boundary(i);
+    }
+    if ((options.dense_checks > 0 || any_on_boundary) && !run.roots().empty() && t_new > t_prev) {
+      ga = g_prev;
       double a = t_prev;
-      for (int j = 1; j <= options.dense_checks && !interior; ++j) {
-        const double b = t_prev + (t_new - t_prev) * j / (options.dense_checks + 1);
-        if (!integrator.Interpolate(b, &x_mid)) break;
-        evaluate_roots(b, x_mid, &g_mid);
+      const int points = options.dense_checks + 1;  // the last one is the step end
+      for (int j = 1; j <= points && !interior; ++j) {
+        const bool end = j == points;
+        if (end && !any_on_boundary) break;  // CVODE watches the step ends
+        const double b = end ? t_new : t_prev + (t_new - t_prev) * j / points;
+        if (end) {
+          evaluate_roots(b, x_new, &g_mid);
+        } else {
+          if (!integrator.Interpolate(b, &x_mid)) break;
+          evaluate_roots(b, x_mid, &g_mid);
+        }
         for (size_t i = 0; i < g_mid.size() && !interior; ++i) {
           const int dir = run.roots()[i].direction;
-          const bool change = (ga[i] > 0.0 && g_mid[i] <= 0.0 && dir <= 0) ||
-                              (ga[i] < 0.0 && g_mid[i] >= 0.0 && dir >= 0);
+          const bool boundary = on_boundary(i);
+          if (end && !boundary) continue;
+          // Whether root i has crossed at g since `a` or, starting on its boundary, moved on in
+          // its direction since the step start.
+          const double g0 = boundary ? g_prev[i] : ga[i];
+          auto reached = [&](double g) {
+            return boundary ? dir * g > dir * g0 : g == 0.0 || (g > 0.0) != (g0 > 0.0);
+          };
+          const bool change = boundary ? reached(g_mid[i])
+                                       : (g0 > 0.0 && g_mid[i] <= 0.0 && dir <= 0) ||
+                                             (g0 < 0.0 && g_mid[i] >= 0.0 && dir >= 0);
           if (!change) continue;
-          // Bisection on the interpolant: g keeps the sign of ga[i] at lo and not at hi.
+          // Bisection on the interpolant: not reached at lo, reached at hi.
           double lo = a, hi = b;
-          std::vector<double> gm;
           while (hi - lo >
                  4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(hi))) {
             const double mid = 0.5 * (lo + hi);
             if (!integrator.Interpolate(mid, &x_mid)) break;
             evaluate_roots(mid, x_mid, &gm);
-            if (gm[i] != 0.0 && (gm[i] > 0.0) == (ga[i] > 0.0))
-              lo = mid;
-            else
+            if (reached(gm[i]))
               hi = mid;
+            else
+              lo = mid;
           }
           t_new = hi;
           integrator.Interpolate(t_new, &x_new);
@@ -675,10 +756,12 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     ++result.steps;
     bool restart = interior;
 
+    forget_reached();  // a new instant
     if (status == CvodeIntegrator::Status::kRoot || interior) {
       bool at_invariant = false;
       for (int r : crossed) at_invariant |= run.roots()[r].invariant;
-      std::vector<Jump> jumps = candidates(crossed);
+      note_reached(crossed);
+      std::vector<Jump> jumps = candidates();
       if (!jumps.empty()) {
         const EventRecord::Cause cause =
             jumps.front().size() > 0 && c_->components[jumps.front()[0].first]
@@ -687,6 +770,16 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
                 ? EventRecord::Cause::kInvariant
                 : EventRecord::Cause::kCrossing;
         running = jump_and_iterate(std::move(jumps), cause);
+        // A component that reached its invariant boundary and has not left its mode (another
+        // component jumped at this instant) violates its invariant.
+        for (size_t c = 0; running && c < reached_invariant.size(); ++c) {
+          if (reached_invariant[c].empty()) continue;
+          result.status = SimulationStatus::kInvariantViolated;
+          result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" +
+                           reached_invariant[c] + "' of mode " + ModeLabel(run.modes()) +
+                           " and no transition is enabled";
+          running = false;
+        }
         if (running && zeno_check()) running = false;
         restart = true;
       } else if (at_invariant) {
@@ -707,25 +800,32 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       }
     }
     if (!running) break;
-    if (status == CvodeIntegrator::Status::kReachedTime && !interior) {
-      if (t >= next_sample && options.sample_step > 0.0 && t < until) {
-        record(StateSample::Kind::kSample);
-        next_sample = std::min(until, next_sample + options.sample_step);
-        // Avoid drift: the k-th sample is at k * sample_step.
-        next_sample = std::min(
-            until, options.sample_step * (std::floor(t / options.sample_step + 0.5) + 1.0));
-      }
-      if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
-        run.SetStepInputs(t);
-        run.Load(t, x.data());
-        running = jump_and_iterate(candidates({}), EventRecord::Cause::kEnabled);
-        if (running && zeno_check()) running = false;
-        restart = true;
-      }
+    // Stop times reached by this step (also when a root lies exactly on one: otherwise the sample
+    // or the input jump there would be skipped, and the next Advance would be asked to stop at
+    // the current time).
+    if (t >= next_sample && options.sample_step > 0.0 && t < until) {
+      record(StateSample::Kind::kSample);
+      next_sample = std::min(until, next_sample + options.sample_step);
+      // Avoid drift: the k-th sample is at k * sample_step.
+      next_sample =
+          std::min(until, options.sample_step * (std::floor(t / options.sample_step + 0.5) + 1.0));
+    }
+    if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
+      run.SetStepInputs(t);
+      run.Load(t, x.data());
+      running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
+      if (running && zeno_check()) running = false;
+      restart = true;
     }
     if (!running) break;
-    if (restart) integrator.Restart(t, x, run.directions());
     evaluate_roots(t, x, &g_prev);
+    // Also restart after a root that fired nothing when some root function is exactly 0 there:
+    // CVODE would fail on the next step (CV_ILL_INPUT, "root found at and very near t") if it is
+    // still 0 just after the root, as when the state lands exactly on a boundary value.
+    if (status == CvodeIntegrator::Status::kRoot && !restart) {
+      restart = std::find(g_prev.begin(), g_prev.end(), 0.0) != g_prev.end();
+    }
+    if (restart) integrator.Restart(t, x, run.directions());
   }
   if (result.status == SimulationStatus::kCompleted && t < until) {
     result.status = SimulationStatus::kSolverFailure;

@@ -36,9 +36,10 @@ struct SimulationOptions {
   int max_event_iterations = 100;
   /// Zeno detection over the last `zeno_events` events (time scale s = max(1, |t|)):
   /// (a) chattering: they all fall inside a window shorter than `zeno_window` * s;
-  /// (b) accumulation: their intervals shrink geometrically (every ratio of consecutive
-  ///     intervals within 1% of their mean r < 1) and the predicted remaining time to the
-  ///     accumulation point, d_last * r / (1 - r), is below `zeno_horizon` * s.
+  /// (b) accumulation: their transitions repeat a cycle (the sequence of names is periodic with
+  ///     a period of at most zeno_events / 2), their intervals shrink geometrically (every ratio
+  ///     of consecutive intervals within 1% of their mean r < 1) and the predicted remaining
+  ///     time to the accumulation point, d_last * r / (1 - r), is below `zeno_horizon` * s.
   int zeno_events = 10;
   double zeno_window = 1e-6;
   double zeno_horizon = 1e-4;
@@ -53,7 +54,8 @@ enum class SimulationStatus {
   kZeno,
   /// The state reached a mode invariant's boundary, moving out, with no transition to take.
   kInvariantViolated,
-  /// CVODE failed (see message).
+  /// CVODE failed, or its steps collapsed (more than CvodeIntegrator::Options::max_steps steps
+  /// towards one stop time); see message.
   kSolverFailure,
   /// More than SimulationOptions::max_events events.
   kEventLimit,
@@ -124,14 +126,24 @@ struct SimulationResult {
 ///   strictly;
 /// - at an invariant boundary, lazy transitions whose guards hold may fire too; if none can, the
 ///   run stops with kInvariantViolated.
+/// A root function that starts exactly on its boundary (CVODE does not report roots at its initial
+/// point), or an invariant comparison already past its boundary by at most event_tolerance, is
+/// watched at the end of each step: once it moves on in its direction, that is a crossing there
+/// (so a strict guard `x > 0` entered at x = 0 fires as soon as x becomes positive, and an
+/// invariant left right after a jump onto its boundary is reported).
 /// Priority among enabled transitions: urgent before lazy, then component order, then declaration
 /// order. A labelled transition of a composed system fires only together with one enabled
 /// transition of the same label in every other component that uses the label (lowest declaration
 /// order first); resets of all participants are evaluated in the state before the jump.
 /// After a jump the new modes' urgent guards are checked (strictly): if one holds it fires at the
-/// same instant (event iteration, at most max_event_iterations times). The same check runs when a
-/// step input jumps. Input breakpoints and sample times are integration stop times, and CVODE is
-/// restarted (CVodeReInit) after every jump and input jump.
+/// same instant (event iteration, at most max_event_iterations times). What the other components
+/// reached at that instant stays in force during the iteration: an urgent transition whose guard
+/// crossed there is still taken (in its closure), a lazy one at its component's invariant boundary
+/// too; a component left at its invariant boundary with no transition taken is an invariant
+/// violation. The same check runs when a step input jumps. Input breakpoints and sample times are
+/// integration stop times (also when an event falls exactly on one), and CVODE is restarted
+/// (CVodeReInit) after every jump and input jump, and after a root at which some root function
+/// is exactly 0.
 class Simulator {
  public:
   /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument

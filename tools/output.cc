@@ -16,6 +16,16 @@ void WriteOutput(const std::string& path, const std::string& text) {
     return;
   }
   const std::filesystem::path target(path);
+  std::error_code status_error;
+  const auto status = std::filesystem::status(target, status_error);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    // A device or pipe (/dev/stdout, a FIFO): write into it; renaming over it would replace it.
+    std::ofstream out(target, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) throw OutputError("cannot write '" + path + "'");
+    return;
+  }
   const std::filesystem::path temp =
       target.string() + ".tmp." + std::to_string(static_cast<long>(::getpid()));
   {

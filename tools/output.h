@@ -11,8 +11,9 @@ struct OutputError : std::runtime_error {
 };
 
 /// Writes `text` to `path` atomically (temporary file in the same directory, then rename), so a
-/// failed run never leaves a partial file; "-" or "" writes to standard output. Throws
-/// OutputError.
+/// failed run never leaves a partial file; "-" or "" writes to standard output; an existing
+/// target that is not a regular file (a device such as /dev/stdout, a FIFO) is written directly.
+/// Throws OutputError.
 void WriteOutput(const std::string& path, const std::string& text);
 
 }  // namespace hybrid::cli

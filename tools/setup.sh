@@ -17,6 +17,7 @@ packages=(
   graphviz               # `dot -Tsvg` for the rendered mode graphs
   clang-format
   python3                # tools/generate_finger.py (checked by a test), benchmark scripts
+  python3-scipy python3-numpy  # tools/compare_scipy.py: the finger simulated by solve_ivp
 )
 
 sudo_cmd=()
