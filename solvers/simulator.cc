@@ -29,10 +29,19 @@ std::string_view StatusName(SimulationStatus status) {
 
 namespace {
 
+// Whether an expression can be followed exactly along a straight-line trajectory: its affine
+// coefficients on the continuous variables (parameters folded), or none when it is not affine in
+// them, and every System slot it reads (to reject inputs that vary within a segment).
+struct Linearity {
+  std::optional<std::vector<std::pair<int, double>>> terms;  // (index in x, coefficient)
+  std::vector<int> slots;
+};
+
 struct CompiledComparison {
   CompiledExpression residual;  // lhs - rhs over System slots
   Relation relation;
   std::string text;
+  Linearity linearity;
 };
 
 struct CompiledTransition {
@@ -47,6 +56,10 @@ struct CompiledTransition {
 
 struct CompiledMode {
   std::vector<std::pair<int, CompiledExpression>> flows;  // (index in x, rhs)
+  // The flows read no continuous variable: the state moves on a straight line between events
+  // while the inputs they read (flow_slots) are constant.
+  bool constant_rate = false;
+  std::vector<int> flow_slots;
   std::vector<CompiledComparison> invariant;
   std::vector<int> outgoing;                     // transition indices
   std::vector<std::pair<int, double>> discrete;  // (System slot, value)
@@ -131,15 +144,39 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
         return Expression::Symbol(symbols[g].name, g);
       });
     };
+    auto linearity = [&](const Expression& e) {
+      Linearity l;
+      l.slots = e.Slots();
+      const Expression folded = e.Substitute([&](const std::string&, int slot)
+                                                 -> std::optional<Expression> {
+        if (symbols[slot].kind != SymbolKind::kParameter) return std::nullopt;
+        return Expression::Constant(c_->parameter_env[slot]);
+      });
+      if (const auto affine = folded.AsAffine()) {
+        l.terms.emplace();
+        for (const auto& [slot, coefficient] : affine->terms) {
+          if (x_index[slot] >= 0) l.terms->emplace_back(x_index[slot], coefficient);
+        }
+      }
+      return l;
+    };
     auto comparison = [&](const Comparison& c) {
-      return CompiledComparison{CompiledExpression(global(c.Residual())), c.relation, c.ToString()};
+      const Expression residual = global(c.Residual());
+      return CompiledComparison{CompiledExpression(residual), c.relation, c.ToString(),
+                                linearity(residual)};
     };
     CompiledComponent cc;
     cc.instance = comp.instance;
     for (const Mode& m : a.modes()) {
       CompiledMode cm;
+      cm.constant_rate = true;
       for (const auto& [slot, rhs] : m.flows) {
-        cm.flows.emplace_back(x_index[comp.global_slot[slot]], CompiledExpression(global(rhs)));
+        const Expression e = global(rhs);
+        cm.flows.emplace_back(x_index[comp.global_slot[slot]], CompiledExpression(e));
+        for (int read : e.Slots()) {
+          cm.constant_rate = cm.constant_rate && x_index[read] < 0;
+          cm.flow_slots.push_back(read);
+        }
       }
       for (const Comparison& c : m.invariant.comparisons) cm.invariant.push_back(comparison(c));
       for (const auto& [slot, value] : m.discrete_values) {
@@ -276,6 +313,36 @@ class Run final : public OdeSystem {
     // Resolved once per mode change: Roots runs at every step and inside CVODE's root search.
     root_residuals_.clear();
     for (const RootRef& r : roots_) root_residuals_.push_back(&ComparisonOf(r).residual);
+    // Exact segments: every flow constant and every root function affine in the state, none of
+    // them reading an input that varies within a segment (a linear signal).
+    auto steady = [&](const std::vector<int>& slots) {
+      return std::none_of(slots.begin(), slots.end(), [&](int slot) {
+        return std::any_of(signals_.begin(), signals_.end(), [&](const InputSignal& s) {
+          return s.slot == slot && s.shape == InputSignal::Shape::kLinear;
+        });
+      });
+    };
+    exact_ = true;
+    for (size_t c = 0; c < components_.size() && exact_; ++c) {
+      const CompiledMode& m = components_[c].modes[modes_[c]];
+      exact_ = m.constant_rate && steady(m.flow_slots);
+    }
+    for (size_t i = 0; i < roots_.size() && exact_; ++i) {
+      const Linearity& l = ComparisonOf(roots_[i]).linearity;
+      exact_ = l.terms.has_value() && steady(l.slots);
+    }
+  }
+
+  /// True when the current modes move the state on a straight line and every root function is
+  /// affine along it, so that crossings are found exactly without a solver.
+  bool exact() const { return exact_; }
+  /// d g_i / dt along the straight line with constant rate `dxdt`.
+  double Slope(int i, const Eigen::VectorXd& dxdt) const {
+    double slope = 0.0;
+    for (const auto& [index, coefficient] : *ComparisonOf(roots_[i]).linearity.terms) {
+      slope += coefficient * dxdt[index];
+    }
+    return slope;
   }
 
   const CompiledComparison& ComparisonOf(const RootRef& r) const {
@@ -322,6 +389,7 @@ class Run final : public OdeSystem {
   std::vector<std::pair<int, const CompiledExpression*>> active_flows_;
   std::vector<RootRef> roots_;
   std::vector<const CompiledExpression*> root_residuals_;  // roots_[i]'s residual
+  bool exact_ = false;
   std::vector<int> directions_;
 };
 
@@ -642,11 +710,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   io.relative_tolerance = options.relative_tolerance;
   io.absolute_tolerance = options.absolute_tolerance;
   io.max_step = options.max_step;
-  CvodeIntegrator integrator(&run, std::max(n, 1), io);
+  // Created on first use: a run that stays in constant-rate modes never needs it.
+  std::optional<CvodeIntegrator> integrator;
+  bool stale = true;  // the integrator must be restarted at (t, x) before its next step
+  Eigen::VectorXd rate = Eigen::VectorXd::Zero(std::max(n, 1));
 
   bool running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
   if (running && zeno_check()) running = false;
-  integrator.Restart(t, x, run.directions());
   size_t next_break = 0;
   double next_sample = options.sample_step > 0.0 ? options.sample_step : until;
   std::vector<double> g_prev(run.roots().size()), g_now, g_mid;
@@ -666,18 +736,69 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         {until, next_sample, next_break < breakpoints.size() ? breakpoints[next_break] : until});
     const double t_prev = t;
     double t_new = t;
-    const auto status = integrator.Advance(t_stop, &t_new, &x_new);
+    crossed.clear();
+    auto on_boundary = [&](size_t i) {
+      const RootRef& ref = run.roots()[i];
+      return ref.direction != 0 &&
+             (g_prev[i] == 0.0 || (ref.invariant && ref.direction * g_prev[i] > 0.0 &&
+                                   std::abs(g_prev[i]) <= options.event_tolerance));
+    };
+    // Exact segment: constant rates and affine root functions. Each root function is
+    // g_i(t) = g_i(t_prev) + s_i (t - t_prev); the first crossing in its direction is a division.
+    // A root function starting on its boundary is left to the solver path (its conventions for
+    // that case apply), so both paths fire the same events.
+    const bool at_breakpoint =
+        next_break < breakpoints.size() && t_stop == breakpoints[next_break];
+    bool exact = run.exact();
+    if (exact) {
+      run.Derivatives(t, x.data(), rate.data());
+      for (size_t i = 0; i < g_prev.size() && exact; ++i) {
+        exact = !(on_boundary(i) && run.roots()[i].direction * run.Slope(static_cast<int>(i), rate) > 0.0);
+      }
+    }
+    CvodeIntegrator::Status status;
+    if (exact) {
+      t_new = t_stop;
+      for (size_t i = 0; i < g_prev.size(); ++i) {
+        const double slope = run.Slope(static_cast<int>(i), rate);
+        const int dir = run.roots()[i].direction;
+        const double g0 = g_prev[i];
+        const bool toward = (dir <= 0 && g0 > 0.0 && slope < 0.0) ||
+                            (dir >= 0 && g0 < 0.0 && slope > 0.0);
+        if (!toward) continue;
+        const double crossing = t_prev - g0 / slope;
+        const double tie = 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
+        if (crossing > t_new + tie || crossing > t_stop) continue;
+        // An invariant boundary reached exactly at an input breakpoint is not left yet: the
+        // input changes there. The next segment starts on the boundary and decides.
+        if (run.roots()[i].invariant && at_breakpoint && crossing >= t_stop - tie) continue;
+        if (crossing < t_new - tie) crossed.clear();
+        t_new = std::min(t_new, crossing);
+        crossed.push_back(static_cast<int>(i));
+      }
+      status = crossed.empty() ? CvodeIntegrator::Status::kReachedTime
+                               : CvodeIntegrator::Status::kRoot;
+      x_new = x + rate.head(x.size()) * (t_new - t_prev);
+      stale = true;
+    } else {
+      if (!integrator) integrator.emplace(&run, std::max(n, 1), io);
+      if (stale) {
+        integrator->Restart(t, x, run.directions());
+        stale = false;
+      }
+      status = integrator->Advance(t_stop, &t_new, &x_new);
+      ++result.steps;
+    }
     if (status == CvodeIntegrator::Status::kFailure) {
       result.status = SimulationStatus::kSolverFailure;
-      result.message = integrator.message() + " at t = " + FormatNumber(t_new) + " in mode " +
+      result.message = integrator->message() + " at t = " + FormatNumber(t_new) + " in mode " +
                        ModeLabel(run.modes());
       break;
     }
     // Roots CVODE reports, or a double crossing inside the step found on the interpolant.
-    crossed.clear();
-    if (status == CvodeIntegrator::Status::kRoot) {
-      for (size_t i = 0; i < integrator.root_info().size(); ++i) {
-        if (integrator.root_info()[i] != 0) crossed.push_back(static_cast<int>(i));
+    if (!exact && status == CvodeIntegrator::Status::kRoot) {
+      for (size_t i = 0; i < integrator->root_info().size(); ++i) {
+        if (integrator->root_info()[i] != 0) crossed.push_back(static_cast<int>(i));
       }
     }
     // Crossings CVODE cannot see, found on the step's interpolating polynomial:
@@ -690,18 +811,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     //   entered at x = 0, or an invariant left right after a jump onto its boundary. Look at the
     //   step end too for those (root functions exactly 0, and invariants past their boundary
     //   within event_tolerance).
-    auto on_boundary = [&](size_t i) {
-      const RootRef& ref = run.roots()[i];
-      return ref.direction != 0 &&
-             (g_prev[i] == 0.0 || (ref.invariant && ref.direction * g_prev[i] > 0.0 &&
-                                   std::abs(g_prev[i]) <= options.event_tolerance));
-    };
     bool interior = false;
     bool any_on_boundary = false;
     for (size_t i = 0; i < g_prev.size() && !any_on_boundary; ++i) {
       any_on_boundary = on_boundary(i);
     }
-    if ((options.dense_checks > 0 || any_on_boundary) && !run.roots().empty() && t_new > t_prev) {
+    if (!exact && (options.dense_checks > 0 || any_on_boundary) && !run.roots().empty() &&
+        t_new > t_prev) {
       ga = g_prev;
       double a = t_prev;
       const int points = options.dense_checks + 1;  // the last one is the step end
@@ -712,7 +828,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         if (end) {
           evaluate_roots(b, x_new, &g_mid);
         } else {
-          if (!integrator.Interpolate(b, &x_mid)) break;
+          if (!integrator->Interpolate(b, &x_mid)) break;
           evaluate_roots(b, x_mid, &g_mid);
         }
         for (size_t i = 0; i < g_mid.size() && !interior; ++i) {
@@ -734,7 +850,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           while (hi - lo >
                  4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(hi))) {
             const double mid = 0.5 * (lo + hi);
-            if (!integrator.Interpolate(mid, &x_mid)) break;
+            if (!integrator->Interpolate(mid, &x_mid)) break;
             evaluate_roots(mid, x_mid, &gm);
             if (reached(gm[i]))
               hi = mid;
@@ -742,7 +858,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
               lo = mid;
           }
           t_new = hi;
-          integrator.Interpolate(t_new, &x_new);
+          integrator->Interpolate(t_new, &x_new);
           crossed = {static_cast<int>(i)};
           interior = true;
         }
@@ -753,7 +869,6 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     t = t_new;
     x = x_new;
     run.Load(t, x.data());
-    ++result.steps;
     bool restart = interior;
 
     forget_reached();  // a new instant
@@ -825,7 +940,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     if (status == CvodeIntegrator::Status::kRoot && !restart) {
       restart = std::find(g_prev.begin(), g_prev.end(), 0.0) != g_prev.end();
     }
-    if (restart) integrator.Restart(t, x, run.directions());
+    if (restart) stale = true;
   }
   if (result.status == SimulationStatus::kCompleted && t < until) {
     result.status = SimulationStatus::kSolverFailure;
