@@ -110,7 +110,7 @@ struct SimulationResult {
   std::vector<StateSample> samples;
   std::vector<EventRecord> events;
   std::optional<ZenoReport> zeno;
-  /// CVODE internal steps.
+  /// CVODE internal steps (none for exact constant-rate segments).
   long steps = 0;
 };
 
@@ -144,6 +144,15 @@ struct SimulationResult {
 /// integration stop times (also when an event falls exactly on one), and CVODE is restarted
 /// (CVodeReInit) after every jump and input jump, and after a root at which some root function
 /// is exactly 0.
+///
+/// Exact segments: while every flow of the current modes reads no continuous variable and no
+/// linearly interpolated input (a constant rate f between input breakpoints), and every root
+/// function is affine in the state (parameters folded), the state moves on the line
+/// x(t) = x0 + f (t - t0) and each root function is g0 + s (t - t0) with s = grad g . f: the
+/// first crossing in its direction is t0 - g0 / s, computed without CVODE (no solver steps, no
+/// integration error). The event rules above apply unchanged; a root function that starts on its
+/// boundary and moves on sends that segment to the solver path, and an invariant boundary reached
+/// exactly at an input breakpoint is decided by the next segment (the input changes there).
 class Simulator {
  public:
   /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument
