@@ -147,11 +147,11 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
     auto linearity = [&](const Expression& e) {
       Linearity l;
       l.slots = e.Slots();
-      const Expression folded = e.Substitute([&](const std::string&, int slot)
-                                                 -> std::optional<Expression> {
-        if (symbols[slot].kind != SymbolKind::kParameter) return std::nullopt;
-        return Expression::Constant(c_->parameter_env[slot]);
-      });
+      const Expression folded =
+          e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
+            if (symbols[slot].kind != SymbolKind::kParameter) return std::nullopt;
+            return Expression::Constant(c_->parameter_env[slot]);
+          });
       if (const auto affine = folded.AsAffine()) {
         l.terms.emplace();
         for (const auto& [slot, coefficient] : affine->terms) {
@@ -747,13 +747,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     // g_i(t) = g_i(t_prev) + s_i (t - t_prev); the first crossing in its direction is a division.
     // A root function starting on its boundary is left to the solver path (its conventions for
     // that case apply), so both paths fire the same events.
-    const bool at_breakpoint =
-        next_break < breakpoints.size() && t_stop == breakpoints[next_break];
+    const bool at_breakpoint = next_break < breakpoints.size() && t_stop == breakpoints[next_break];
     bool exact = run.exact();
     if (exact) {
       run.Derivatives(t, x.data(), rate.data());
       for (size_t i = 0; i < g_prev.size() && exact; ++i) {
-        exact = !(on_boundary(i) && run.roots()[i].direction * run.Slope(static_cast<int>(i), rate) > 0.0);
+        exact = !(on_boundary(i) &&
+                  run.roots()[i].direction * run.Slope(static_cast<int>(i), rate) > 0.0);
       }
     }
     CvodeIntegrator::Status status;
@@ -763,11 +763,12 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         const double slope = run.Slope(static_cast<int>(i), rate);
         const int dir = run.roots()[i].direction;
         const double g0 = g_prev[i];
-        const bool toward = (dir <= 0 && g0 > 0.0 && slope < 0.0) ||
-                            (dir >= 0 && g0 < 0.0 && slope > 0.0);
+        const bool toward =
+            (dir <= 0 && g0 > 0.0 && slope < 0.0) || (dir >= 0 && g0 < 0.0 && slope > 0.0);
         if (!toward) continue;
         const double crossing = t_prev - g0 / slope;
-        const double tie = 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
+        const double tie =
+            4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
         if (crossing > t_new + tie || crossing > t_stop) continue;
         // An invariant boundary reached exactly at an input breakpoint is not left yet: the
         // input changes there. The next segment starts on the boundary and decides.
@@ -776,8 +777,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         t_new = std::min(t_new, crossing);
         crossed.push_back(static_cast<int>(i));
       }
-      status = crossed.empty() ? CvodeIntegrator::Status::kReachedTime
-                               : CvodeIntegrator::Status::kRoot;
+      status =
+          crossed.empty() ? CvodeIntegrator::Status::kReachedTime : CvodeIntegrator::Status::kRoot;
       x_new = x + rate.head(x.size()) * (t_new - t_prev);
       stale = true;
     } else {

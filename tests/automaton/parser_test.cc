@@ -21,11 +21,13 @@
 #include "automaton/automaton.h"
 #include "automaton/expression.h"
 #include "automaton/system.h"
+#include "tests/test_utilities/command_line.h"
 
 namespace hybrid {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 const fs::path kMalformedDir = kSourceDir / "tests" / "data" / "malformed";
@@ -76,29 +78,6 @@ std::string TestName(const ::testing::TestParamInfo<Expectation>& info) {
   }
   return name;
 }
-
-// A fresh directory under the system temporary directory, removed by the destructor.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("hybrid_parser_test_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path Write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-
- private:
-  fs::path path_;
-};
 
 // The ParseError that parsing `text` throws; fails the test if none (or another exception) is
 // thrown.

@@ -19,83 +19,21 @@
 
 #include "automaton/dot_writer.h"
 #include "automaton/parser.h"
+#include "tests/test_utilities/command_line.h"
 
 namespace hybrid {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Quote;
+using testing::ReadAll;
+using testing::Result;
+using testing::RunHybrid;
+using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 const fs::path kFinger = kSourceDir / "spec" / "finger.ha";
 const fs::path kMalformedDir = kSourceDir / "tests" / "data" / "malformed";
-
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// A fresh directory under the system temporary directory, removed by the destructor.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("hybrid_cli_test_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path Write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-  std::vector<std::string> Files() const {
-    std::vector<std::string> out;
-    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
- private:
-  fs::path path_;
-};
-
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs `hybrid ARGS` through the shell (arguments are passed as written: quote them), with
-// stdout redirected to `stdout_target` when given.
-Result RunHybrid(const std::string& args, const std::string& stdout_target = "") {
-  TempDir dir;
-  const fs::path out = dir.path() / "stdout", err = dir.path() / "stderr";
-  const std::string command = Quote(HYBRID_BINARY) + " " + args + " >" +
-                              (stdout_target.empty() ? Quote(out) : stdout_target) + " 2>" +
-                              Quote(err) + " </dev/null";
-  const int status = std::system(command.c_str());
-  Result r;
-  if (WIFEXITED(status)) {
-    r.exit_code = WEXITSTATUS(status);
-  } else {
-    ADD_FAILURE() << command << ": did not exit normally (status " << status << ")";
-  }
-  r.out = ReadAll(out);
-  r.err = ReadAll(err);
-  return r;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Usage.

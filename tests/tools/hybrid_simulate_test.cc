@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_utilities/command_line.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {
@@ -24,6 +25,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using testing::Quote;
+using testing::ReadAll;
+using testing::Result;
+using testing::RunHybrid;
+using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
@@ -31,74 +37,8 @@ std::string Spec(const std::string& name) {
   return (kSourceDir / "spec" / (name + ".ha")).string();
 }
 
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// A fresh directory under the system temporary directory, removed by the destructor.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("hybrid_simulate_test_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  std::string Write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-  std::vector<std::string> Files() const {
-    std::vector<std::string> out;
-    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
- private:
-  fs::path path_;
-};
-
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
 // Runs `hybrid simulate ARGS` through the shell (quote the arguments that need it).
-Result Simulate(const std::string& args) {
-  TempDir dir;
-  const fs::path out = dir.path() / "stdout", err = dir.path() / "stderr";
-  const std::string command = Quote(HYBRID_BINARY) + " simulate " + args + " >" +
-                              Quote(out.string()) + " 2>" + Quote(err.string()) + " </dev/null";
-  const int status = std::system(command.c_str());
-  Result r;
-  if (WIFEXITED(status)) {
-    r.exit_code = WEXITSTATUS(status);
-  } else {
-    ADD_FAILURE() << command << ": did not exit normally (status " << status << ")";
-  }
-  r.out = ReadAll(out);
-  r.err = ReadAll(err);
-  return r;
-}
+Result Simulate(const std::string& args) { return RunHybrid("simulate " + args); }
 
 json SimulateJson(const std::string& args, int expected_exit = 0) {
   const Result r = Simulate(args + " --json");

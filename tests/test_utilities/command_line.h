@@ -1,0 +1,100 @@
+#pragma once
+
+// Shared helpers for tests that write files and run the `hybrid` binary (HYBRID_BINARY).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace hybrid::testing {
+
+/// `s` single-quoted for the shell.
+inline std::string Quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+/// The whole content of a file ("" if it cannot be read).
+inline std::string ReadAll(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// A fresh directory under the system temporary directory, removed by the destructor.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("hybrid_test_" + std::to_string(rd()) + "_" + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  /// Writes `text` to the file `name` in the directory and returns its path.
+  std::filesystem::path Write(const std::string& name, const std::string& text) const {
+    const std::filesystem::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  /// The path of `name` in the directory (not created).
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+  /// Names of the files in the directory, sorted.
+  std::vector<std::string> Files() const {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::directory_iterator(path_)) {
+      out.push_back(e.path().filename());
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Exit code and captured output of one run.
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+/// Runs `hybrid ARGS` through the shell (arguments as written: quote them), with standard output
+/// redirected to `stdout_target` when given. A run that does not exit normally is a test failure.
+inline Result RunHybrid(const std::string& args, const std::string& stdout_target = "") {
+  TempDir dir;
+  const std::filesystem::path out = dir.path() / "stdout", err = dir.path() / "stderr";
+  const std::string command = Quote(HYBRID_BINARY) + " " + args + " >" +
+                              (stdout_target.empty() ? Quote(out.string()) : stdout_target) +
+                              " 2>" + Quote(err.string()) + " </dev/null";
+  const int status = std::system(command.c_str());
+  Result r;
+  if (WIFEXITED(status)) {
+    r.exit_code = WEXITSTATUS(status);
+  } else {
+    ADD_FAILURE() << command << ": did not exit normally (status " << status << ")";
+  }
+  r.out = ReadAll(out);
+  r.err = ReadAll(err);
+  return r;
+}
+
+}  // namespace hybrid::testing
