@@ -921,8 +921,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     // the current time).
     if (t >= next_sample && options.sample_step > 0.0 && t < until) {
       record(StateSample::Kind::kSample);
-      next_sample = std::min(until, next_sample + options.sample_step);
-      // Avoid drift: the k-th sample is at k * sample_step.
+      // The k-th sample is at k * sample_step exactly (no accumulated drift).
       next_sample =
           std::min(until, options.sample_step * (std::floor(t / options.sample_step + 0.5) + 1.0));
     }
