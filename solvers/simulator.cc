@@ -719,7 +719,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   if (running && zeno_check()) running = false;
   size_t next_break = 0;
   double next_sample = options.sample_step > 0.0 ? options.sample_step : until;
-  std::vector<double> g_prev(run.roots().size()), g_now, g_mid;
+  std::vector<double> g_prev(run.roots().size()), g_mid;
   auto evaluate_roots = [&](double time, const Eigen::VectorXd& state, std::vector<double>* g) {
     g->resize(run.roots().size());
     if (!g->empty()) run.Roots(time, state.data(), g->data());
@@ -874,46 +874,29 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
 
     forget_reached();  // a new instant
     if (status == CvodeIntegrator::Status::kRoot || interior) {
-      bool at_invariant = false;
-      for (int r : crossed) at_invariant |= run.roots()[r].invariant;
       note_reached(crossed);
       std::vector<Jump> jumps = candidates();
-      if (!jumps.empty()) {
+      const bool jumped = !jumps.empty();
+      if (jumped) {
+        const auto [c0, t0] = jumps.front().front();
         const EventRecord::Cause cause =
-            jumps.front().size() > 0 && c_->components[jumps.front()[0].first]
-                                                .transitions[jumps.front()[0].second]
-                                                .urgency == Urgency::kLazy
+            c_->components[c0].transitions[t0].urgency == Urgency::kLazy
                 ? EventRecord::Cause::kInvariant
                 : EventRecord::Cause::kCrossing;
         running = jump_and_iterate(std::move(jumps), cause);
-        // A component that reached its invariant boundary and has not left its mode (another
-        // component jumped at this instant) violates its invariant.
-        for (size_t c = 0; running && c < reached_invariant.size(); ++c) {
-          if (reached_invariant[c].empty()) continue;
-          result.status = SimulationStatus::kInvariantViolated;
-          result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" +
-                           reached_invariant[c] + "' of mode " + ModeLabel(run.modes()) +
-                           " and no transition is enabled";
-          running = false;
-        }
-        if (running && zeno_check()) running = false;
         restart = true;
-      } else if (at_invariant) {
-        std::string which;
-        for (int r : crossed) {
-          const RootRef& ref = run.roots()[r];
-          if (ref.invariant) {
-            which = c_->components[ref.component]
-                        .modes[run.modes()[ref.component]]
-                        .invariant[ref.comparison]
-                        .text;
-          }
-        }
+      }
+      // A component that reached its invariant boundary and has not left its mode (nothing was
+      // enabled, or only other components jumped at this instant) violates its invariant.
+      for (size_t c = 0; running && c < reached_invariant.size(); ++c) {
+        if (reached_invariant[c].empty()) continue;
         result.status = SimulationStatus::kInvariantViolated;
-        result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" + which +
-                         "' of mode " + ModeLabel(run.modes()) + " and no transition is enabled";
+        result.message = "at t = " + FormatNumber(t) + " the state leaves the invariant '" +
+                         reached_invariant[c] + "' of mode " + ModeLabel(run.modes()) +
+                         " and no transition is enabled";
         running = false;
       }
+      if (running && jumped && zeno_check()) running = false;
     }
     if (!running) break;
     // Stop times reached by this step (also when a root lies exactly on one: otherwise the sample
