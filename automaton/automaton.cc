@@ -106,6 +106,27 @@ int Automaton::AddParameter(std::string name, Expression value, std::string unit
   return slot;
 }
 
+void Automaton::SetParameter(std::string_view name, double value) {
+  constexpr std::string_view kApi = "Automaton::SetParameter";
+  const std::optional<int> slot = symbols_.Find(name);
+  if (!slot || symbols_[*slot].kind != SymbolKind::kParameter) {
+    Fail(kApi, "'" + std::string(name) + "' is not a parameter of automaton '" + name_ + "'");
+  }
+  if (!std::isfinite(value)) Fail(kApi, "value of '" + std::string(name) + "' is not finite");
+  auto it = std::find_if(parameters_.begin(), parameters_.end(),
+                         [&](const auto& p) { return p.first == *slot; });
+  const Expression old = it->second;
+  it->second = Expression::Constant(value);
+  const std::vector<double> env = ParameterEnvironment();
+  for (const auto& [s, e] : parameters_) {
+    if (!std::isfinite(env[s])) {
+      it->second = old;
+      Fail(kApi, "setting '" + std::string(name) + "' makes parameter '" + symbols_[s].name +
+                     "' non-finite");
+    }
+  }
+}
+
 ModeId Automaton::AddMode(Mode mode) {
   constexpr std::string_view kApi = "Automaton::AddMode";
   if (mode.name.empty()) Fail(kApi, "empty mode name");

@@ -77,6 +77,11 @@ class Automaton {
   int AddInput(std::string name, Range bounds, std::string unit = "");
   /// `value` may read only parameters declared earlier; it must evaluate to a finite number.
   int AddParameter(std::string name, Expression value, std::string unit = "");
+  /// Replaces the defining expression of parameter `name` by the constant `value`; parameters
+  /// defined from it follow (they are evaluated in declaration order). Throws
+  /// std::invalid_argument ("Automaton::SetParameter: ...") if `name` is not a parameter, `value`
+  /// is not finite, or a parameter defined from it becomes non-finite (the old value is kept).
+  void SetParameter(std::string_view name, double value);
   /// Flows must be sorted by slot and name continuous variables; every discrete variable must
   /// get a value; the mode name must be new.
   ModeId AddMode(Mode mode);

@@ -262,6 +262,23 @@ std::pair<double, double> System::InputBounds(int slot) const {
   Fail("System::InputBounds", "no component declares input '" + symbols_[slot].name + "'");
 }
 
+void System::SetParameter(std::string_view name, double value) {
+  constexpr std::string_view kApi = "System::SetParameter";
+  int found = 0;
+  for (Component& c : components_) {
+    const std::optional<int> slot = c.automaton.symbols().Find(name);
+    if (!slot || c.automaton.symbols()[*slot].kind != SymbolKind::kParameter) continue;
+    try {
+      c.automaton.SetParameter(name, value);
+      c.source.SetParameter(c.source.symbols()[*slot].name, value);
+    } catch (const std::invalid_argument& e) {
+      Fail(kApi, e.what());
+    }
+    ++found;
+  }
+  if (found == 0) Fail(kApi, "no component has a parameter '" + std::string(name) + "'");
+}
+
 void System::SetScenario(Scenario scenario) {
   constexpr std::string_view kApi = "System::SetScenario";
   if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {

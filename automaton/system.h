@@ -60,6 +60,11 @@ class System {
   /// input's bounds, until > 0 and finite); throws std::invalid_argument
   /// ("System::SetScenario: ...") otherwise.
   void SetScenario(Scenario scenario);
+  /// Sets parameter `name` (a System name: "A.gob1", or a shared or unqualified "gob1") to
+  /// `value` in every component that declares it (Automaton::SetParameter). Throws
+  /// std::invalid_argument ("System::SetParameter: ...") if no component declares such a
+  /// parameter, or as Automaton::SetParameter does.
+  void SetParameter(std::string_view name, double value);
 
   const SymbolTable& symbols() const { return symbols_; }
   std::span<const Component> components() const { return components_; }

@@ -78,12 +78,27 @@ def normalise(s):
     return s
 
 
-M3 = "(theta3_min + (theta3_max - theta3_min) / (255 - g)) * u"
+# Phase 3 (decision C1, docs/finger_model.md): section 4's law theta3(g) = theta3_s +
+# (theta3_max - theta3_s) (g - g_s) / (255 - g), continued from theta3_s and g_s, the values when
+# link 2 was blocked, differentiated in g. (Section 3's m3(g) = theta3_min + c / (255 - g) is not
+# this rate.) The max(.., 1e-12) only matters for g_s = g = 255, where the numerator is 0 too.
+M3 = "(theta3_max - theta3_s) * (255 - g_s) / max((255 - g) ^ 2, 1e-12) * u"
 
 
 def rate(flow):
     """A flow right-hand side as written in the model (m3 expanded)."""
     return M3 if flow == "m3 * u" else flow
+
+
+def release_guard(i):
+    """Transitions 2 and 4 (D2): link i leaves its contact or limit when the motor reverses and
+    link i + 1 is back where it was when link i stopped: theta2 at its minimum for link 1,
+    theta3 at theta3_s for link 2 (C2), at once for link 3."""
+    if i == 1:
+        return "theta2 == theta2_min and u < 0"
+    if i == 2:
+        return "theta3 == theta3_s and u < 0"
+    return "u < 0"
 
 
 def transitions(all_states):
@@ -95,10 +110,29 @@ def transitions(all_states):
         p = phase(s)
         flows = FLOWS[p]
 
-        def emit(kind, link, target, guard, label):
+        def emit(kind, link, target, guard, label, resets=""):
             target = normalise(tuple(target))
-            if target in known and target != s:
-                out.append((f"t{kind}_{name(s)}_to_{name(target)}", s, target, guard, label))
+            if target not in known or target == s:
+                return
+            blocks_link2 = (target[1] or target[4]) and not (s[1] or s[4])
+            if blocks_link2:
+                # Remember where link 2 stopped: the start of the phase-3 law.
+                extra = "theta3_s := theta3, g_s := g"
+                resets = f"{resets}, {extra}" if resets else extra
+            releases_link2 = (s[1] or s[4]) and not (target[1] or target[4])
+            if releases_link2 and target[5] == 0 and phase(target) in ("1", "2"):
+                # Decision C2: back in phase 1 or 2, link 3 is at its lower limit (the primed
+                # phase) when it was there when link 2 stopped.
+                # The primed twin comes first: at the crossing the simulator tests a guard in
+                # its closure, where `theta3_s > theta3_min` holds for theta3_s = theta3_min
+                # too; declaration order then gives the primed phase priority.
+                primed = target[:5] + (-1,)
+                out.append((f"t{kind}_{name(s)}_to_{name(primed)}", s, primed,
+                            f"{guard} and theta3_s <= theta3_min", label, resets))
+                out.append((f"t{kind}_{name(s)}_to_{name(target)}", s, target,
+                            f"{guard} and theta3_s > theta3_min", label, resets))
+                return
+            out.append((f"t{kind}_{name(s)}_to_{name(target)}", s, target, guard, label, resets))
 
         for i in (1, 2, 3):
             ci, li = c[i - 1], l[i - 1]
@@ -110,31 +144,32 @@ def transitions(all_states):
                 t[i - 1] = 1
                 emit(1, i, t, f"g >= gob{i} and u > 0", f"contact{i}")
             # 2. c_i: 1 -> 0 when theta_{i+1} = theta_{i+1,min} and u < 0 (link 3: u < 0).
+            #    Link 2 (decision C2): theta3 back at theta3_s, where phase 3 started.
             if ci == 1:
                 t = c + l
                 t[i - 1] = 0
-                guard = (f"theta{i + 1} == theta{i + 1}_min and u < 0" if i < 3 else "u < 0")
-                emit(2, i, t, guard, f"release{i}")
+                emit(2, i, t, release_guard(i), f"release{i}")
             # 3. l_i: 0 -> 1 when theta_i + dtheta_i >= theta_i,max: in continuous time, theta_i
             #    at its limit and its rate pushing further (otherwise the finger moving away from
             #    the limit would be caught again at once).
             if li == 0 and ci == 0 and theta in flows:
                 t = c + l
                 t[3 + i - 1] = 1
-                emit(3, i, t, f"{theta} >= {theta}_max and {rate(flows[theta])} > 0", "")
+                emit(3, i, t, f"{theta} >= {theta}_max and {rate(flows[theta])} > 0", "",
+                     f"{theta} := {theta}_max")
             # 4. l_i: 1 -> 0 when the motor reverses. Decision D2: like transition 2, links 1 and 2
             #    leave their limits only once the next link is back at its minimum
             #    (theta_{i+1} = theta_{i+1,min}), so that opening retraces table 4.1.
             if li == 1:
                 t = c + l
                 t[3 + i - 1] = 0
-                guard = (f"theta{i + 1} == theta{i + 1}_min and u < 0" if i < 3 else "u < 0")
-                emit(4, i, t, guard, "")
+                emit(4, i, t, release_guard(i), "")
         # 5. l3: 0 -> -1 when theta3 reaches its lower limit (phases 1 and 2, where the table has a
         #    primed phase to go to).
         if l[2] == 0 and c[2] == 0 and "theta3" in flows and p in ("1", "2"):
             emit(5, 3, c + l[:2] + [-1],
-                 f"theta3 <= theta3_min and {rate(flows['theta3'])} < 0", "")
+                 f"theta3 <= theta3_min and {rate(flows['theta3'])} < 0", "",
+                 "theta3 := theta3_min")
         # 6. l3: -1 -> 0. Decision D1: when the motor reverses and the vertical-orientation
         #    coupling theta3 = -(theta1 + theta2) of phases 1 and 2 lifts theta3 off its limit,
         #    i.e. theta1 + theta2 <= -theta3_min. (The report's "theta3 + u > theta3_min" holds at
@@ -176,6 +211,10 @@ automaton finger {
   var theta2 [deg] in [theta2_min, theta2_max];
   var theta3 [deg] in [theta3_min, theta3_max];
   var g [count] in [0, 255];
+  # theta3 and g when link 2 was last blocked (set by the transition that blocks it): where the
+  # phase-3 law of theta3 starts (decision C1).
+  var theta3_s [deg] in [theta3_min, theta3_max];
+  var g_s [count] in [0, 255];
   discrete c1, c2, c3, l1, l2, l3;
   input u [count/s] in [-1, 1];""")
     invariant = ("theta1 >= theta1_min and theta1 <= theta1_max and theta2 >= theta2_min and "
@@ -190,19 +229,20 @@ automaton finger {
         for var in ("theta1", "theta2", "theta3", "g"):
             if var in FLOWS[p]:
                 rhs = FLOWS[p][var]
-                # m3(g) = theta3_min + (theta3_max - theta3_min) / (255 - g), section 3.
-                rhs = rate(rhs)
+                rhs = rate(rhs)  # phase 3: section 4's law (C1)
                 print(f"    {var}' = {rhs};")
         print(f"    inv {invariant};")
         print("  }")
-    for tname, s, t, guard, label in transitions(all_states):
+    for tname, s, t, guard, label, resets in transitions(all_states):
         print(f"\n  transition {tname}: {name(s)} -> {name(t)} {{")
         print(f"    guard {guard};")
+        if resets:
+            print(f"    reset {resets};")
         if label:
             print(f"    label {label};")
         print("  }")
     print("""
-  init c000_l000 { theta1 = 0; theta2 = 0; theta3 = 0; g = 0; }
+  init c000_l000 { theta1 = 0; theta2 = 0; theta3 = 0; g = 0; theta3_s = 0; g_s = 0; }
 
   # Close at full speed for 255 s (the finger stops against the palm at g = 240), hold, then open
   # at full speed back to g = 0 (the controller's position request: close, hold, open).

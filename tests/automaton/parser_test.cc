@@ -451,7 +451,7 @@ TEST(Parser, FingerModel) {
   EXPECT_EQ(a.name(), "finger");
   EXPECT_EQ(s.components()[0].instance, "");
   EXPECT_EQ(a.num_modes(), 31);
-  EXPECT_EQ(a.variables().size(), 4u);
+  EXPECT_EQ(a.variables().size(), 6u);  // theta1..3, g, theta3_s, g_s
   EXPECT_EQ(a.discrete_variables().size(), 6u);
   EXPECT_EQ(a.inputs().size(), 1u);
   EXPECT_EQ(a.parameters().size(), 11u);

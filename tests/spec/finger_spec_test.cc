@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -52,7 +53,7 @@ TEST(FingerSpecTest, CommittedFileIsTheGeneratorOutput) {
 TEST(FingerSpecTest, SizeAndReachability) {
   const Automaton a = Finger();
   EXPECT_EQ(a.num_modes(), 31);
-  EXPECT_EQ(a.num_transitions(), 94);
+  EXPECT_EQ(a.num_transitions(), 100);
   const ModeGraph graph(a);
   EXPECT_EQ(graph.ReachableModes().size(), 31u);
   EXPECT_TRUE(graph.Warnings().empty());
@@ -122,25 +123,58 @@ TEST(FingerSpecTest, LimitTransitionsSetTheirLimitFlag) {
   EXPECT_GT(count, 0);
 }
 
-// Report clash, pinned: section 3's m3(g) is not the rate of section 4's theta3 law.
-// Section 4: theta3(g) = theta3_min + c (g - g_s) / (255 - g) after link 2 stops at g_s, so
-// d theta3/dg = c (255 - g_s) / (255 - g)^2. Section 3: m3(g) = theta3_min + c / (255 - g).
-TEST(FingerSpecTest, Section3ThetaRateDisagreesWithSection4) {
+// Clash C1, pinned: section 3's m3(g) is not the rate of section 4's theta3 law, and the model
+// follows section 4. Section 4: theta3(g) = theta3_min + c (g - g_s) / (255 - g) after link 2
+// stops at g_s (c = theta3_max - theta3_min), so d theta3/dg = c (255 - g_s) / (255 - g)^2.
+// Section 3: m3(g) = theta3_min + c / (255 - g), negative below g = 253.2, which would drive
+// theta3 below its lower limit. The model's phase-3 flow, from (theta3_s, g_s) =
+// (theta3_min, 240), is section 4's rate.
+TEST(FingerSpecTest, Clash_Section3ThetaRate_ModelFollowsSection4) {
   const Automaton a = Finger();
   const auto flow = a.mode(*a.FindMode("c000_l110")).FlowOf(Slot(a, "theta3"));
   ASSERT_TRUE(flow.has_value());
   std::vector<double> env = a.ParameterEnvironment();
   env[Slot(a, "u")] = 1.0;
-  const double c = Param(a, "theta3_max") - Param(a, "theta3_min");
-  const double g_s = 240.0;  // free space: link 2 reaches its limit at g = 240
+  const double th3_min = Param(a, "theta3_min");
+  const double c = Param(a, "theta3_max") - th3_min;
+  const double g_s = 240.0;
+  env[Slot(a, "theta3_s")] = th3_min;
+  env[Slot(a, "g_s")] = g_s;
   for (double g : {240.0, 245.0, 250.0}) {
     env[Slot(a, "g")] = g;
-    const double section3 = flow->Evaluate(env);
+    const double model = flow->Evaluate(env);
+    const double section3 = th3_min + c / (255 - g);
     const double section4 = c * (255 - g_s) / ((255 - g) * (255 - g));
     EXPECT_LT(section3, 0.0) << "section 3's m3 drives theta3 below its lower limit at g = " << g;
-    EXPECT_GT(section4, 0.0);
     EXPECT_GT(std::abs(section3 - section4), 1.0) << "g = " << g;
+    EXPECT_NEAR(model, section4, 1e-12) << "g = " << g;
   }
+}
+
+// Every transition that blocks link 2 (contact 2 or its limit) records theta3_s and g_s, where
+// the phase-3 law starts; every transition that releases it tests theta3 == theta3_s.
+TEST(FingerSpecTest, Link2BlockRecordsThePhase3Start) {
+  const Automaton a = Finger();
+  const int c2 = Slot(a, "c2"), l2 = Slot(a, "l2");
+  int blocks = 0, releases = 0;
+  for (const Transition& t : a.transitions()) {
+    const Mode& from = a.mode(t.source);
+    const Mode& to = a.mode(t.target);
+    const bool before = *from.DiscreteValueOf(c2) || *from.DiscreteValueOf(l2);
+    const bool after = *to.DiscreteValueOf(c2) || *to.DiscreteValueOf(l2);
+    if (!before && after) {
+      ++blocks;
+      std::set<std::string> reset;
+      for (const auto& [slot, e] : t.resets) reset.insert(a.symbols()[slot].name);
+      EXPECT_TRUE(reset.count("theta3_s") && reset.count("g_s")) << t.name;
+    }
+    if (before && !after) {
+      ++releases;
+      EXPECT_NE(t.guard.ToString().find("theta3 == theta3_s"), std::string::npos) << t.name;
+    }
+  }
+  EXPECT_EQ(blocks, 10);  // contact 2 from phases 1, 1', 2, 2' (6 modes), limit 2 from 2, 2' (4)
+  EXPECT_GT(releases, 0);
 }
 
 }  // namespace

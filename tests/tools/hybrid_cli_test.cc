@@ -91,7 +91,7 @@ TEST(HybridCli, InfoJsonOfTheFinger) {
   EXPECT_EQ(c["modes"].size(), 31u);
   EXPECT_EQ(c["reachable_modes"].size(), 31u);
   EXPECT_TRUE(c["unreachable_modes"].empty());
-  EXPECT_EQ(c["variables"].size(), 4u);
+  EXPECT_EQ(c["variables"].size(), 6u);
   EXPECT_EQ(c["variables"][0]["name"], "theta1");
   EXPECT_EQ(c["variables"][0]["unit"], "deg");
   EXPECT_EQ(c["variables"][0]["domain"], nlohmann::json::array({0.0, 70.0}));

@@ -1,0 +1,219 @@
+#include "gripper/finger_closed_form.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hybrid::gripper {
+namespace {
+
+bool IsPalm(const std::array<int, 3>& c, const std::array<int, 3>& l) {
+  return l[0] == 1 && l[1] == 1 && l[2] == -1 && c[0] == 0 && c[1] == 0 && c[2] == 0;
+}
+
+// The phase of a discrete state, as tools/generate_finger.py assigns it.
+FingerPhase PhaseOf(const std::array<int, 3>& c, const std::array<int, 3>& l) {
+  if (c[2] == 1 || l[2] == 1 || IsPalm(c, l)) return FingerPhase::k4;
+  if (c[1] == 1 || l[1] == 1) return FingerPhase::k3;
+  if (c[0] == 1 || l[0] == 1) return l[2] == -1 ? FingerPhase::k2Prime : FingerPhase::k2;
+  return l[2] == -1 ? FingerPhase::k1Prime : FingerPhase::k1;
+}
+
+// Links whose position in space changes in a phase (only these can newly touch an object).
+bool Moves(FingerPhase phase, int link) {
+  switch (phase) {
+    case FingerPhase::k1:
+    case FingerPhase::k1Prime:
+      return true;
+    case FingerPhase::k2:
+    case FingerPhase::k2Prime:
+      return link >= 1;
+    case FingerPhase::k3:
+      return link == 2;
+    case FingerPhase::k4:
+      return false;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string PhaseName(FingerPhase phase) {
+  switch (phase) {
+    case FingerPhase::k1:
+      return "1";
+    case FingerPhase::k1Prime:
+      return "1'";
+    case FingerPhase::k2:
+      return "2";
+    case FingerPhase::k2Prime:
+      return "2'";
+    case FingerPhase::k3:
+      return "3";
+    case FingerPhase::k4:
+      return "4";
+  }
+  return "?";
+}
+
+FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
+                                   const FingerParameters& parameters)
+    : parameters_(parameters), contacts_(contacts) {
+  const FingerParameters& p = parameters_;
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(contacts.gob[i]) || contacts.gob[i] < 0.0) {
+      throw std::invalid_argument("FingerClosedForm: contact position of link " +
+                                  std::to_string(i + 1) + " must be >= 0 (got " +
+                                  std::to_string(contacts.gob[i]) + ")");
+    }
+    if (!(p.theta_min[i] < p.theta_max[i]) || !std::isfinite(p.theta_min[i]) ||
+        !std::isfinite(p.theta_max[i])) {
+      throw std::invalid_argument("FingerClosedForm: empty range for joint " +
+                                  std::to_string(i + 1));
+    }
+  }
+  if (p.theta_min[0] != 0.0 || p.theta_min[1] != 0.0 || p.theta_min[2] > 0.0 ||
+      p.theta_max[2] < 0.0 || !(p.m1() > 0.0) || !(p.m2() > 0.0) || !(p.motor_max > 0.0) ||
+      !std::isfinite(p.motor_max)) {
+    throw std::invalid_argument(
+        "FingerClosedForm: parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
+        "theta2_max, theta3_min <= 0 <= theta3_max and a positive finite motor range");
+  }
+  const double kNone = FingerContacts::kNone;
+  std::array<double, 3> gob;
+  for (int i = 0; i < 3; ++i) {
+    gob[i] = contacts.gob[i] > p.motor_max ? kNone : contacts.gob[i];
+  }
+
+  double g = 0.0;
+  Eigen::Vector3d theta = Eigen::Vector3d::Zero();
+  std::array<int, 3> c = {0, 0, 0}, l = {0, 0, 0};
+  // At most one flag changes per event and flags only get set while closing, so a handful of
+  // iterations suffices; the bound guards against a logic error.
+  for (int iteration = 0; iteration < 32; ++iteration) {
+    Piece piece;
+    piece.g0 = g;
+    piece.theta0 = theta;
+    piece.c = c;
+    piece.l = l;
+    piece.phase = PhaseOf(c, l);
+    if (piece.phase == FingerPhase::k4) {
+      stop_ = g;
+      piece.g1 = p.motor_max;
+      pieces_.push_back(piece);
+      return;
+    }
+    switch (piece.phase) {
+      case FingerPhase::k1:
+        piece.rate = {p.m1(), 0.0, -p.m1()};
+        break;
+      case FingerPhase::k1Prime:
+        piece.rate = {p.m1(), 0.0, 0.0};
+        break;
+      case FingerPhase::k2:
+        piece.rate = {0.0, p.m2(), -p.m2()};
+        break;
+      case FingerPhase::k2Prime:
+        piece.rate = {0.0, p.m2(), 0.0};
+        break;
+      default:
+        break;  // phase 3: theta3 follows the rational law; no linear rate
+    }
+    // Candidate events in the simulator's priority order: for each link, contact then limit;
+    // then theta3 reaching its lower limit (phases 1 and 2).
+    enum Kind { kContact, kLimit, kLower, kEndOfTravel };
+    struct Event {
+      double at;
+      Kind kind;
+      int link;
+    };
+    std::vector<Event> events;
+    for (int i = 0; i < 3; ++i) {
+      if (c[i] == 0 && l[i] != 1 && Moves(piece.phase, i) && gob[i] != kNone) {
+        events.push_back({std::max(gob[i], g), kContact, i});
+      }
+      if (c[i] == 0 && l[i] == 0) {
+        if (piece.phase == FingerPhase::k3 && i == 2) {
+          if (theta[2] >= p.theta_max[2]) {
+            events.push_back({g, kLimit, 2});
+          } else if (g < p.motor_max) {
+            events.push_back({0.5 * (p.motor_max + g), kLimit, 2});
+          }
+        } else if (piece.rate[i] > 0.0) {
+          events.push_back({g + std::max(0.0, p.theta_max[i] - theta[i]) / piece.rate[i], kLimit, i});
+        }
+      }
+    }
+    if ((piece.phase == FingerPhase::k1 || piece.phase == FingerPhase::k2) && l[2] == 0) {
+      events.push_back({g + std::max(0.0, theta[2] - p.theta_min[2]) / -piece.rate[2], kLower, 2});
+    }
+    events.push_back({p.motor_max, kEndOfTravel, -1});
+    double end = p.motor_max;
+    for (const Event& e : events) end = std::min(end, e.at);
+    piece.g1 = end;
+    if (end > g || pieces_.empty()) pieces_.push_back(piece);
+    theta = Evaluate(piece, end);
+    g = end;
+    const Event* first = nullptr;
+    for (const Event& e : events) {
+      if (e.at <= end) {
+        first = &e;
+        break;
+      }
+    }
+    switch (first->kind) {
+      case kEndOfTravel:
+        return;  // still moving at the end of the motor range
+      case kContact:
+        c[first->link] = 1;
+        break;
+      case kLimit:
+        l[first->link] = 1;
+        theta[first->link] = p.theta_max[first->link];
+        break;
+      case kLower:
+        l[2] = -1;
+        theta[2] = p.theta_min[2];
+        break;
+    }
+    // Blocking link 2 leaves phases 1' and 2' for phase 3 (l3 = 0), except against the palm.
+    if ((c[1] == 1 || l[1] == 1) && l[2] == -1 && c[2] == 0 && !IsPalm(c, l)) l[2] = 0;
+  }
+  throw std::logic_error("FingerClosedForm: too many events");
+}
+
+Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
+  if (piece.phase != FingerPhase::k3) return piece.theta0 + piece.rate * (g - piece.g0);
+  Eigen::Vector3d theta = piece.theta0;
+  const double rest = parameters_.motor_max - g;
+  const double moved = g - piece.g0;
+  // (g - g_s) / (255 - g), which reaches 1 half way between g_s and 255; clamped there.
+  const double fraction = moved <= 0.0 ? 0.0 : (moved >= rest ? 1.0 : moved / rest);
+  theta[2] = piece.theta0[2] + (parameters_.theta_max[2] - piece.theta0[2]) * fraction;
+  return theta;
+}
+
+FingerConfiguration FingerClosedForm::At(double g) const {
+  if (!(g >= 0.0 && g <= parameters_.motor_max)) {
+    throw std::out_of_range("FingerClosedForm::At: g = " + std::to_string(g) +
+                            " is outside the motor range [0, " +
+                            std::to_string(parameters_.motor_max) + "]");
+  }
+  const Piece* piece = &pieces_.back();
+  for (const Piece& candidate : pieces_) {
+    if (g <= candidate.g1) {
+      piece = &candidate;
+      break;
+    }
+  }
+  FingerConfiguration out;
+  out.theta = Evaluate(*piece, std::min(g, piece->g1));
+  out.motor = std::min(g, stop_);
+  out.c = piece->c;
+  out.l = piece->l;
+  out.phase = piece->phase;
+  return out;
+}
+
+}  // namespace hybrid::gripper

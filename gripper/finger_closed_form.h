@@ -1,0 +1,105 @@
+#pragma once
+
+#include <array>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gripper/finger_parameters.h"
+
+namespace hybrid::gripper {
+
+/// Motor positions (counts) at which links 1, 2 and 3 are blocked by an object while the finger
+/// closes: the report's g_ob (section 4.2). A value above the motor range (the default, +inf, or
+/// the model's 256) means the link is never blocked by an object.
+struct FingerContacts {
+  static constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::array<double, 3> gob = {kNone, kNone, kNone};
+};
+
+/// The report's movement phases (section 3). k4 is the stopped finger: link 3 blocked by an
+/// object or at its upper limit, or the fully closed free finger against the palm (decision D3).
+enum class FingerPhase { k1, k1Prime, k2, k2Prime, k3, k4 };
+
+/// "1", "1'", "2", "2'", "3" or "4".
+std::string PhaseName(FingerPhase phase);
+
+/// The quasistatic state of a finger at a commanded motor position.
+struct FingerConfiguration {
+  /// Joint angles (theta1, theta2, theta3) in degrees; theta3 relative to link 2.
+  Eigen::Vector3d theta = Eigen::Vector3d::Zero();
+  /// Where the motor is: the commanded g, or the position where the finger stopped (phase 4),
+  /// whichever is smaller.
+  double motor = 0.0;
+  /// The discrete state (c1, c2, c3) and (l1, l2, l3); l3 = -1 at the lower limit of link 3.
+  std::array<int, 3> c = {0, 0, 0};
+  std::array<int, 3> l = {0, 0, 0};
+  FingerPhase phase = FingerPhase::k1;
+};
+
+/// The closed-form (quasistatic) model of one finger closing from g = 0: the tables of section 4
+/// of the report with the decisions of docs/finger_model.md, assembled at their breakpoints.
+///
+/// The configuration is a continuous, piecewise function of g with at most eight pieces:
+/// - phase 1 (0 <= g, link 3 vertical): theta1 = m1 g, theta3 = -m1 g; phase 1' once theta3 is
+///   at its minimum (theta3 = theta3_min);
+/// - phase 2 from g1, where link 1 stopped (object at gob1 or its limit at 140):
+///   theta2 = m2 (g - g1), theta3 = max(-(theta1 + theta2), theta3_min) (2 and 2');
+/// - phase 3 from g_s, where link 2 stopped (object at gob2, or its limit):
+///   theta3 = theta3_s + (theta3_max - theta3_s) (g - g_s) / (255 - g) (decision C1: section 4's
+///   law continued from theta3_s, theta3's value at g_s, so theta3 is continuous; the report's
+///   tables have theta3_s = theta3_min). It reaches theta3_max at g = (255 + g_s) / 2;
+/// - phase 4 (stopped) from the first of: link 3 blocked by an object (gob3), theta3 reaching
+///   theta3_max, or the free finger fully closed against the palm at g = 240 (D3). Beyond that
+///   the configuration no longer changes and `motor` stays at the stopping position.
+///
+/// Events at the same g are taken in the model's declaration order (contact before limit, link 1
+/// before 2 before 3), as the simulator does. Every value is finite for every g in [0, 255],
+/// including g = 255 (the report's law divides by 255 - g; the pieces end before that except
+/// when g_s = 255, where theta3 stays at theta3_s).
+class FingerClosedForm {
+ public:
+  /// Throws std::invalid_argument ("FingerClosedForm: ...") if a contact position is negative or
+  /// NaN, or the parameters are inconsistent (empty joint range, m1 or m2 not positive,
+  /// theta3_min > 0 or theta3_max < 0, the open straight finger outside the joint ranges).
+  explicit FingerClosedForm(const FingerContacts& contacts = {},
+                            const FingerParameters& parameters = {});
+
+  /// The configuration at commanded motor position g. Precondition: 0 <= g <= motor_max; throws
+  /// std::out_of_range ("FingerClosedForm::At: ...") otherwise (NaN included). Breakpoints
+  /// belong to the piece that ends there, as in the report's tables (g = 110 is phase 1).
+  FingerConfiguration At(double g) const;
+
+  /// The motor position where the finger stops (phase 4), or nullopt-like +inf when it is still
+  /// moving at motor_max.
+  double stop() const { return stop_; }
+
+  /// One piece of the path: on (g0, g1] (the first on [g0, g1]) theta = theta0 + rate (g - g0),
+  /// except theta3 in phase 3, which follows the law above from (g_s, theta3_s) = (g0,
+  /// theta0[2]).
+  struct Piece {
+    double g0 = 0.0;
+    double g1 = 0.0;
+    Eigen::Vector3d theta0 = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rate = Eigen::Vector3d::Zero();
+    std::array<int, 3> c = {0, 0, 0};
+    std::array<int, 3> l = {0, 0, 0};
+    FingerPhase phase = FingerPhase::k1;
+  };
+  std::span<const Piece> pieces() const { return pieces_; }
+  const FingerParameters& parameters() const { return parameters_; }
+  const FingerContacts& contacts() const { return contacts_; }
+
+ private:
+  Eigen::Vector3d Evaluate(const Piece& piece, double g) const;
+
+  FingerParameters parameters_;
+  FingerContacts contacts_;
+  std::vector<Piece> pieces_;
+  double stop_ = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace hybrid::gripper
