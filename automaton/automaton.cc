@@ -209,6 +209,16 @@ TransitionId Automaton::AddTransition(Transition t) {
   return TransitionId(num_transitions() - 1);
 }
 
+void Automaton::SetGuard(TransitionId id, Constraint guard) {
+  constexpr std::string_view kApi = "Automaton::SetGuard";
+  if (!id.is_valid() || id.value() >= num_transitions()) Fail(kApi, "unknown transition");
+  Transition& t = transitions_[id.value()];
+  for (const Comparison& c : guard.comparisons) {
+    CheckSlots(c.Residual(), std::string(kApi) + ": guard of '" + t.name + "'", true, true);
+  }
+  t.guard = std::move(guard);
+}
+
 void Automaton::AddInitialState(InitialState state) {
   constexpr std::string_view kApi = "Automaton::AddInitialState";
   if (!state.mode.is_valid() || state.mode.value() >= num_modes()) Fail(kApi, "unknown mode");

@@ -87,6 +87,10 @@ class Automaton {
   ModeId AddMode(Mode mode);
   /// Source and target must exist; resets must assign continuous variables; the name must be new.
   TransitionId AddTransition(Transition transition);
+  /// Replaces the guard of transition `id` (a model transformation, e.g. contact guards computed
+  /// from geometry). Throws std::invalid_argument ("Automaton::SetGuard: ...") for an unknown
+  /// transition or a guard reading undeclared slots.
+  void SetGuard(TransitionId id, Constraint guard);
   /// Every continuous variable must get exactly one value; bounds read parameters only.
   void AddInitialState(InitialState state);
   /// Comparisons may read variables, discrete variables and parameters, not inputs; `in` atoms

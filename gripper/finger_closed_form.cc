@@ -141,7 +141,8 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
             events.push_back({0.5 * (p.motor_max + g), kLimit, 2});
           }
         } else if (piece.rate[i] > 0.0) {
-          events.push_back({g + std::max(0.0, p.theta_max[i] - theta[i]) / piece.rate[i], kLimit, i});
+          events.push_back(
+              {g + std::max(0.0, p.theta_max[i] - theta[i]) / piece.rate[i], kLimit, i});
         }
       }
     }

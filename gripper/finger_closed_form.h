@@ -1,12 +1,11 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <limits>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "gripper/finger_parameters.h"
 

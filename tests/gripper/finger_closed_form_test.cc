@@ -75,8 +75,8 @@ TEST(FingerClosedFormTest, FreeSpaceBetweenIntegers) {
 TEST(FingerClosedFormTest, ContactOnLink1FollowsTheTable) {
   for (double gob : {0.0, 30.0, 70.0, 110.0, 123.4, 140.0}) {
     const FingerClosedForm f(Contacts(gob, FingerContacts::kNone, FingerContacts::kNone));
-    const double g_s = gob + 100;                 // link 2 reaches its limit
-    const double g_stop = (255 + g_s) / 2;        // theta3 reaches its limit half way to 255
+    const double g_s = gob + 100;           // link 2 reaches its limit
+    const double g_stop = (255 + g_s) / 2;  // theta3 reaches its limit half way to 255
     for (double g = gob + 0.25; g <= 255; g += 0.25) {
       const FingerConfiguration q = f.At(g);
       const double th1 = kM1 * gob;
@@ -202,9 +202,9 @@ System FingerWithContacts(const FingerContacts& contacts) {
 
 double Contact() {
   // No object, or an object anywhere along the motor range.
-  return *rc::gen::oneOf(rc::gen::just(FingerContacts::kNone),
-                         rc::gen::map(rc::gen::inRange(0, 2550001),
-                                      [](int k) { return k / 10000.0; }));
+  return *rc::gen::oneOf(
+      rc::gen::just(FingerContacts::kNone),
+      rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 10000.0; }));
 }
 
 // Close at u = 1 to g = 255 and open at u = -1 until the motor is back at 0 (the controller
@@ -254,10 +254,9 @@ RC_GTEST_PROP(FingerClosedFormProperty, SimulationEqualsClosedForm, ()) {
     for (int k = 0; k < 3; ++k) {
       const double error = std::abs(s.x[std::array{th1, th2, th3}[k]] - q.theta[k]);
       if (error > worst && error > 1e-6) {
-        RC_LOG() << "t = " << s.time << " g = " << motor << " mode "
-                 << sim.ModeName(0, s.modes[0]) << ": theta" << k + 1 << " = "
-                 << s.x[std::array{th1, th2, th3}[k]] << ", closed form " << q.theta[k] << " ("
-                 << StateName(q) << ")\n";
+        RC_LOG() << "t = " << s.time << " g = " << motor << " mode " << sim.ModeName(0, s.modes[0])
+                 << ": theta" << k + 1 << " = " << s.x[std::array{th1, th2, th3}[k]]
+                 << ", closed form " << q.theta[k] << " (" << StateName(q) << ")\n";
       }
       worst = std::max(worst, error);
     }

@@ -1,0 +1,45 @@
+#include "gripper/finger_geometry.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace hybrid::gripper {
+
+FingerGeometry::FingerGeometry(const FingerLengths& lengths) : lengths_(lengths) {
+  for (double l : {lengths.proximal, lengths.medial, lengths.distal}) {
+    if (!(l > 0.0) || !std::isfinite(l)) {
+      throw std::invalid_argument("FingerGeometry: link lengths must be positive and finite");
+    }
+  }
+  palm_y_ = Points(Eigen::Vector3d(70.0, 90.0, -55.0))[3].y();
+}
+
+std::array<Eigen::Vector2d, 4> FingerGeometry::Points(const Eigen::Vector3d& theta) const {
+  constexpr double kRad = std::numbers::pi / 180.0;
+  const double phi1 = theta[0] * kRad;
+  const double phi2 = phi1 + theta[1] * kRad;
+  const double phi3 = phi2 + theta[2] * kRad;
+  std::array<Eigen::Vector2d, 4> p;
+  p[0] = Eigen::Vector2d::Zero();
+  p[1] = p[0] + lengths_.proximal * Eigen::Vector2d(std::sin(phi1), std::cos(phi1));
+  p[2] = p[1] + lengths_.medial * Eigen::Vector2d(std::sin(phi2), std::cos(phi2));
+  p[3] = p[2] + lengths_.distal * Eigen::Vector2d(std::sin(phi3), std::cos(phi3));
+  return p;
+}
+
+std::array<Segment2, 3> FingerGeometry::Links(const Eigen::Vector3d& theta) const {
+  const auto p = Points(theta);
+  return {Segment2{p[0], p[1]}, Segment2{p[1], p[2]}, Segment2{p[2], p[3]}};
+}
+
+std::array<Segment2, 3> FingerGeometry::ContactSegments(const Eigen::Vector3d& theta) const {
+  auto links = Links(theta);
+  for (int k = 1; k < 3; ++k) {
+    const Eigen::Vector2d d = links[k].b - links[k].a;
+    links[k].a += kJointMargin / d.norm() * d;
+  }
+  return links;
+}
+
+}  // namespace hybrid::gripper

@@ -1,0 +1,60 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+
+namespace hybrid::gripper {
+
+/// A straight segment [a, b] in the finger plane (metres).
+struct Segment2 {
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+};
+
+/// Link lengths of the planar finger (metres), from `../shared/robotiq/kinematics.md`: proximal
+/// (joint 1 to joint 2), medial (joint 2 to joint 3) and distal (joint 3 to the fingertip).
+struct FingerLengths {
+  double proximal = 0.05715;
+  double medial = 0.03894;
+  double distal = 0.038;
+};
+
+/// Planar forward kinematics of one finger in its own frame.
+///
+/// Frame: origin at joint 1; +y along the open finger (away from the palm), +x the closing
+/// direction (towards the opposite finger). Joint angles are the report's relative angles in
+/// degrees; link k points along the absolute angle phi_k = theta1 + ... + thetak, measured from
+/// +y towards +x: link k's direction is (sin phi_k, cos phi_k). So the open finger (all 0) is
+/// straight up, and in phase 1 (theta3 = -theta1) link 3 stays vertical, as the report says.
+///
+/// The palm surface is the line y = palm_y() (below joint 1): decision G1 of
+/// docs/finger_model.md places it where the fingertip is at the report's self-collision
+/// configuration (theta1_max, theta2_max, theta3_min) = (70, 90, -55): y = -0.0269 m with the
+/// default lengths.
+class FingerGeometry {
+ public:
+  /// Throws std::invalid_argument ("FingerGeometry: ...") unless all lengths are positive and
+  /// finite.
+  explicit FingerGeometry(const FingerLengths& lengths = {});
+
+  /// Joint 1, joint 2, joint 3 and the fingertip for joint angles `theta` (degrees).
+  std::array<Eigen::Vector2d, 4> Points(const Eigen::Vector3d& theta) const;
+  /// Links 1, 2 and 3 as segments between consecutive Points.
+  std::array<Segment2, 3> Links(const Eigen::Vector3d& theta) const;
+  /// The parts of the links that make contact (decision G2): link 1 whole; links 2 and 3 from
+  /// kJointMargin after their joint. A joint belongs to the link it ends: an object touching
+  /// the knuckle at joint 3 blocks link 2, and link 3, rotating about that joint, is blocked
+  /// only when its own body reaches the object. (With whole links, link 3 would touch the
+  /// object at the knuckle for a whole interval of g: a contact with no crossing.)
+  std::array<Segment2, 3> ContactSegments(const Eigen::Vector3d& theta) const;
+  static constexpr double kJointMargin = 0.002;
+  /// Height of the palm surface (negative: below joint 1).
+  double palm_y() const { return palm_y_; }
+  const FingerLengths& lengths() const { return lengths_; }
+
+ private:
+  FingerLengths lengths_;
+  double palm_y_;
+};
+
+}  // namespace hybrid::gripper

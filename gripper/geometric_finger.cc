@@ -1,0 +1,175 @@
+#include "gripper/geometric_finger.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace hybrid::gripper {
+
+GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeometry& geometry,
+                                 const FingerParameters& parameters)
+    : objects_(std::move(objects)),
+      geometry_(geometry),
+      parameters_(parameters),
+      closed_form_(FingerContacts{}, parameters) {
+  const Obstacle palm_bar = palm();
+  const auto open_links = geometry_.ContactSegments(Eigen::Vector3d::Zero());
+  for (size_t k = 0; k < objects_.size(); ++k) {
+    const Obstacle& o = objects_[k];
+    const double lowest = std::min(o.a().y(), o.b().y()) - o.radius();
+    if (lowest < geometry_.palm_y()) {
+      throw std::invalid_argument(
+          "GeometricFinger: object " + o.ToString() +
+          " overlaps the palm (its lowest point y = " + FormatNumber(lowest) +
+          " is below the palm surface y = " + FormatNumber(geometry_.palm_y()) + ")");
+    }
+    for (int i = 0; i < 3; ++i) {
+      if (o.Distance(open_links[i]) <= 0.0) {
+        throw std::invalid_argument("GeometricFinger: object " + o.ToString() + " overlaps link " +
+                                    std::to_string(i + 1) + " of the open finger (g = 0)");
+      }
+    }
+  }
+  // Signed distance of link i to obstacle k (kPalm for the palm) at motor position g of `cf`.
+  auto distance = [&](const FingerClosedForm& cf, double g, int i, int k) {
+    const auto links = geometry_.ContactSegments(cf.At(g).theta);
+    return (k == kPalm ? palm_bar : objects_[k]).Distance(links[i]);
+  };
+  FingerContacts contacts;
+  double g = 0.0;
+  for (int round = 0; round < 3; ++round) {
+    const FingerClosedForm cf(contacts, parameters_);
+    const double end = std::min(cf.stop(), parameters_.motor_max);
+    // Sample points: a regular grid plus every breakpoint, in [g, end].
+    std::vector<double> grid;
+    for (double s = g; s < end; s += kResolution) grid.push_back(s);
+    for (const auto& piece : cf.pieces()) {
+      for (double b : {piece.g0, piece.g1}) {
+        if (b > g && b < end) grid.push_back(b);
+      }
+    }
+    grid.push_back(end);
+    std::sort(grid.begin(), grid.end());
+    struct Hit {
+      double g;
+      int link;
+      int obstacle;
+    };
+    std::optional<Hit> first;
+    for (size_t s = 1; s < grid.size() && !first; ++s) {
+      for (int i = 0; i < 3; ++i) {
+        if (contacts.gob[i] != FingerContacts::kNone) continue;
+        for (int k = kPalm; k < static_cast<int>(objects_.size()); ++k) {
+          const double d_hi = distance(cf, grid[s], i, k);
+          if (d_hi > 0.0) continue;
+          double lo = grid[s - 1], hi = grid[s];
+          const double d_lo = distance(cf, lo, i, k);
+          if (d_lo <= 0.0) {
+            // Touching already where the previous contact stopped the finger (e.g. at the joint
+            // shared with the blocked link): a contact if the link moves further in.
+            if (d_hi < d_lo && (!first || lo < first->g)) first = Hit{lo, i, k};
+            continue;
+          }
+          while (hi - lo > 1e-10) {
+            const double mid = 0.5 * (lo + hi);
+            (distance(cf, mid, i, k) <= 0.0 ? hi : lo) = mid;
+          }
+          if (!first || hi < first->g) first = Hit{hi, i, k};
+        }
+      }
+    }
+    if (!first) break;
+    // The palm touches the fingertip at the free-space stop by construction (G1): not a contact.
+    if (first->obstacle == kPalm && first->g >= cf.stop() - 1e-7) break;
+    contacts.gob[first->link] = first->g;
+    blocked_by_[first->link] = first->obstacle;
+    g = first->g;
+  }
+  closed_form_ = FingerClosedForm(contacts, parameters_);
+}
+
+bool GeometricFinger::touches_object() const {
+  return std::any_of(blocked_by_.begin(), blocked_by_.end(),
+                     [](const std::optional<int>& k) { return k && *k != kPalm; });
+}
+
+Obstacle GeometricFinger::palm() const {
+  constexpr double kThickness = 0.05;
+  const double y = geometry_.palm_y() - kThickness;
+  return Obstacle::Bar({-0.15, y}, {0.15, y}, kThickness);
+}
+
+Automaton GeometricFinger::ContactAutomaton(const Automaton& finger) const {
+  std::vector<Obstacle> all = objects_;
+  all.push_back(palm());
+  return WithGeometricContacts(finger, all, geometry_);
+}
+
+double GeometricFinger::Clearance(const Eigen::Vector3d& theta, int link) const {
+  const Segment2 s = geometry_.ContactSegments(theta)[link];
+  double d = palm().Distance(s);
+  for (const Obstacle& o : objects_) d = std::min(d, o.Distance(s));
+  return d;
+}
+
+Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obstacle>& obstacles,
+                                const FingerGeometry& geometry) {
+  constexpr std::string_view kApi = "WithGeometricContacts";
+  if (obstacles.empty()) throw std::invalid_argument(std::string(kApi) + ": no obstacles");
+  std::array<Expression, 3> theta;
+  for (int i = 0; i < 3; ++i) {
+    const std::string name = "theta" + std::to_string(i + 1);
+    const auto slot = finger.symbols().Find(name);
+    if (!slot) throw std::invalid_argument(std::string(kApi) + ": no variable " + name);
+    theta[i] = Expression::Symbol(name, *slot);
+  }
+  using E = Expression;
+  const E to_rad = E::Constant(std::numbers::pi / 180.0);
+  const E phi1 = theta[0] * to_rad;
+  const E phi2 = (theta[0] + theta[1]) * to_rad;
+  const E phi3 = (theta[0] + theta[1] + theta[2]) * to_rad;
+  const FingerLengths& l = geometry.lengths();
+  std::array<E, 4> x, y;
+  x[0] = E::Constant(0.0), y[0] = E::Constant(0.0);
+  x[1] = E::Constant(l.proximal) * E::Unary(Op::kSin, phi1);
+  y[1] = E::Constant(l.proximal) * E::Unary(Op::kCos, phi1);
+  x[2] = x[1] + E::Constant(l.medial) * E::Unary(Op::kSin, phi2);
+  y[2] = y[1] + E::Constant(l.medial) * E::Unary(Op::kCos, phi2);
+  x[3] = x[2] + E::Constant(l.distal) * E::Unary(Op::kSin, phi3);
+  y[3] = y[2] + E::Constant(l.distal) * E::Unary(Op::kCos, phi3);
+  // Contact segments (FingerGeometry::ContactSegments): links 2 and 3 start kJointMargin after
+  // their joint.
+  const E margin = E::Constant(FingerGeometry::kJointMargin);
+  const std::array<E, 3> sx = {x[0], x[1] + margin * E::Unary(Op::kSin, phi2),
+                               x[2] + margin * E::Unary(Op::kSin, phi3)};
+  const std::array<E, 3> sy = {y[0], y[1] + margin * E::Unary(Op::kCos, phi2),
+                               y[2] + margin * E::Unary(Op::kCos, phi3)};
+  std::array<E, 3> distance;
+  for (int i = 0; i < 3; ++i) {
+    distance[i] = obstacles[0].DistanceExpression(sx[i], sy[i], x[i + 1], y[i + 1]);
+    for (size_t k = 1; k < obstacles.size(); ++k) {
+      distance[i] = E::Binary(Op::kMin, distance[i],
+                              obstacles[k].DistanceExpression(sx[i], sy[i], x[i + 1], y[i + 1]));
+    }
+  }
+  Automaton out = finger;
+  for (int t = 0; t < out.num_transitions(); ++t) {
+    const Transition& tr = out.transitions()[t];
+    if (tr.label.size() != 8 || tr.label.rfind("contact", 0) != 0) continue;
+    const int i = tr.label[7] - '1';
+    if (i < 0 || i > 2 || tr.guard.comparisons.empty() ||
+        tr.guard.comparisons[0].lhs.ToString() != "g" ||
+        tr.guard.comparisons[0].rhs.ToString() != "gob" + std::to_string(i + 1)) {
+      throw std::invalid_argument(std::string(kApi) + ": transition '" + tr.name +
+                                  "' is not a contact transition of spec/finger.ha");
+    }
+    Constraint guard = tr.guard;
+    guard.comparisons[0] = Comparison{distance[i], Relation::kLessEqual, E::Constant(0.0)};
+    out.SetGuard(TransitionId(t), std::move(guard));
+  }
+  return out;
+}
+
+}  // namespace hybrid::gripper
