@@ -6,7 +6,12 @@
 
 namespace hybrid::gripper {
 
-FingerGeometry::FingerGeometry(const FingerLengths& lengths) : lengths_(lengths) {
+FingerGeometry::FingerGeometry(const FingerLengths& lengths, const FingerPlacement& placement)
+    : lengths_(lengths), placement_(placement) {
+  if (!std::isfinite(placement.origin_x) || !std::isfinite(placement.x_scale) ||
+      placement.x_scale == 0.0) {
+    throw std::invalid_argument("FingerGeometry: placement must be finite with x_scale != 0");
+  }
   for (double l : {lengths.proximal, lengths.medial, lengths.distal}) {
     if (!(l > 0.0) || !std::isfinite(l)) {
       throw std::invalid_argument("FingerGeometry: link lengths must be positive and finite");
@@ -16,6 +21,12 @@ FingerGeometry::FingerGeometry(const FingerLengths& lengths) : lengths_(lengths)
 }
 
 std::array<Eigen::Vector2d, 4> FingerGeometry::Points(const Eigen::Vector3d& theta) const {
+  auto p = LocalPoints(theta);
+  for (auto& q : p) q = Place(q);
+  return p;
+}
+
+std::array<Eigen::Vector2d, 4> FingerGeometry::LocalPoints(const Eigen::Vector3d& theta) const {
   constexpr double kRad = std::numbers::pi / 180.0;
   const double phi1 = theta[0] * kRad;
   const double phi2 = phi1 + theta[1] * kRad;
@@ -34,10 +45,12 @@ std::array<Segment2, 3> FingerGeometry::Links(const Eigen::Vector3d& theta) cons
 }
 
 std::array<Segment2, 3> FingerGeometry::ContactSegments(const Eigen::Vector3d& theta) const {
-  auto links = Links(theta);
-  for (int k = 1; k < 3; ++k) {
-    const Eigen::Vector2d d = links[k].b - links[k].a;
-    links[k].a += kJointMargin / d.norm() * d;
+  const auto p = LocalPoints(theta);
+  std::array<Segment2, 3> links;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector2d a = p[k];
+    if (k > 0) a += kJointMargin / (p[k + 1] - p[k]).norm() * (p[k + 1] - p[k]);
+    links[k] = Segment2{Place(a), Place(p[k + 1])};
   }
   return links;
 }

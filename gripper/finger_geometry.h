@@ -19,7 +19,18 @@ struct FingerLengths {
   double distal = 0.038;
 };
 
-/// Planar forward kinematics of one finger in its own frame.
+/// Where a finger stands in the plane its objects are described in: a point at finger coordinates
+/// (x, y) is at (origin_x + x_scale * x, y). The identity (the default) is the finger's own frame.
+/// In the hand (gripper/hand.h) objects are described in the palm's x-y plane and extruded along
+/// z; a finger whose plane is turned by the spread angle phi about the vertical axis sees them
+/// through x_scale = -cos(phi) (facing -x): contact with an extruded object happens exactly when
+/// the link's projection onto the x-y plane touches the object's section.
+struct FingerPlacement {
+  double origin_x = 0.0;
+  double x_scale = 1.0;
+};
+
+/// Planar forward kinematics of one finger in its own frame (or placed, see FingerPlacement).
 ///
 /// Frame: origin at joint 1; +y along the open finger (away from the palm), +x the closing
 /// direction (towards the opposite finger). Joint angles are the report's relative angles in
@@ -34,10 +45,10 @@ struct FingerLengths {
 class FingerGeometry {
  public:
   /// Throws std::invalid_argument ("FingerGeometry: ...") unless all lengths are positive and
-  /// finite.
-  explicit FingerGeometry(const FingerLengths& lengths = {});
+  /// finite and the placement is finite with x_scale != 0.
+  explicit FingerGeometry(const FingerLengths& lengths = {}, const FingerPlacement& placement = {});
 
-  /// Joint 1, joint 2, joint 3 and the fingertip for joint angles `theta` (degrees).
+  /// Joint 1, joint 2, joint 3 and the fingertip for joint angles `theta` (degrees), placed.
   std::array<Eigen::Vector2d, 4> Points(const Eigen::Vector3d& theta) const;
   /// Links 1, 2 and 3 as segments between consecutive Points.
   std::array<Segment2, 3> Links(const Eigen::Vector3d& theta) const;
@@ -51,9 +62,15 @@ class FingerGeometry {
   /// Height of the palm surface (negative: below joint 1).
   double palm_y() const { return palm_y_; }
   const FingerLengths& lengths() const { return lengths_; }
+  const FingerPlacement& placement() const { return placement_; }
 
  private:
+  std::array<Eigen::Vector2d, 4> LocalPoints(const Eigen::Vector3d& theta) const;
+  Eigen::Vector2d Place(const Eigen::Vector2d& local) const {
+    return {placement_.origin_x + placement_.x_scale * local.x(), local.y()};
+  }
   FingerLengths lengths_;
+  FingerPlacement placement_;
   double palm_y_;
 };
 

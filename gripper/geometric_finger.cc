@@ -9,7 +9,7 @@
 namespace hybrid::gripper {
 
 GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeometry& geometry,
-                                 const FingerParameters& parameters)
+                                 const FingerParameters& parameters, const FingerContacts& imposed)
     : objects_(std::move(objects)),
       geometry_(geometry),
       parameters_(parameters),
@@ -80,6 +80,13 @@ GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeom
         }
       }
     }
+    for (int i = 0; i < 3; ++i) {
+      const double at = imposed.gob[i];
+      if (contacts.gob[i] == FingerContacts::kNone && at >= g && at <= end &&
+          (!first || at < first->g)) {
+        first = Hit{at, i, kImposed};
+      }
+    }
     if (!first) break;
     // The palm touches the fingertip at the free-space stop by construction (G1): not a contact.
     if (first->obstacle == kPalm && first->g >= cf.stop() - 1e-7) break;
@@ -142,8 +149,13 @@ Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obsta
   // Contact segments (FingerGeometry::ContactSegments): links 2 and 3 start kJointMargin after
   // their joint.
   const E margin = E::Constant(FingerGeometry::kJointMargin);
-  const std::array<E, 3> sx = {x[0], x[1] + margin * E::Unary(Op::kSin, phi2),
-                               x[2] + margin * E::Unary(Op::kSin, phi3)};
+  std::array<E, 3> sx = {x[0], x[1] + margin * E::Unary(Op::kSin, phi2),
+                         x[2] + margin * E::Unary(Op::kSin, phi3)};
+  // Placement: x' = origin_x + x_scale * x.
+  const E origin = E::Constant(geometry.placement().origin_x);
+  const E scale = E::Constant(geometry.placement().x_scale);
+  for (auto& v : sx) v = (origin + scale * v).FoldConstants();
+  for (auto& v : x) v = (origin + scale * v).FoldConstants();
   const std::array<E, 3> sy = {y[0], y[1] + margin * E::Unary(Op::kCos, phi2),
                                y[2] + margin * E::Unary(Op::kCos, phi3)};
   std::array<E, 3> distance;
@@ -166,7 +178,10 @@ Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obsta
                                   "' is not a contact transition of spec/finger.ha");
     }
     Constraint guard = tr.guard;
-    guard.comparisons[0] = Comparison{distance[i], Relation::kLessEqual, E::Constant(0.0)};
+    // In millimetres: the simulator's boundary tolerance (1e-9) then means 1e-12 m, so contact
+    // is located to about 1e-8 degrees instead of 1e-5.
+    guard.comparisons[0] = Comparison{(E::Constant(1000.0) * distance[i]).FoldConstants(),
+                                      Relation::kLessEqual, E::Constant(0.0)};
     out.SetGuard(TransitionId(t), std::move(guard));
   }
   return out;

@@ -28,18 +28,23 @@ class GeometricFinger {
  public:
   static constexpr double kResolution = 0.05;
 
-  /// Throws std::invalid_argument ("GeometricFinger: ...") if an object overlaps the palm or
-  /// the open finger (g = 0).
+  /// `imposed`: contacts found outside this finger (another finger touching link i at
+  /// imposed.gob[i], see gripper/hand.h); each competes with the geometric contacts (the first
+  /// one blocks the link). Throws std::invalid_argument ("GeometricFinger: ...") if an object
+  /// overlaps the palm or the open finger (g = 0).
   explicit GeometricFinger(std::vector<Obstacle> objects,
                            const FingerGeometry& geometry = FingerGeometry(),
-                           const FingerParameters& parameters = {});
+                           const FingerParameters& parameters = {},
+                           const FingerContacts& imposed = {});
 
   const FingerClosedForm& closed_form() const { return closed_form_; }
   FingerConfiguration At(double g) const { return closed_form_.At(g); }
   /// Motor positions where links 1..3 are blocked (FingerContacts::kNone: never).
   const FingerContacts& contacts() const { return closed_form_.contacts(); }
-  /// For each link, the obstacle that blocks it: an index into objects(), kPalm, or nullopt.
+  /// For each link, the obstacle that blocks it: an index into objects(), kPalm, kImposed, or
+  /// nullopt.
   static constexpr int kPalm = -1;
+  static constexpr int kImposed = -2;
   const std::array<std::optional<int>, 3>& blocked_by() const { return blocked_by_; }
   /// Whether some link touches one of the objects (not the palm) while closing.
   bool touches_object() const;
@@ -62,7 +67,8 @@ class GeometricFinger {
 };
 
 /// `finger` (the automaton of spec/finger.ha) with each contact guard `g >= gob_i and u > 0`
-/// (transitions labelled contact1..3) replaced by `d_i <= 0 and u > 0`, where d_i is the smallest
+/// (transitions labelled contact1..3) replaced by `1000 d_i <= 0 and u > 0` (millimetres, so
+/// that the simulator's boundary tolerance is 1e-12 m), where d_i is the smallest
 /// signed distance from contact segment i (FingerGeometry::ContactSegments), computed from
 /// theta1..theta3 by the forward kinematics of `geometry`, to `obstacles`
 /// (Obstacle::DistanceExpression). Throws std::invalid_argument
