@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +20,7 @@
 #include "automaton/mode_graph.h"
 #include "automaton/parser.h"
 #include "automaton/system.h"
+#include "tools/gripper_command.h"
 #include "tools/output.h"
 #include "tools/simulate_command.h"
 
@@ -303,11 +306,104 @@ int main(int argc, char** argv) {
   simulate->add_option("--events", sim_args.events, "Event log CSV");
   simulate->add_flag("--json", sim_args.json, "JSON summary with every event on standard output");
 
+  // The gripper (gripper/): closed form, objects by geometry, the hand.
+  const std::string default_finger = std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha";
+  const std::string default_hand = std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha";
+  hybrid::cli::FingerArgs finger_args;
+  finger_args.model = default_finger;
+  double g_value = 0.0;
+  std::array<double, 3> gob = {std::nan(""), std::nan(""), std::nan("")};
+  auto* finger = app.add_subcommand(
+      "finger",
+      "One Robotiq finger, closed form (report section 4): joint angles at motor position G, "
+      "against objects given by contact positions or by geometry");
+  auto* g_option = finger->add_option("--g", g_value, "Motor position in [0, 255]");
+  for (int i = 0; i < 3; ++i) {
+    finger->add_option("--gob" + std::to_string(i + 1), gob[i],
+                       "Motor position where link " + std::to_string(i + 1) +
+                           " is blocked by an object (the report's g_ob)");
+  }
+  finger->add_option("--object", finger_args.objects,
+                     "An object in the finger plane (metres; x towards the palm centre, y along "
+                     "the open finger, origin at joint 1): circle:X,Y,R or "
+                     "segment:X1,Y1,X2,Y2[,R]; repeatable");
+  finger->add_flag("--json", finger_args.json, "Machine-readable output");
+  finger->add_option("--draw", finger_args.draw, "Write an SVG drawing of the finger (see --at)");
+  finger
+      ->add_option("--at", finger_args.draw_at,
+                   "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)")
+      ->delimiter(',');
+  finger->add_option("--plot", finger_args.plot,
+                     "Write an SVG plot of theta1..3 against g (as the report's figure 5.4)");
+  finger->add_flag("--simulate", finger_args.simulate,
+                   "Also simulate the finger automaton closing (u = 1 to g = 255) and compare it "
+                   "with the closed form (exit 5 if they differ by more than 1e-6 degrees)");
+  finger->add_option("--model", finger_args.model, "Finger automaton for --simulate")
+      ->capture_default_str();
+
+  hybrid::cli::HandArgs hand_args;
+  hand_args.model = default_hand;
+  double g_a = 0, g_b = 0, g_c = 0, spread = 0;
+  auto* hand = app.add_subcommand(
+      "hand", "The three-finger hand closing on objects: fingers A, B, C and the spread modes");
+  hand->add_option("--object", hand_args.objects,
+                   "An object in the palm's x-y plane, extruded across the hand (metres; x from "
+                   "finger A towards B and C, y the palm normal, origin between the fingers at "
+                   "the height of joint 1): circle:X,Y,R or segment:X1,Y1,X2,Y2[,R]; repeatable");
+  hand->add_option("--mode", hand_args.mode, "Operating mode: basic, wide, pinch or scissor")
+      ->capture_default_str();
+  auto* spread_option =
+      hand->add_option("--spread", spread, "Spread motor position in [0, 255] (overrides --mode)");
+  hand->add_option("--g", hand_args.g, "One motor command for all fingers, in [0, 255]")
+      ->capture_default_str();
+  auto* ga = hand->add_option("--g-a", g_a, "Motor command of finger A (one command per finger)");
+  auto* gb = hand->add_option("--g-b", g_b, "Motor command of finger B");
+  auto* gc = hand->add_option("--g-c", g_c, "Motor command of finger C");
+  hand->add_flag("--json", hand_args.json, "Machine-readable output");
+  hand->add_option("--draw", hand_args.draw, "Write an SVG drawing of the hand (see --at)");
+  hand->add_option("--at", hand_args.draw_at,
+                   "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)")
+      ->delimiter(',');
+  hand->add_flag("--simulate", hand_args.simulate,
+                 "Also simulate the composed finger automata and compare with the closed form");
+  hand->add_option("--model", hand_args.model, "Hand model for --simulate")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitUsage;
+  }
+
+  if (finger->parsed() || hand->parsed()) {
+    const std::string name = finger->parsed() ? "hybrid finger" : "hybrid hand";
+    try {
+      if (finger->parsed()) {
+        if (g_option->count() > 0) finger_args.g = g_value;
+        finger_args.gob.assign(gob.begin(), gob.end());
+        return hybrid::cli::RunFinger(finger_args);
+      }
+      if (spread_option->count() > 0) hand_args.spread = spread;
+      if (ga->count() > 0) hand_args.g_a = g_a;
+      if (gb->count() > 0) hand_args.g_b = g_b;
+      if (gc->count() > 0) hand_args.g_c = g_c;
+      return hybrid::cli::RunHand(hand_args);
+    } catch (const hybrid::cli::InputError& e) {
+      std::cerr << name << ": " << e.what() << "\n";
+      return kExitModelError;
+    } catch (const hybrid::ParseError& e) {
+      std::cerr << e.what() << "\n";
+      return kExitModelError;
+    } catch (const OutputError& e) {
+      std::cerr << "hybrid: " << e.what() << "\n";
+      return kExitOutput;
+    } catch (const std::invalid_argument& e) {
+      std::cerr << name << ": " << e.what() << "\n";
+      return kExitUsage;
+    } catch (const std::exception& e) {
+      std::cerr << "hybrid: internal error: " << e.what() << "\n";
+      return 4;
+    }
   }
 
   try {

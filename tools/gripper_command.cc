@@ -1,0 +1,430 @@
+#include "tools/gripper_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "automaton/expression.h"
+#include "automaton/parser.h"
+#include "gripper/finger_closed_form.h"
+#include "gripper/geometric_finger.h"
+#include "gripper/hand.h"
+#include "gripper/svg_figures.h"
+#include "solvers/simulator.h"
+#include "tools/output.h"
+
+namespace hybrid::cli {
+namespace {
+
+using gripper::FingerClosedForm;
+using gripper::FingerConfiguration;
+using gripper::FingerContacts;
+using gripper::GeometricFinger;
+using gripper::Obstacle;
+using json = nlohmann::ordered_json;
+
+constexpr int kExitDisagrees = 5;
+constexpr double kAgreement = 1e-6;  // degrees: simulation against the closed form
+
+std::vector<Obstacle> ParseObjects(const std::vector<std::string>& texts) {
+  std::vector<Obstacle> out;
+  for (const std::string& text : texts) {
+    try {
+      out.push_back(Obstacle::Parse(text));
+    } catch (const gripper::ObstacleParseError& e) {
+      throw InputError("--object '" + text + "': column " + std::to_string(e.column()) + ": " +
+                       e.what());
+    } catch (const std::invalid_argument& e) {
+      throw InputError("--object '" + text + "': " + e.what());
+    }
+  }
+  return out;
+}
+
+void CheckMotor(const std::string& option, double g) {
+  if (!(g >= 0.0 && g <= 255.0)) {
+    const std::string value =
+        std::isnan(g) ? "nan" : (std::isinf(g) ? (g > 0 ? "inf" : "-inf") : FormatNumber(g));
+    throw std::invalid_argument(option + " must be a motor position in [0, 255] (got " + value +
+                                ")");
+  }
+}
+
+std::string StateName(const FingerConfiguration& q) {
+  auto digit = [](int v) { return v == -1 ? std::string("n") : std::to_string(v); };
+  return "c" + digit(q.c[0]) + digit(q.c[1]) + digit(q.c[2]) + "_l" + digit(q.l[0]) +
+         digit(q.l[1]) + digit(q.l[2]);
+}
+
+json ConfigurationJson(double g, const FingerConfiguration& q) {
+  return {{"g", g},
+          {"motor", q.motor},
+          {"theta1", q.theta[0]},
+          {"theta2", q.theta[1]},
+          {"theta3", q.theta[2]},
+          {"phase", gripper::PhaseName(q.phase)},
+          {"mode", StateName(q)},
+          {"state",
+           {{"c1", q.c[0]},
+            {"c2", q.c[1]},
+            {"c3", q.c[2]},
+            {"l1", q.l[0]},
+            {"l2", q.l[1]},
+            {"l3", q.l[2]}}}};
+}
+
+std::string Fixed(double v, int digits = 6) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+// Who blocks link i: "object K" (1-based), "palm", "finger X" or "gob" for a given position.
+std::string BlockerName(const std::optional<int>& by, const std::string& imposed_name) {
+  if (!by) return "given";
+  if (*by == GeometricFinger::kPalm) return "palm";
+  if (*by == GeometricFinger::kImposed) return imposed_name;
+  return "object " + std::to_string(*by + 1);
+}
+
+json ContactsJson(const FingerContacts& contacts, const std::array<std::optional<int>, 3>& by,
+                  const std::array<std::string, 3>& imposed_names) {
+  json out = json::array();
+  for (int i = 0; i < 3; ++i) {
+    if (contacts.gob[i] > 255.0) continue;
+    out.push_back(
+        {{"link", i + 1}, {"g", contacts.gob[i]}, {"by", BlockerName(by[i], imposed_names[i])}});
+  }
+  return out;
+}
+
+json StopJson(double stop) { return std::isfinite(stop) ? json(stop) : json(nullptr); }
+
+// Closes `system` at u = 1 from 0 to `until` (input `inputs`, one per finger) and compares each
+// finger's joint angles, at every recorded state, with `expected(f, motor)`.
+struct Comparison {
+  SimulationStatus status;
+  std::string message;
+  double max_difference = 0.0;
+  json contacts = json::array();
+  std::vector<Eigen::Vector3d> final_theta;
+};
+
+template <typename Expected>
+Comparison SimulateClosing(const System& system, const std::vector<std::string>& prefixes,
+                           const std::vector<std::pair<std::string, double>>& commands,
+                           const std::vector<bool>& compare, Expected expected) {
+  const Simulator sim(system);
+  std::vector<InputSignal> signals;
+  double until = 1.0;
+  for (const auto& [input, command] : commands) {
+    InputSignal s{*system.symbols().Find(input), InputSignal::Shape::kStep, {{0.0, 1.0}}};
+    if (command > 0.0) s.points.push_back({command, 0.0});
+    if (command == 0.0) s.points = {{0.0, 0.0}};
+    signals.push_back(s);
+    until = std::max(until, command + 1.0);
+  }
+  SimulationOptions o;
+  o.until = until;
+  o.sample_step = 0.5;
+  const SimulationResult r = sim.Run(o, signals);
+  Comparison out{r.status, r.message};
+  const auto& names = sim.variable_names();
+  auto index = [&](const std::string& n) {
+    return static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  for (size_t f = 0; f < prefixes.size(); ++f) {
+    const std::string& p = prefixes[f];
+    const int g = index(p + "g");
+    const std::array<int, 3> th = {index(p + "theta1"), index(p + "theta2"), index(p + "theta3")};
+    for (const StateSample& s : r.samples) {
+      if (!compare[f]) break;
+      const Eigen::Vector3d q = expected(static_cast<int>(f), std::clamp(s.x[g], 0.0, 255.0));
+      for (int k = 0; k < 3; ++k) {
+        out.max_difference = std::max(out.max_difference, std::abs(s.x[th[k]] - q[k]));
+      }
+    }
+    const auto& last = r.samples.back().x;
+    out.final_theta.emplace_back(last[th[0]], last[th[1]], last[th[2]]);
+    for (const EventRecord& e : r.events) {
+      for (const std::string& label : {e.label}) {
+        const std::string want = p + "contact";
+        if (label.rfind(want, 0) == 0) {
+          out.contacts.push_back({{"finger", p.empty() ? "" : p.substr(0, p.size() - 1)},
+                                  {"link", std::stoi(label.substr(want.size()))},
+                                  {"g", e.before[g]}});
+        }
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<double> DefaultFrames(const std::vector<double>& at) {
+  return at.empty() ? std::vector<double>{0, 30, 70, 110, 150, 180, 210, 255} : at;
+}
+
+}  // namespace
+
+int RunFinger(const FingerArgs& args) {
+  if (args.g) CheckMotor("--g", *args.g);
+  for (double g : args.draw_at) CheckMotor("--at", g);
+  FingerContacts contacts;
+  bool any_gob = false;
+  for (int i = 0; i < 3 && i < static_cast<int>(args.gob.size()); ++i) {
+    if (std::isnan(args.gob[i])) continue;
+    CheckMotor("--gob" + std::to_string(i + 1), args.gob[i]);
+    contacts.gob[i] = args.gob[i];
+    any_gob = true;
+  }
+  if (any_gob && !args.objects.empty()) {
+    throw std::invalid_argument("--gob1..3 and --object cannot be combined");
+  }
+  if (!args.g && args.draw.empty() && args.plot.empty()) {
+    throw std::invalid_argument("nothing to do: give --g, --draw or --plot");
+  }
+  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  std::optional<GeometricFinger> geometric;
+  if (!objects.empty()) {
+    try {
+      geometric.emplace(objects);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
+    if (!geometric->touches_object()) {
+      throw InputError("the finger cannot reach the object(s): it closes to g = " +
+                       FormatNumber(std::min(255.0, geometric->closed_form().stop())) +
+                       " without touching " +
+                       (objects.size() == 1 ? objects[0].ToString() : "any of them"));
+    }
+  }
+  const FingerClosedForm closed = geometric ? geometric->closed_form() : FingerClosedForm(contacts);
+  std::array<std::optional<int>, 3> by;
+  if (geometric) by = geometric->blocked_by();
+  json report;
+  if (args.g) report = ConfigurationJson(*args.g, closed.At(*args.g));
+  report["contacts"] = ContactsJson(closed.contacts(), by, {"", "", ""});
+  report["stop"] = StopJson(closed.stop());
+  if (!objects.empty()) {
+    json list = json::array();
+    for (const Obstacle& o : objects) list.push_back(o.ToString());
+    report["objects"] = list;
+  }
+  int code = 0;
+  if (args.simulate) {
+    const System model = ParseModelFile(args.model);
+    if (model.components().size() != 1) {
+      throw std::invalid_argument(args.model + " is not a single finger automaton");
+    }
+    System system =
+        System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
+                             : model.components()[0].automaton);
+    for (int i = 0; i < 3 && !geometric; ++i) {
+      system.SetParameter("gob" + std::to_string(i + 1), std::min(contacts.gob[i], 256.0));
+    }
+    const Comparison c = SimulateClosing(system, {""}, {{"u", 255.0}}, {true},
+                                         [&](int, double g) { return closed.At(g).theta; });
+    const bool agrees = c.status == SimulationStatus::kCompleted && c.max_difference <= kAgreement;
+    report["simulation"] = {{"status", std::string(StatusName(c.status))},
+                            {"contacts", c.contacts},
+                            {"max_angle_difference_deg", c.max_difference},
+                            {"agrees", agrees}};
+    if (!c.message.empty()) report["simulation"]["message"] = c.message;
+    if (!agrees) code = kExitDisagrees;
+  }
+  if (!args.draw.empty()) {
+    std::vector<std::pair<double, FingerConfiguration>> frames;
+    for (double g : DefaultFrames(args.draw_at)) frames.emplace_back(g, closed.At(g));
+    WriteOutput(args.draw, gripper::FingerDrawingSvg(
+                               geometric ? geometric->geometry() : gripper::FingerGeometry(),
+                               objects, frames));
+  }
+  if (!args.plot.empty()) {
+    std::string title = "Robotiq finger, closed form";
+    if (!objects.empty()) title += " against " + objects[0].ToString();
+    for (int i = 0; i < 3 && any_gob; ++i) {
+      if (contacts.gob[i] <= 255.0) {
+        title += ", gob" + std::to_string(i + 1) + " = " + FormatNumber(contacts.gob[i]);
+      }
+    }
+    WriteOutput(args.plot, gripper::AnglePlotSvg(closed, title));
+  }
+  if (args.json) {
+    WriteOutput("-", report.dump(2) + "\n");
+    return code;
+  }
+  std::ostringstream out;
+  if (args.g) {
+    const FingerConfiguration q = closed.At(*args.g);
+    out << "g = " << FormatNumber(*args.g) << ": phase " << gripper::PhaseName(q.phase)
+        << ", state " << StateName(q) << ", motor at " << FormatNumber(q.motor) << "\n"
+        << "theta1 = " << Fixed(q.theta[0]) << " deg\ntheta2 = " << Fixed(q.theta[1])
+        << " deg\ntheta3 = " << Fixed(q.theta[2]) << " deg\n";
+  }
+  out << "contacts:";
+  if (report["contacts"].empty()) out << " none";
+  for (const auto& c : report["contacts"]) {
+    out << " link " << c["link"].get<int>() << " at g = " << Fixed(c["g"].get<double>()) << " ("
+        << c["by"].get<std::string>() << ");";
+  }
+  out << "\nthe finger stops at "
+      << (std::isfinite(closed.stop()) ? "g = " + Fixed(closed.stop()) : "no g (still moving)")
+      << "\n";
+  if (args.simulate) {
+    const json& s = report["simulation"];
+    out << "simulation (" << args.model << "): " << s["status"].get<std::string>()
+        << ", max |theta difference| = " << s["max_angle_difference_deg"].get<double>()
+        << " deg: " << (s["agrees"].get<bool>() ? "agrees" : "DISAGREES")
+        << " with the closed form\n";
+  }
+  WriteOutput("-", out.str());
+  return code;
+}
+
+int RunHand(const HandArgs& args) {
+  CheckMotor("--g", args.g);
+  std::array<double, 3> commands = {args.g, args.g, args.g};
+  const std::array<std::optional<double>, 3> per = {args.g_a, args.g_b, args.g_c};
+  const bool per_finger = args.g_a || args.g_b || args.g_c;
+  for (int f = 0; f < 3; ++f) {
+    if (per[f]) {
+      CheckMotor(std::string("--g-") + "abc"[f], *per[f]);
+      commands[f] = *per[f];
+    }
+  }
+  const gripper::SpreadMode mode = gripper::SpreadModeByName(args.mode);
+  double spread = gripper::Hand::SpreadPosition(mode);
+  if (args.spread) {
+    if (!(*args.spread >= 0.0 && *args.spread <= 255.0)) {
+      throw std::invalid_argument("--spread must be in [0, 255]");
+    }
+    spread = *args.spread;
+  }
+  for (double g : args.draw_at) CheckMotor("--at", g);
+  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  std::optional<gripper::Hand> hand;
+  try {
+    hand.emplace(objects, spread, commands);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  bool touched = false;
+  for (int f = 0; f < 3; ++f) touched |= hand->finger(f).touches_object();
+  if (!objects.empty() && !touched) {
+    throw InputError("no finger reaches the object(s): the hand closes without touching them");
+  }
+  const std::string names = "ABC";
+  json fingers = json::array();
+  for (int f = 0; f < 3; ++f) {
+    std::array<std::string, 3> imposed;
+    for (const auto& t : hand->touches()) {
+      if (t.finger_a == f) imposed[t.link_a] = std::string("finger ") + names[t.finger_b];
+      if (t.finger_b == f) imposed[t.link_b] = std::string("finger ") + names[t.finger_a];
+    }
+    json j = {{"finger", std::string(1, names[f])}, {"command", commands[f]}};
+    j.update(ConfigurationJson(commands[f], hand->At(f, 255.0)));
+    j.erase("g");
+    j["contacts"] = ContactsJson(hand->finger(f).contacts(), hand->finger(f).blocked_by(), imposed);
+    j["stop"] = StopJson(hand->finger(f).closed_form().stop());
+    fingers.push_back(j);
+  }
+  json touches = json::array();
+  for (const auto& t : hand->touches()) {
+    touches.push_back({{"fingers", std::string{names[t.finger_a], names[t.finger_b]}},
+                       {"links", {t.link_a + 1, t.link_b + 1}},
+                       {"g", t.g}});
+  }
+  json report = {{"mode", args.mode},
+                 {"spread", spread},
+                 {"spread_angle_deg", hand->spread_angle()},
+                 {"fingers", fingers},
+                 {"finger_touches", touches}};
+  int code = 0;
+  if (args.simulate) {
+    const System model = ParseModelFile(args.model);
+    const Automaton* finger = nullptr;
+    const Automaton* spread_automaton = nullptr;
+    for (const Component& c : model.components()) {
+      if (c.source.name() == "finger") finger = &c.source;
+      if (c.source.name() == "spread") spread_automaton = &c.source;
+    }
+    if (!finger) throw std::invalid_argument(args.model + " has no 'finger' automaton");
+    System system("hand");
+    if (!per_finger) system.Share("u");
+    for (int f = 0; f < 3; ++f) {
+      system.AddComponent(std::string(1, names[f]), hand->finger(f).ContactAutomaton(*finger));
+    }
+    if (spread_automaton) system.AddComponent("S", *spread_automaton);
+    std::vector<std::pair<std::string, double>> inputs;
+    if (per_finger) {
+      for (int f = 0; f < 3; ++f) inputs.emplace_back(std::string(1, names[f]) + ".u", commands[f]);
+    } else {
+      inputs.emplace_back("u", args.g);
+    }
+    // Finger-finger touches are not in the automata (their guards see objects and the palm
+    // only): fingers involved in one are not compared.
+    std::vector<bool> compare(3, true);
+    for (const auto& t : hand->touches()) compare[t.finger_a] = compare[t.finger_b] = false;
+    const Comparison c = SimulateClosing(
+        system, {"A.", "B.", "C."}, inputs, compare,
+        [&](int f, double g) { return hand->finger(f).At(std::min(g, commands[f])).theta; });
+    const bool agrees = c.status == SimulationStatus::kCompleted && c.max_difference <= kAgreement;
+    json compared = json::array();
+    for (int f = 0; f < 3; ++f) {
+      if (compare[f]) compared.push_back(std::string(1, names[f]));
+    }
+    report["simulation"] = {{"status", std::string(StatusName(c.status))},
+                            {"contacts", c.contacts},
+                            {"compared_fingers", compared},
+                            {"max_angle_difference_deg", c.max_difference},
+                            {"agrees", agrees}};
+    if (!c.message.empty()) report["simulation"]["message"] = c.message;
+    if (!agrees) code = kExitDisagrees;
+  }
+  if (!args.draw.empty()) {
+    // HAND_DRAWING_PENDING
+  }
+  if (args.json) {
+    WriteOutput("-", report.dump(2) + "\n");
+    return code;
+  }
+  std::ostringstream out;
+  out << "hand, " << args.mode << " mode (spread s = " << FormatNumber(spread) << ", angle "
+      << Fixed(hand->spread_angle(), 3) << " deg)";
+  for (const Obstacle& o : objects) out << ", object " << o.ToString();
+  out << "\n";
+  for (const auto& j : fingers) {
+    out << "finger " << j["finger"].get<std::string>() << " (command "
+        << FormatNumber(j["command"].get<double>()) << "): phase " << j["phase"].get<std::string>()
+        << ", " << j["mode"].get<std::string>() << ", motor at "
+        << Fixed(j["motor"].get<double>(), 3) << "; theta = ("
+        << Fixed(j["theta1"].get<double>(), 4) << ", " << Fixed(j["theta2"].get<double>(), 4)
+        << ", " << Fixed(j["theta3"].get<double>(), 4) << ") deg; contacts:";
+    if (j["contacts"].empty()) out << " none";
+    for (const auto& c : j["contacts"]) {
+      out << " link " << c["link"].get<int>() << " at g = " << Fixed(c["g"].get<double>(), 4)
+          << " (" << c["by"].get<std::string>() << ")";
+    }
+    out << "\n";
+  }
+  for (const auto& t : touches) {
+    out << "fingers " << t["fingers"].get<std::string>() << " touch (links "
+        << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
+        << ") at g = " << Fixed(t["g"].get<double>(), 4) << "\n";
+  }
+  if (args.simulate) {
+    const json& s = report["simulation"];
+    out << "simulation of the composed automata: " << s["status"].get<std::string>()
+        << ", max |theta difference| = " << s["max_angle_difference_deg"].get<double>()
+        << " deg over fingers " << s["compared_fingers"].dump() << ": "
+        << (s["agrees"].get<bool>() ? "agrees" : "DISAGREES") << " with the closed form\n";
+  }
+  WriteOutput("-", out.str());
+  return code;
+}
+
+}  // namespace hybrid::cli

@@ -1,0 +1,49 @@
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hybrid::cli {
+
+/// Options of `hybrid finger` (see docs/cli.md).
+struct FingerArgs {
+  std::optional<double> g;           ///< commanded motor position (required unless drawing)
+  std::vector<double> gob;           ///< --gob1..3 as given (nan = not given)
+  std::vector<std::string> objects;  ///< --object descriptions (finger frame)
+  bool json = false;
+  std::string draw;             ///< SVG of the finger at `draw_at`
+  std::vector<double> draw_at;  ///< motor positions of the drawing's panels
+  std::string plot;             ///< SVG plot of theta1..3 against g
+  bool simulate = false;        ///< also simulate the automaton and compare
+  std::string model;            ///< the finger automaton for --simulate
+};
+
+/// Options of `hybrid hand`.
+struct HandArgs {
+  std::vector<std::string> objects;     ///< --object descriptions (palm x-y plane)
+  std::string mode = "basic";           ///< operating mode (sets the spread)
+  std::optional<double> spread;         ///< spread motor position (overrides the mode's)
+  double g = 255.0;                     ///< one motor command for all fingers
+  std::optional<double> g_a, g_b, g_c;  ///< per-finger commands (override g)
+  bool json = false;
+  std::string draw;  ///< SVG of the hand at `draw_at`
+  std::vector<double> draw_at;
+  bool simulate = false;  ///< also simulate the composed automata
+  std::string model;      ///< spec/hand.ha (its finger and spread automata)
+};
+
+/// `hybrid finger` and `hybrid hand`. Return the exit code (0, or 5 when --simulate disagrees
+/// with the closed form or does not complete). Throw std::invalid_argument for bad option values
+/// (exit 2), InputError for bad objects (exit 1, message names the option and column),
+/// hybrid::ParseError for a bad model, OutputError when a file cannot be written.
+int RunFinger(const FingerArgs& args);
+int RunHand(const HandArgs& args);
+
+/// A bad object description or an object the gripper cannot hold (exit code 1).
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace hybrid::cli
