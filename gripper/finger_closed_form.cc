@@ -102,6 +102,7 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
       stop_ = g;
       piece.g1 = p.motor_max;
       pieces_.push_back(piece);
+      PackEnds();
       return;
     }
     switch (piece.phase) {
@@ -165,6 +166,7 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
     }
     switch (first->kind) {
       case kEndOfTravel:
+        PackEnds();
         return;  // still moving at the end of the motor range
       case kContact:
         c[first->link] = 1;
@@ -184,6 +186,12 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
   throw std::logic_error("FingerClosedForm: too many events");
 }
 
+void FingerClosedForm::PackEnds() {
+  if (pieces_.size() > ends_.size()) throw std::logic_error("FingerClosedForm: too many pieces");
+  ends_.fill(std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < pieces_.size(); ++k) ends_[k] = pieces_[k].g1;
+}
+
 Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
   if (piece.phase != FingerPhase::k3) return piece.theta0 + piece.rate * (g - piece.g0);
   Eigen::Vector3d theta = piece.theta0;
@@ -201,13 +209,9 @@ FingerConfiguration FingerClosedForm::At(double g) const {
                             " is outside the motor range [0, " +
                             std::to_string(parameters_.motor_max) + "]");
   }
-  const Piece* piece = &pieces_.back();
-  for (const Piece& candidate : pieces_) {
-    if (g <= candidate.g1) {
-      piece = &candidate;
-      break;
-    }
-  }
+  size_t k = 0;
+  while (k + 1 < pieces_.size() && g > ends_[k]) ++k;
+  const Piece* piece = &pieces_[k];
   FingerConfiguration out;
   out.theta = Evaluate(*piece, std::min(g, piece->g1));
   out.motor = std::min(g, stop_);

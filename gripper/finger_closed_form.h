@@ -94,10 +94,13 @@ class FingerClosedForm {
 
  private:
   Eigen::Vector3d Evaluate(const Piece& piece, double g) const;
+  void PackEnds();
 
   FingerParameters parameters_;
   FingerContacts contacts_;
   std::vector<Piece> pieces_;
+  // pieces_[k].g1, packed for the search in At (at most 8 pieces; the rest +inf).
+  std::array<double, 8> ends_;
   double stop_ = std::numeric_limits<double>::infinity();
 };
 

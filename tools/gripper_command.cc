@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -48,14 +49,44 @@ void CheckMotor(const std::string& option, double g) {
     const std::string value =
         std::isnan(g) ? "nan" : (std::isinf(g) ? (g > 0 ? "inf" : "-inf") : FormatNumber(g));
     throw std::invalid_argument(option + " must be a motor position in [0, 255] (got " + value +
-                                ")");
+                                ")");  // the spread motor has the same range
   }
 }
 
 std::string StateName(const FingerConfiguration& q) {
-  auto digit = [](int v) { return v == -1 ? std::string("n") : std::to_string(v); };
-  return "c" + digit(q.c[0]) + digit(q.c[1]) + digit(q.c[2]) + "_l" + digit(q.l[0]) +
-         digit(q.l[1]) + digit(q.l[2]);
+  std::string name = "c";
+  auto digit = [&](int v) { name.push_back(v == -1 ? 'n' : static_cast<char>('0' + v)); };
+  for (int v : q.c) digit(v);
+  name += "_l";
+  for (int v : q.l) digit(v);
+  return name;
+}
+
+// The message of a model-level exception without its API prefixes ("Hand: finger A:
+// GeometricFinger: object ..." -> "finger A: object ...").
+std::string UserMessage(const std::string& what) {
+  std::string out = what;
+  for (const std::string prefix : {"Hand: ", "GeometricFinger: "}) {
+    for (auto at = out.find(prefix); at != std::string::npos; at = out.find(prefix)) {
+      out.erase(at, prefix.size());
+    }
+  }
+  return out;
+}
+
+// Writes every (path, text) pair; if one fails, removes the files already written, so a failed
+// run leaves no output.
+void WriteAll(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::string> written;
+  try {
+    for (const auto& [path, text] : files) {
+      WriteOutput(path, text);
+      written.push_back(path);
+    }
+  } catch (const OutputError&) {
+    for (const std::string& path : written) std::remove(path.c_str());
+    throw;
+  }
 }
 
 json ConfigurationJson(double g, const FingerConfiguration& q) {
@@ -132,7 +163,9 @@ Comparison SimulateClosing(const System& system, const std::vector<std::string>&
   o.until = until;
   o.sample_step = 0.5;
   const SimulationResult r = sim.Run(o, signals);
-  Comparison out{r.status, r.message};
+  Comparison out;
+  out.status = r.status;
+  out.message = r.message;
   const auto& names = sim.variable_names();
   auto index = [&](const std::string& n) {
     return static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin());
@@ -193,7 +226,7 @@ int RunFinger(const FingerArgs& args) {
     try {
       geometric.emplace(objects);
     } catch (const std::invalid_argument& e) {
-      throw InputError(e.what());
+      throw InputError(UserMessage(e.what()));
     }
     if (!geometric->touches_object()) {
       throw InputError("the finger cannot reach the object(s): it closes to g = " +
@@ -236,12 +269,13 @@ int RunFinger(const FingerArgs& args) {
     if (!c.message.empty()) report["simulation"]["message"] = c.message;
     if (!agrees) code = kExitDisagrees;
   }
+  std::vector<std::pair<std::string, std::string>> files;
   if (!args.draw.empty()) {
     std::vector<std::pair<double, FingerConfiguration>> frames;
     for (double g : DefaultFrames(args.draw_at)) frames.emplace_back(g, closed.At(g));
-    WriteOutput(args.draw, gripper::FingerDrawingSvg(
-                               geometric ? geometric->geometry() : gripper::FingerGeometry(),
-                               objects, frames));
+    files.emplace_back(args.draw, gripper::FingerDrawingSvg(
+                                      geometric ? geometric->geometry() : gripper::FingerGeometry(),
+                                      objects, frames));
   }
   if (!args.plot.empty()) {
     std::string title = "Robotiq finger, closed form";
@@ -251,8 +285,9 @@ int RunFinger(const FingerArgs& args) {
         title += ", gob" + std::to_string(i + 1) + " = " + FormatNumber(contacts.gob[i]);
       }
     }
-    WriteOutput(args.plot, gripper::AnglePlotSvg(closed, title));
+    files.emplace_back(args.plot, gripper::AnglePlotSvg(closed, title));
   }
+  WriteAll(files);
   if (args.json) {
     WriteOutput("-", report.dump(2) + "\n");
     return code;
@@ -299,9 +334,7 @@ int RunHand(const HandArgs& args) {
   const gripper::SpreadMode mode = gripper::SpreadModeByName(args.mode);
   double spread = gripper::Hand::SpreadPosition(mode);
   if (args.spread) {
-    if (!(*args.spread >= 0.0 && *args.spread <= 255.0)) {
-      throw std::invalid_argument("--spread must be in [0, 255]");
-    }
+    CheckMotor("--spread", *args.spread);
     spread = *args.spread;
   }
   for (double g : args.draw_at) CheckMotor("--at", g);
@@ -310,7 +343,7 @@ int RunHand(const HandArgs& args) {
   try {
     hand.emplace(objects, spread, commands);
   } catch (const std::invalid_argument& e) {
-    throw InputError(e.what());
+    throw InputError(UserMessage(e.what()));
   }
   bool touched = false;
   for (int f = 0; f < 3; ++f) touched |= hand->finger(f).touches_object();
@@ -377,16 +410,21 @@ int RunHand(const HandArgs& args) {
     for (int f = 0; f < 3; ++f) {
       if (compare[f]) compared.push_back(std::string(1, names[f]));
     }
+    // With every finger touching another there is nothing to compare: agrees is null.
     report["simulation"] = {{"status", std::string(StatusName(c.status))},
                             {"contacts", c.contacts},
                             {"compared_fingers", compared},
                             {"max_angle_difference_deg", c.max_difference},
-                            {"agrees", agrees}};
+                            {"agrees", compared.empty() ? json(nullptr) : json(agrees)}};
     if (!c.message.empty()) report["simulation"]["message"] = c.message;
     if (!agrees) code = kExitDisagrees;
   }
   if (!args.draw.empty()) {
-    // HAND_DRAWING_PENDING
+    std::vector<gripper::HandFrame> frames;
+    for (double g : DefaultFrames(args.draw_at)) {
+      frames.push_back({g, {hand->At(0, g), hand->At(1, g), hand->At(2, g)}});
+    }
+    WriteOutput(args.draw, gripper::HandDrawingSvg(*hand, frames));
   }
   if (args.json) {
     WriteOutput("-", report.dump(2) + "\n");
@@ -421,7 +459,11 @@ int RunHand(const HandArgs& args) {
     out << "simulation of the composed automata: " << s["status"].get<std::string>()
         << ", max |theta difference| = " << s["max_angle_difference_deg"].get<double>()
         << " deg over fingers " << s["compared_fingers"].dump() << ": "
-        << (s["agrees"].get<bool>() ? "agrees" : "DISAGREES") << " with the closed form\n";
+        << (s["agrees"].is_null()
+                ? "nothing compared (every finger touches another, which the automata do not see)"
+                : (s["agrees"].get<bool>() ? "agrees with the closed form"
+                                           : "DISAGREES with the closed form"))
+        << "\n";
   }
   WriteOutput("-", out.str());
   return code;

@@ -22,3 +22,24 @@ for model in "$root"/spec/*.ha; do
   echo "wrote out/$name.json, out/$name.dot, out/$name.svg, out/$name.trace.csv, out/$name.events.csv"
   echo
 done
+
+# The gripper (docs/finger_model.md): the closed form against the report's figures, objects by
+# geometry checked against the simulated automaton, and the hand closing on a cylinder.
+echo "=== gripper ==="
+"$hybrid" finger --g 120
+"$hybrid" finger --draw "$out/finger_free.svg" --plot "$out/finger_angles_free.svg"     # figures 6.2, 5.2
+for gob in 30 70 110; do                                                                # figure 5.4
+  "$hybrid" finger --gob1 "$gob" --plot "$out/finger_angles_gob$gob.svg" --draw "$out/finger_gob$gob.svg"
+done
+"$hybrid" finger --gob2 200 --plot "$out/finger_angles_gob200.svg" --draw "$out/finger_gob200.svg"
+# A cylinder of radius 1 cm in the finger plane: contacts found by geometry, then the automaton with
+# distance guards simulated and compared with the closed form (exit 5 if they differ by > 1e-6 deg).
+"$hybrid" finger --g 255 --object circle:0.06,0.08,0.01 --simulate \
+  --draw "$out/finger_object.svg" --plot "$out/finger_angles_object.svg"
+"$hybrid" finger --g 255 --object circle:0.06,0.08,0.01 --simulate --json > "$out/finger_object.json"
+# The hand (basic mode, one motor command) closing on a cylinder across the palm, simulated as three
+# composed finger automata with geometric contact; and pinch mode, where fingers touch each other.
+"$hybrid" hand --object circle:0,0.06,0.02 --simulate --draw "$out/hand_basic.svg"
+"$hybrid" hand --object circle:0,0.06,0.02 --simulate --json > "$out/hand_basic.json"
+"$hybrid" hand --object circle:0,0.06,0.02 --mode pinch --draw "$out/hand_pinch.svg"
+echo "wrote out/finger_*.svg, out/finger_object.json, out/hand_basic.svg, out/hand_basic.json, out/hand_pinch.svg"

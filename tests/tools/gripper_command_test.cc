@@ -1,0 +1,386 @@
+// End-to-end tests of `hybrid finger` and `hybrid hand` (HYBRID_BINARY; tools/gripper_command.cc,
+// docs/finger_model.md): the closed form of section 4 through the command line (free-space table
+// 4.1, a link-1 contact given as gob1), objects given by geometry (the analytic contact position
+// of a circle), --simulate agreeing with the closed form, the SVG outputs, the hand's three
+// fingers, and every kind of bad input (exit 2 for bad options, 1 for bad objects, 3 for
+// unwritable outputs; a message on stderr, nothing on stdout, no file left behind).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/test_utilities/command_line.h"
+
+namespace hybrid {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using testing::Quote;
+using testing::ReadAll;
+using testing::Result;
+using testing::RunHybrid;
+using testing::TempDir;
+
+// Runs `hybrid ARGS --json`, expects `expected_exit`, and parses standard output.
+json RunJson(const std::string& args, int expected_exit = 0) {
+  const Result r = RunHybrid(args + " --json");
+  EXPECT_EQ(r.exit_code, expected_exit) << "hybrid " << args << "\n" << r.err;
+  try {
+    return json::parse(r.out);
+  } catch (const json::exception& e) {
+    ADD_FAILURE() << "hybrid " << args << ": not JSON (" << e.what() << "):\n" << r.out;
+    return json::object();
+  }
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// A rejected run: exit code `code` (never a crash: a signal shows as 128 + N through the shell),
+// nothing on standard output, and a message on stderr containing each of `parts`.
+void ExpectRejected(const std::string& args, int code, const std::vector<std::string>& parts) {
+  const Result r = RunHybrid(args);
+  EXPECT_EQ(r.exit_code, code) << "hybrid " << args << "\nstderr: " << r.err;
+  EXPECT_LT(r.exit_code, 128) << "hybrid " << args;
+  EXPECT_EQ(r.out, "") << "hybrid " << args;
+  EXPECT_FALSE(r.err.empty()) << "hybrid " << args;
+  for (const std::string& part : parts) {
+    EXPECT_TRUE(Contains(r.err, part))
+        << "hybrid " << args << "\nstderr lacks '" << part << "': " << r.err;
+  }
+}
+
+// A complete SVG document.
+void ExpectSvg(const fs::path& path) {
+  const std::string svg = ReadAll(path);
+  ASSERT_FALSE(svg.empty()) << path;
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u) << path << ": " << svg.substr(0, 80);
+  const std::string end = "</svg>\n";
+  ASSERT_GE(svg.size(), end.size());
+  EXPECT_EQ(svg.substr(svg.size() - end.size()), end) << path;
+}
+
+double Deg(double radians) { return radians * 180.0 / std::numbers::pi; }
+double Rad(double degrees) { return degrees * std::numbers::pi / 180.0; }
+
+// "circle:X,Y,R" with every digit of the doubles (17 significant digits).
+std::string Circle(double x, double y, double r) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "circle:" << x << "," << y << "," << r;
+  return s.str();
+}
+
+// A circle of radius 5 mm whose centre is at distance 0.04 m from joint 1, 40 degrees from +y
+// towards +x (the closing direction). Link 1 (0.05715 m, along theta1 from +y) is tangent to it
+// when theta1 = 40 - asin(0.005 / 0.04): before theta1 reaches its limit (phase 1, m1 = 0.5), so
+// gob1 = 2 (40 - asin(0.125)).
+constexpr double kRho = 0.04, kAlphaDeg = 40.0, kRadius = 0.005;
+std::string Link1Circle() {
+  return Circle(kRho * std::sin(Rad(kAlphaDeg)), kRho * std::cos(Rad(kAlphaDeg)), kRadius);
+}
+double Link1CircleGob1() { return 2.0 * (kAlphaDeg - Deg(std::asin(kRadius / kRho))); }
+
+const std::string kHandObject = "circle:0,0.06,0.02";  // centred between the fingers
+
+// ---------------------------------------------------------------------------------------------
+// The closed form (section 4) through `hybrid finger`.
+
+// Phase 1' of table 4.1: at g = 120 theta1 = m1 g = 60 and link 3 is at its lower limit.
+TEST(HybridFinger, TextAtG120IsPhase1Prime) {
+  const Result r = RunHybrid("finger --g 120");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_TRUE(Contains(r.out, "phase 1'")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "state c000_l00n")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "theta1 = 60.000000 deg")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "theta2 = 0.000000 deg")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "theta3 = -55.000000 deg")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "contacts: none")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "stops at g = 240")) << r.out;  // the palm (D3)
+}
+
+// The JSON report's keys: angles in degrees, the motor, phase, automaton state, contacts, stop.
+TEST(HybridFinger, JsonAtG120HasEveryKey) {
+  const json j = RunJson("finger --g 120");
+  EXPECT_EQ(j["theta1"], 60.0);
+  EXPECT_EQ(j["theta2"], 0.0);
+  EXPECT_EQ(j["theta3"], -55.0);
+  EXPECT_EQ(j["motor"], 120.0);
+  EXPECT_EQ(j["phase"], "1'");
+  EXPECT_EQ(j["mode"], "c000_l00n");
+  EXPECT_EQ(j["state"], (json{{"c1", 0}, {"c2", 0}, {"c3", 0}, {"l1", 0}, {"l2", 0}, {"l3", -1}}));
+  ASSERT_TRUE(j["contacts"].is_array());
+  EXPECT_TRUE(j["contacts"].empty());
+  EXPECT_EQ(j["stop"], 240.0);
+}
+
+// Table 4.1 (free space): theta1 = min(0.5 g, 70), theta2 = clamp(0.9 (g - 140), 0, 90),
+// theta3 = max(-0.5 g, -55); the motor stops at 240 against the palm (C4, D3).
+TEST(HybridFinger, FreeSpaceTableOfSection41) {
+  for (double g : {0.0, 55.0, 110.0, 125.0, 140.0, 190.0, 240.0, 250.0}) {
+    const json j = RunJson("finger --g " + std::to_string(g));
+    SCOPED_TRACE("g = " + std::to_string(g));
+    EXPECT_NEAR(j["theta1"].get<double>(), std::min(0.5 * g, 70.0), 1e-9);
+    EXPECT_NEAR(j["theta2"].get<double>(), std::clamp(0.9 * (g - 140.0), 0.0, 90.0), 1e-9);
+    EXPECT_NEAR(j["theta3"].get<double>(), std::max(-0.5 * g, -55.0), 1e-9);
+    EXPECT_NEAR(j["motor"].get<double>(), std::min(g, 240.0), 1e-9);
+    EXPECT_TRUE(j["contacts"].empty());
+  }
+}
+
+// Section 4.2, link 1 blocked at gob1 = 80 (theta1 = 40): link 2 reaches its limit at g = 180
+// with theta3 at its minimum, then theta3 = -55 + 98 (g - 180) / (255 - g), reaching 43 (and
+// stopping) half way between 180 and 255 (C3).
+TEST(HybridFinger, Link1ContactFollowsTheContactTable) {
+  const json j = RunJson("finger --gob1 80 --g 200");
+  EXPECT_NEAR(j["theta1"].get<double>(), 40.0, 1e-9);
+  EXPECT_NEAR(j["theta2"].get<double>(), 90.0, 1e-9);
+  EXPECT_NEAR(j["theta3"].get<double>(), -55.0 + 98.0 * (200.0 - 180.0) / (255.0 - 200.0), 1e-9);
+  EXPECT_EQ(j["phase"], "3");
+  EXPECT_EQ(j["state"]["c1"], 1);
+  EXPECT_EQ(j["state"]["l2"], 1);
+  EXPECT_NEAR(j["stop"].get<double>(), 217.5, 1e-9);
+  ASSERT_EQ(j["contacts"].size(), 1u) << j.dump(2);
+  EXPECT_EQ(j["contacts"][0]["link"], 1);
+  EXPECT_EQ(j["contacts"][0]["g"], 80.0);
+  EXPECT_EQ(j["contacts"][0]["by"], "given");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Objects by geometry.
+
+// A circle tangent to link 1: the contact is found at the analytic motor position (to 1e-6
+// counts; GeometricFinger bisects to 1e-10) and attributed to the object.
+TEST(HybridFinger, CircleBlocksLink1AtTheAnalyticPosition) {
+  const json j = RunJson("finger --g 255 --object " + Link1Circle());
+  ASSERT_EQ(j["contacts"].size(), 1u) << j.dump(2);
+  const json& c = j["contacts"][0];
+  EXPECT_EQ(c["link"], 1);
+  EXPECT_EQ(c["by"], "object 1");
+  EXPECT_NEAR(c["g"].get<double>(), Link1CircleGob1(), 1e-6);
+  EXPECT_NEAR(j["theta1"].get<double>(), 0.5 * Link1CircleGob1(), 1e-6);
+  EXPECT_EQ(j["state"]["c1"], 1);
+  ASSERT_EQ(j["objects"].size(), 1u);
+  // Link 2 then reaches its limit 100 counts later and phase 3 ends half way to 255 (C3).
+  EXPECT_NEAR(j["stop"].get<double>(), (Link1CircleGob1() + 100.0 + 255.0) / 2.0, 1e-6);
+  // The text form names the object too.
+  const Result r = RunHybrid("finger --g 255 --object " + Link1Circle());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Contains(r.out, "link 1 at g = ")) << r.out;
+  EXPECT_TRUE(Contains(r.out, "(object 1)")) << r.out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// --simulate: the automaton (spec/finger.ha, with contact guards given by gob or by distance)
+// closing at u = 1 equals the closed form within 1e-6 degrees.
+
+TEST(HybridFinger, SimulationAgreesWithAGivenContact) {
+  const Result r = RunHybrid("finger --gob1 80 --g 200 --simulate");
+  EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(Contains(r.out, "agrees")) << r.out;
+  EXPECT_FALSE(Contains(r.out, "DISAGREES")) << r.out;
+  const json j = RunJson("finger --gob1 80 --g 200 --simulate");
+  EXPECT_EQ(j["simulation"]["status"], "completed");
+  EXPECT_EQ(j["simulation"]["agrees"], true);
+  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
+  ASSERT_EQ(j["simulation"]["contacts"].size(), 1u) << j.dump(2);
+  EXPECT_EQ(j["simulation"]["contacts"][0]["link"], 1);
+  EXPECT_NEAR(j["simulation"]["contacts"][0]["g"].get<double>(), 80.0, 1e-6);
+}
+
+TEST(HybridFinger, SimulationAgreesWithAnObject) {
+  const Result r = RunHybrid("finger --g 255 --object " + Link1Circle() + " --simulate");
+  EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(Contains(r.out, "agrees")) << r.out;
+  EXPECT_FALSE(Contains(r.out, "DISAGREES")) << r.out;
+  const json j = RunJson("finger --g 255 --object " + Link1Circle() + " --simulate");
+  EXPECT_EQ(j["simulation"]["status"], "completed");
+  EXPECT_EQ(j["simulation"]["agrees"], true);
+  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
+  ASSERT_EQ(j["simulation"]["contacts"].size(), 1u) << j.dump(2);
+  EXPECT_NEAR(j["simulation"]["contacts"][0]["g"].get<double>(), Link1CircleGob1(), 1e-6);
+}
+
+// ---------------------------------------------------------------------------------------------
+// SVG outputs.
+
+// --draw (panels at --at) and --plot each write a whole SVG document; nothing else is created.
+TEST(HybridFinger, DrawAndPlotWriteSvg) {
+  TempDir dir;
+  const Result d = RunHybrid("finger --draw " + Quote(dir.File("finger.svg")) + " --at 0,110,240");
+  EXPECT_EQ(d.exit_code, 0) << d.err;
+  ExpectSvg(dir.File("finger.svg"));
+  const Result p = RunHybrid("finger --plot " + Quote(dir.File("plot.svg")));
+  EXPECT_EQ(p.exit_code, 0) << p.err;
+  ExpectSvg(dir.File("plot.svg"));
+  // With an object and a given g too.
+  const Result o =
+      RunHybrid("finger --g 100 --object " + Link1Circle() + " --draw " +
+                Quote(dir.File("object.svg")) + " --plot " + Quote(dir.File("object_plot.svg")));
+  EXPECT_EQ(o.exit_code, 0) << o.err;
+  ExpectSvg(dir.File("object.svg"));
+  ExpectSvg(dir.File("object_plot.svg"));
+  EXPECT_EQ(dir.Files(),
+            (std::vector<std::string>{"finger.svg", "object.svg", "object_plot.svg", "plot.svg"}));
+}
+
+// An output that cannot be written: exit 3, a message naming the path, nothing left behind (the
+// write is atomic: no temporary file either), nothing on stdout.
+TEST(HybridFinger, UnwritableOutputIsExit3AndLeavesNoFile) {
+  TempDir dir;
+  const std::string missing = dir.File("no_such_dir/out.svg");
+  ExpectRejected("finger --draw " + Quote(missing) + " --at 0,110,240", 3, {"cannot write"});
+  ExpectRejected("finger --plot " + Quote(missing), 3, {"cannot write"});
+  ExpectRejected("finger --g 100 --json --draw " + Quote(missing), 3, {"cannot write"});
+  EXPECT_TRUE(dir.Files().empty());
+  // The target is an existing directory.
+  fs::create_directory(dir.path() / "a_directory");
+  ExpectRejected("finger --plot " + Quote(dir.File("a_directory")), 3, {"cannot write"});
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a_directory"});
+  EXPECT_TRUE(fs::is_empty(dir.path() / "a_directory"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input to `hybrid finger`.
+
+// Bad option values: exit 2 and a message naming the option.
+TEST(HybridFinger, BadOptionValuesAreExit2) {
+  ExpectRejected("finger --g 300", 2, {"--g", "[0, 255]", "300"});
+  ExpectRejected("finger --g -1", 2, {"--g", "[0, 255]"});
+  ExpectRejected("finger --g nan", 2, {"--g", "nan"});
+  ExpectRejected("finger --gob1 300 --g 10", 2, {"--gob1"});
+  TempDir dir;
+  ExpectRejected("finger --draw " + Quote(dir.File("x.svg")) + " --at 0,300", 2, {"--at", "300"});
+  EXPECT_TRUE(dir.Files().empty());
+  ExpectRejected("finger --gob1 80 --object " + Link1Circle() + " --g 100", 2,
+                 {"--gob", "--object"});
+  ExpectRejected("finger", 2, {"--g", "--draw", "--plot"});
+  ExpectRejected("finger --json", 2, {"nothing to do"});
+}
+
+// Malformed objects: exit 1, the message names --object and the column of the fault.
+TEST(HybridFinger, MalformedObjectsAreExit1WithTheColumn) {
+  ExpectRejected("finger --g 100 --object circle:0.05,abc,0.01", 1, {"--object", "column 13"});
+  ExpectRejected("finger --g 100 --object square:1,2,3", 1, {"--object", "column 1:"});
+  ExpectRejected("finger --g 100 --object circle:0.1,0.2", 1, {"--object", "column 15"});
+  ExpectRejected("finger --g 100 --object circle:0.05,0.05,-0.01", 1,
+                 {"--object", "column 18", "radius"});
+}
+
+// Objects the finger cannot hold: overlapping the palm (G1) or the open finger, or out of reach.
+TEST(HybridFinger, ObjectsTheFingerCannotHoldAreExit1) {
+  ExpectRejected("finger --g 100 --object circle:0.05,-0.03,0.01", 1, {"overlaps the palm"});
+  ExpectRejected("finger --g 100 --object circle:0,0.05,0.01", 1, {"overlaps", "open finger"});
+  ExpectRejected("finger --g 100 --object circle:-0.2,0.05,0.01", 1, {"cannot reach"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// `hybrid hand`.
+
+// A cylinder centred between the fingers (basic mode): each finger's link 2 meets it.
+TEST(HybridHand, EveryFingerTouchesACentredCylinderWithLink2) {
+  const Result r = RunHybrid("hand --object " + kHandObject);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"finger A", "finger B", "finger C"}) {
+    EXPECT_TRUE(Contains(r.out, f)) << r.out;
+  }
+  const json j = RunJson("hand --object " + kHandObject);
+  EXPECT_EQ(j["mode"], "basic");
+  EXPECT_EQ(j["spread"], 137.0);
+  ASSERT_EQ(j["fingers"].size(), 3u) << j.dump(2);
+  for (int f = 0; f < 3; ++f) {
+    const json& finger = j["fingers"][f];
+    SCOPED_TRACE(std::string("finger ") + "ABC"[f]);
+    EXPECT_EQ(finger["finger"], std::string(1, "ABC"[f]));
+    for (const char* k : {"theta1", "theta2", "theta3", "motor", "command", "state", "stop"}) {
+      EXPECT_TRUE(finger.contains(k)) << k;
+    }
+    ASSERT_EQ(finger["contacts"].size(), 1u) << finger.dump(2);
+    EXPECT_EQ(finger["contacts"][0]["link"], 2);
+    EXPECT_EQ(finger["contacts"][0]["by"], "object 1");
+    EXPECT_EQ(finger["state"]["c2"], 1);
+  }
+  ASSERT_TRUE(j["finger_touches"].is_array());
+  EXPECT_TRUE(j["finger_touches"].empty());
+}
+
+// The composed automata (spec/hand.ha, one shared u) agree with the quasistatic hand on every
+// finger.
+TEST(HybridHand, SimulationAgreesWithTheClosedForm) {
+  const json j = RunJson("hand --object " + kHandObject + " --simulate");
+  EXPECT_EQ(j["simulation"]["status"], "completed");
+  EXPECT_EQ(j["simulation"]["agrees"], true);
+  EXPECT_EQ(j["simulation"]["compared_fingers"], json::array({"A", "B", "C"}));
+  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
+  EXPECT_EQ(j["simulation"]["contacts"].size(), 3u) << j.dump(2);
+}
+
+// Pinch mode (spread 255) with finger A commanded to 100: the fingers touch each other (H3), and
+// finger A's motor never passes its command.
+TEST(HybridHand, PinchWithPerFingerCommandReportsFingerTouches) {
+  const json j = RunJson("hand --mode pinch --g-a 100 --object " + kHandObject);
+  EXPECT_EQ(j["mode"], "pinch");
+  EXPECT_EQ(j["spread"], 255.0);
+  ASSERT_EQ(j["fingers"].size(), 3u);
+  EXPECT_EQ(j["fingers"][0]["command"], 100.0);
+  EXPECT_LE(j["fingers"][0]["motor"].get<double>(), 100.0);
+  ASSERT_TRUE(j["finger_touches"].is_array());
+  EXPECT_FALSE(j["finger_touches"].empty()) << j.dump(2);
+  for (const json& t : j["finger_touches"]) {
+    EXPECT_EQ(t["fingers"].get<std::string>().size(), 2u);
+    EXPECT_EQ(t["links"].size(), 2u);
+  }
+}
+
+// Without objects the fingers close freely and stop against the palm at (70, 90, -55) (table
+// 4.1, D3).
+TEST(HybridHand, NoObjectClosesFreely) {
+  const json j = RunJson("hand");
+  EXPECT_EQ(j["mode"], "basic");
+  ASSERT_EQ(j["fingers"].size(), 3u);
+  for (const json& finger : j["fingers"]) {
+    SCOPED_TRACE(finger["finger"].dump());
+    EXPECT_NEAR(finger["theta1"].get<double>(), 70.0, 1e-9);
+    EXPECT_NEAR(finger["theta2"].get<double>(), 90.0, 1e-9);
+    EXPECT_NEAR(finger["theta3"].get<double>(), -55.0, 1e-9);
+    EXPECT_NEAR(finger["motor"].get<double>(), 240.0, 1e-9);
+    EXPECT_TRUE(finger["contacts"].empty());
+  }
+  EXPECT_TRUE(j["finger_touches"].empty());
+}
+
+// Bad options (exit 2) and an object overlapping the palm (exit 1).
+TEST(HybridHand, BadInputIsRejected) {
+  ExpectRejected("hand --mode bogus", 2, {"bogus"});
+  ExpectRejected("hand --g-b 400", 2, {"--g-b", "400"});
+  ExpectRejected("hand --g nan", 2, {"--g"});
+  ExpectRejected("hand --spread 300", 2, {"--spread"});
+  ExpectRejected("hand --object circle:0,-0.01,0.02", 1, {"overlaps the palm"});
+  ExpectRejected("hand --object circle:0,0.06,abc", 1, {"--object", "column 15"});
+  ExpectRejected("hand --object circle:0.3,0.5,0.01", 1, {"no finger reaches"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Help.
+
+TEST(HybridGripperHelp, FingerAndHandDescribeObjects) {
+  for (const std::string command : {"finger", "hand"}) {
+    const Result r = RunHybrid(command + " --help");
+    EXPECT_EQ(r.exit_code, 0) << command << "\n" << r.err;
+    EXPECT_TRUE(Contains(r.out, "--object")) << command << "\n" << r.out;
+    EXPECT_TRUE(Contains(r.out, "circle:X,Y,R")) << command << "\n" << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace hybrid
