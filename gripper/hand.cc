@@ -107,32 +107,49 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
   // Sweep g for touches between fingers.
   double g0 = 0.0;
   for (int round = 0; round < 18; ++round) {
-    auto separation = [&](int f1, int l1, int f2, int l2, double g) {
-      const auto p1 = Points(f1, At(f1, g).theta);
-      const auto p2 = Points(f2, At(f2, g).theta);
-      return SegmentDistance3(p1[l1], p1[l1 + 1], p2[l2], p2[l2 + 1]) - layout_.link_width;
+    // Links of every finger in space at sweep position g.
+    auto links_at = [&](double g) {
+      std::array<std::array<Eigen::Vector3d, 4>, 3> p;
+      for (int f = 0; f < 3; ++f) p[f] = Points(f, At(f, g).theta);
+      return p;
+    };
+    auto separation = [&](const std::array<std::array<Eigen::Vector3d, 4>, 3>& p, int f1, int l1,
+                          int f2, int l2) {
+      return SegmentDistance3(p[f1][l1], p[f1][l1 + 1], p[f2][l2], p[f2][l2 + 1]) -
+             layout_.link_width;
     };
     std::vector<double> grid;
     for (double g = g0; g < 255.0; g += GeometricFinger::kResolution) grid.push_back(g);
     grid.push_back(255.0);
     std::optional<FingerTouch> first;
+    auto previous = links_at(grid[0]);
     for (size_t k = 1; k < grid.size() && !first; ++k) {
+      const auto current = links_at(grid[k]);
       for (int f1 = 0; f1 < 3; ++f1) {
         for (int f2 = f1 + 1; f2 < 3; ++f2) {
           for (int l1 = 0; l1 < 3; ++l1) {
             for (int l2 = 0; l2 < 3; ++l2) {
-              if (separation(f1, l1, f2, l2, grid[k]) > 0.0) continue;
+              const double now = separation(current, f1, l1, f2, l2);
+              if (now > 0.0) continue;
               double lo = grid[k - 1], hi = grid[k];
-              if (separation(f1, l1, f2, l2, lo) <= 0.0) continue;  // touching already
+              const double before = separation(previous, f1, l1, f2, l2);
+              if (before <= 0.0) {
+                // Touching already where the last touch stopped the sweep (e.g. A meets B and,
+                // by symmetry, C at the same g): a touch if the links move further in.
+                if (now < before && (!first || lo < first->g))
+                  first = FingerTouch{f1, l1, f2, l2, lo};
+                continue;
+              }
               while (hi - lo > 1e-10) {
                 const double mid = 0.5 * (lo + hi);
-                (separation(f1, l1, f2, l2, mid) <= 0.0 ? hi : lo) = mid;
+                (separation(links_at(mid), f1, l1, f2, l2) <= 0.0 ? hi : lo) = mid;
               }
               if (!first || hi < first->g) first = FingerTouch{f1, l1, f2, l2, hi};
             }
           }
         }
       }
+      previous = current;
     }
     if (!first) break;
     touches_.push_back(*first);
