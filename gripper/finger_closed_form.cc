@@ -154,6 +154,7 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
     double end = p.motor_max;
     for (const Event& e : events) end = std::min(end, e.at);
     piece.g1 = end;
+    if (piece.phase == FingerPhase::k3) piece.span3 = p.theta_max[2] - theta[2];
     if (end > g || pieces_.empty()) pieces_.push_back(piece);
     theta = Evaluate(piece, end);
     g = end;
@@ -193,13 +194,16 @@ void FingerClosedForm::PackEnds() {
 }
 
 Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
-  if (piece.phase != FingerPhase::k3) return piece.theta0 + piece.rate * (g - piece.g0);
-  Eigen::Vector3d theta = piece.theta0;
-  const double rest = parameters_.motor_max - g;
+  // Branch-free (At is called with random g): linear part plus the phase-3 term, which is 0
+  // outside phase 3 (span3 = 0).
   const double moved = g - piece.g0;
-  // (g - g_s) / (255 - g), which reaches 1 half way between g_s and 255; clamped there.
-  const double fraction = moved <= 0.0 ? 0.0 : (moved >= rest ? 1.0 : moved / rest);
-  theta[2] = piece.theta0[2] + (parameters_.theta_max[2] - piece.theta0[2]) * fraction;
+  const double rest = parameters_.motor_max - g;
+  // (g - g_s) / (255 - g), which reaches 1 half way between g_s and 255; clamped there. At
+  // g = g_s = 255 nothing has moved: 0.
+  const double ratio = moved / (rest > 0.0 ? rest : 1.0);
+  const double fraction = moved > 0.0 && moved >= rest ? 1.0 : std::clamp(ratio, 0.0, 1.0);
+  Eigen::Vector3d theta = piece.theta0 + piece.rate * moved;
+  theta[2] += piece.span3 * fraction;
   return theta;
 }
 
@@ -209,15 +213,17 @@ FingerConfiguration FingerClosedForm::At(double g) const {
                             " is outside the motor range [0, " +
                             std::to_string(parameters_.motor_max) + "]");
   }
+  // The piece index is the number of piece ends below g (ends_ is sorted; unused entries are
+  // +inf and the last piece ends at motor_max >= g), counted without branches.
   size_t k = 0;
-  while (k + 1 < pieces_.size() && g > ends_[k]) ++k;
-  const Piece* piece = &pieces_[k];
+  for (double end : ends_) k += g > end ? 1 : 0;
+  const Piece& piece = pieces_[k];
   FingerConfiguration out;
-  out.theta = Evaluate(*piece, std::min(g, piece->g1));
+  out.theta = Evaluate(piece, std::min(g, piece.g1));
   out.motor = std::min(g, stop_);
-  out.c = piece->c;
-  out.l = piece->l;
-  out.phase = piece->phase;
+  out.c = piece.c;
+  out.l = piece.l;
+  out.phase = piece.phase;
   return out;
 }
 

@@ -87,6 +87,9 @@ class FingerClosedForm {
     std::array<int, 3> c = {0, 0, 0};
     std::array<int, 3> l = {0, 0, 0};
     FingerPhase phase = FingerPhase::k1;
+    /// theta3_max - theta0[2] in phase 3 (theta3 = theta0[2] + span3 (g - g0) / (255 - g),
+    /// clamped at 1), 0 in other phases.
+    double span3 = 0.0;
   };
   std::span<const Piece> pieces() const { return pieces_; }
   const FingerParameters& parameters() const { return parameters_; }
