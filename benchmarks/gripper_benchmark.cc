@@ -86,20 +86,8 @@ BENCHMARK(BM_HandClosing)->Unit(benchmark::kMillisecond);
 void BM_HandClosingSimulated(benchmark::State& state) {
   const Hand hand({Obstacle::Circle({0.0, 0.06}, 0.02)}, Hand::SpreadPosition(SpreadMode::kBasic),
                   {255, 255, 255});
-  const hybrid::System model =
-      hybrid::ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha");
-  const hybrid::Automaton* finger = nullptr;
-  const hybrid::Automaton* spread = nullptr;
-  for (const auto& c : model.components()) {
-    if (c.source.name() == "finger") finger = &c.source;
-    if (c.source.name() == "spread") spread = &c.source;
-  }
-  hybrid::System system("hand");
-  system.Share("u");
-  for (int f = 0; f < 3; ++f) {
-    system.AddComponent(std::string(1, "ABC"[f]), hand.finger(f).ContactAutomaton(*finger));
-  }
-  system.AddComponent("S", *spread);
+  const hybrid::System system = hand.ComposedAutomata(
+      hybrid::ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha"), true);
   const hybrid::Simulator simulator(system);
   hybrid::SimulationOptions options;
   options.until = 256.0;

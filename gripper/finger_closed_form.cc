@@ -57,6 +57,15 @@ std::string PhaseName(FingerPhase phase) {
   return "?";
 }
 
+std::string FingerModeName(const FingerConfiguration& q) {
+  std::string name = "c";
+  auto digit = [&](int v) { name.push_back(v == -1 ? 'n' : static_cast<char>('0' + v)); };
+  for (int v : q.c) digit(v);
+  name += "_l";
+  for (int v : q.l) digit(v);
+  return name;
+}
+
 FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
                                    const FingerParameters& parameters)
     : parameters_(parameters), contacts_(contacts) {

@@ -39,6 +39,10 @@ struct FingerConfiguration {
   FingerPhase phase = FingerPhase::k1;
 };
 
+/// The name of the mode of spec/finger.ha with `q`'s discrete state: "c<c1c2c3>_l<l1l2l3>", "n"
+/// for -1 (e.g. "c100_l00n").
+std::string FingerModeName(const FingerConfiguration& q);
+
 /// The closed-form (quasistatic) model of one finger closing from g = 0: the tables of section 4
 /// of the report with the decisions of docs/finger_model.md, assembled at their breakpoints.
 ///

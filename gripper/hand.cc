@@ -172,6 +172,26 @@ FingerConfiguration Hand::At(int f, double g) const {
   return fingers_.at(f).At(std::min(g, commands_[f]));
 }
 
+System Hand::ComposedAutomata(const System& hand_model, bool shared_command) const {
+  const Automaton* finger = nullptr;
+  const Automaton* spread = nullptr;
+  for (const Component& c : hand_model.components()) {
+    if (c.source.name() == "finger") finger = &c.source;
+    if (c.source.name() == "spread") spread = &c.source;
+  }
+  if (finger == nullptr) {
+    throw std::invalid_argument("Hand::ComposedAutomata: the model '" + hand_model.name() +
+                                "' has no automaton named 'finger'");
+  }
+  System system("hand");
+  if (shared_command) system.Share("u");
+  for (int f = 0; f < 3; ++f) {
+    system.AddComponent(std::string(1, "ABC"[f]), fingers_[f].ContactAutomaton(*finger));
+  }
+  if (spread != nullptr) system.AddComponent("S", *spread);
+  return system;
+}
+
 FingerGeometry Hand::FingerGeometryOf(int f) const {
   if (f == 0) return FingerGeometry({}, FingerPlacement{-layout_.half_span, 1.0});
   return FingerGeometry({}, FingerPlacement{layout_.half_span, -std::cos(phi_ * kDeg)});

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "automaton/system.h"
 #include "gripper/geometric_finger.h"
 
 namespace hybrid::gripper {
@@ -85,6 +86,14 @@ class Hand {
   std::array<Eigen::Vector3d, 4> Points(int f, const Eigen::Vector3d& theta) const;
   /// The finger's placement in the x-y plane (origin_x, x_scale) and its plane's base z.
   FingerGeometry FingerGeometryOf(int f) const;
+
+  /// The hand as composed automata, for simulation: instances A, B and C of the automaton named
+  /// "finger" in `hand_model` (spec/hand.ha) with this hand's geometric contact guards
+  /// (GeometricFinger::ContactAutomaton: objects and palm, not the other fingers), and instance
+  /// S of its "spread" automaton if it has one. One motor command `u` shared by the fingers when
+  /// `shared_command`, else one per finger (A.u, B.u, C.u). Throws std::invalid_argument
+  /// ("Hand::ComposedAutomata: ...") if `hand_model` has no automaton named "finger".
+  System ComposedAutomata(const System& hand_model, bool shared_command) const;
 
  private:
   std::vector<Obstacle> objects_;

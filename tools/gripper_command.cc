@@ -53,15 +53,6 @@ void CheckMotor(const std::string& option, double g) {
   }
 }
 
-std::string StateName(const FingerConfiguration& q) {
-  std::string name = "c";
-  auto digit = [&](int v) { name.push_back(v == -1 ? 'n' : static_cast<char>('0' + v)); };
-  for (int v : q.c) digit(v);
-  name += "_l";
-  for (int v : q.l) digit(v);
-  return name;
-}
-
 // The message of a model-level exception without its API prefixes ("Hand: finger A:
 // GeometricFinger: object ..." -> "finger A: object ...").
 std::string UserMessage(const std::string& what) {
@@ -96,7 +87,7 @@ json ConfigurationJson(double g, const FingerConfiguration& q) {
           {"theta2", q.theta[1]},
           {"theta3", q.theta[2]},
           {"phase", gripper::PhaseName(q.phase)},
-          {"mode", StateName(q)},
+          {"mode", gripper::FingerModeName(q)},
           {"state",
            {{"c1", q.c[0]},
             {"c2", q.c[1]},
@@ -296,7 +287,8 @@ int RunFinger(const FingerArgs& args) {
   if (args.g) {
     const FingerConfiguration q = closed.At(*args.g);
     out << "g = " << FormatNumber(*args.g) << ": phase " << gripper::PhaseName(q.phase)
-        << ", state " << StateName(q) << ", motor at " << FormatNumber(q.motor) << "\n"
+        << ", state " << gripper::FingerModeName(q) << ", motor at " << FormatNumber(q.motor)
+        << "\n"
         << "theta1 = " << Fixed(q.theta[0]) << " deg\ntheta2 = " << Fixed(q.theta[1])
         << " deg\ntheta3 = " << Fixed(q.theta[2]) << " deg\n";
   }
@@ -378,20 +370,8 @@ int RunHand(const HandArgs& args) {
                  {"finger_touches", touches}};
   int code = 0;
   if (args.simulate) {
-    const System model = ParseModelFile(args.model);
-    const Automaton* finger = nullptr;
-    const Automaton* spread_automaton = nullptr;
-    for (const Component& c : model.components()) {
-      if (c.source.name() == "finger") finger = &c.source;
-      if (c.source.name() == "spread") spread_automaton = &c.source;
-    }
-    if (!finger) throw std::invalid_argument(args.model + " has no 'finger' automaton");
-    System system("hand");
-    if (!per_finger) system.Share("u");
-    for (int f = 0; f < 3; ++f) {
-      system.AddComponent(std::string(1, names[f]), hand->finger(f).ContactAutomaton(*finger));
-    }
-    if (spread_automaton) system.AddComponent("S", *spread_automaton);
+    const System system =
+        hand->ComposedAutomata(ParseModelFile(args.model), /*shared_command=*/!per_finger);
     std::vector<std::pair<std::string, double>> inputs;
     if (per_finger) {
       for (int f = 0; f < 3; ++f) inputs.emplace_back(std::string(1, names[f]) + ".u", commands[f]);

@@ -25,12 +25,6 @@ FingerContacts Contacts(double gob1, double gob2, double gob3) {
   return c;
 }
 
-std::string StateName(const FingerConfiguration& q) {
-  auto digit = [](int v) { return v == -1 ? std::string("n") : std::to_string(v); };
-  return "c" + digit(q.c[0]) + digit(q.c[1]) + digit(q.c[2]) + "_l" + digit(q.l[0]) +
-         digit(q.l[1]) + digit(q.l[2]);
-}
-
 // Section 4.1, the table without object, reproduced exactly at every integer motor position
 // (the formulas are evaluated in the table's own form; integer g makes both sides exact).
 TEST(FingerClosedFormTest, FreeSpaceTableOfSection41) {
@@ -52,11 +46,13 @@ TEST(FingerClosedFormTest, FreeSpaceTableOfSection41) {
     EXPECT_EQ(q.theta, table) << "g = " << g;
     EXPECT_EQ(q.phase, phase) << "g = " << g;
     // The report's remark: theta3 = max(-m1 g, theta3_min) in phases 1 and 1'.
-    if (g <= 140) EXPECT_EQ(q.theta[2], std::max(-kM1 * g, kTh3Min));
+    if (g <= 140) {
+      EXPECT_EQ(q.theta[2], std::max(-kM1 * g, kTh3Min));
+    }
     EXPECT_EQ(q.motor, std::min(g, 240.0));  // the palm stops the motor at 240 (D3)
   }
   EXPECT_EQ(f.stop(), 240.0);
-  EXPECT_EQ(StateName(f.At(255)), "c000_l11n");
+  EXPECT_EQ(FingerModeName(f.At(255)), "c000_l11n");
 }
 
 // The table says phase 2 for 140 < g <= 240; with theta3 already at its lower limit that is the
@@ -125,7 +121,7 @@ TEST(FingerClosedFormTest, ContactOnLinks1And2FollowsTheText) {
     EXPECT_NEAR(q.theta[1], kM2 * (gob2 - gob1), 1e-12);
     EXPECT_NEAR(q.theta[2], std::min(kTh3Max, kTh3Min + kC * (gg - gob2) / (255 - gg)), 1e-9);
   }
-  EXPECT_EQ(StateName(f.At(200)), "c110_l000");
+  EXPECT_EQ(FingerModeName(f.At(200)), "c110_l000");
 }
 
 // Clash C2 (inside section 4): for link 2 blocked while theta3 is above its minimum (gob2 <=
@@ -256,14 +252,14 @@ RC_GTEST_PROP(FingerClosedFormProperty, SimulationEqualsClosedForm, ()) {
       if (error > worst && error > 1e-6) {
         RC_LOG() << "t = " << s.time << " g = " << motor << " mode " << sim.ModeName(0, s.modes[0])
                  << ": theta" << k + 1 << " = " << s.x[std::array{th1, th2, th3}[k]]
-                 << ", closed form " << q.theta[k] << " (" << StateName(q) << ")\n";
+                 << ", closed form " << q.theta[k] << " (" << FingerModeName(q) << ")\n";
       }
       worst = std::max(worst, error);
     }
     if (s.time <= 255.0) {
       RC_ASSERT(std::abs(motor - std::min(s.time, closed.stop())) <= 1e-6);
       if (!near_breakpoint(motor) && s.kind == StateSample::Kind::kSample) {
-        RC_ASSERT(sim.ModeName(0, s.modes[0]) == StateName(q));
+        RC_ASSERT(sim.ModeName(0, s.modes[0]) == FingerModeName(q));
       }
     }
   }

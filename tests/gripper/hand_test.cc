@@ -188,20 +188,7 @@ RC_GTEST_PROP(HandProperty, ComposedAutomataFollowTheQuasistaticHand, ()) {
   }
   const Hand& hand = *maybe;
   static const System model = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha");
-  const Automaton* finger = nullptr;
-  const Automaton* spread_automaton = nullptr;
-  for (const Component& c : model.components()) {
-    if (c.source.name() == "finger") finger = &c.source;
-    if (c.source.name() == "spread") spread_automaton = &c.source;
-  }
-  RC_ASSERT(finger != nullptr);
-  RC_ASSERT(spread_automaton != nullptr);
-  System system("hand");
-  system.Share("u");
-  for (int f = 0; f < 3; ++f) {
-    system.AddComponent(std::string(1, "ABC"[f]), hand.finger(f).ContactAutomaton(*finger));
-  }
-  system.AddComponent("S", *spread_automaton);
+  const System system = hand.ComposedAutomata(model, /*shared_command=*/true);
   const Simulator sim(system);
   SimulationOptions o;
   o.until = 255.0;
