@@ -126,20 +126,23 @@ json ContactsJson(const FingerContacts& contacts, const std::array<std::optional
 
 json StopJson(double stop) { return std::isfinite(stop) ? json(stop) : json(nullptr); }
 
-// Closes `system` at u = 1 from 0 to `until` (input `inputs`, one per finger) and compares each
-// finger's joint angles, at every recorded state, with `expected(f, motor)`.
+// The closing of the fingers of `system` (instance prefixes "A.", ... or "" for one finger),
+// each driven at u = 1 until its command (`commands`: input name and command), compared at
+// every recorded state with the closed form: joint angles with `expected(f, motor)`, and the
+// motor position at time t with min(t, command, stops[f]) (where the closed form stops).
 struct Comparison {
   SimulationStatus status;
   std::string message;
-  double max_difference = 0.0;
+  double max_angle_difference = 0.0;
+  double max_motor_difference = 0.0;
   json contacts = json::array();
-  std::vector<Eigen::Vector3d> final_theta;
 };
 
 template <typename Expected>
 Comparison SimulateClosing(const System& system, const std::vector<std::string>& prefixes,
                            const std::vector<std::pair<std::string, double>>& commands,
-                           const std::vector<bool>& compare, Expected expected) {
+                           const std::vector<double>& stops, const std::vector<bool>& compare,
+                           Expected expected) {
   const Simulator sim(system);
   std::vector<InputSignal> signals;
   double until = 1.0;
@@ -165,27 +168,40 @@ Comparison SimulateClosing(const System& system, const std::vector<std::string>&
     const std::string& p = prefixes[f];
     const int g = index(p + "g");
     const std::array<int, 3> th = {index(p + "theta1"), index(p + "theta2"), index(p + "theta3")};
+    const double command = commands[std::min(f, commands.size() - 1)].second;
     for (const StateSample& s : r.samples) {
       if (!compare[f]) break;
       const Eigen::Vector3d q = expected(static_cast<int>(f), std::clamp(s.x[g], 0.0, 255.0));
       for (int k = 0; k < 3; ++k) {
-        out.max_difference = std::max(out.max_difference, std::abs(s.x[th[k]] - q[k]));
+        out.max_angle_difference = std::max(out.max_angle_difference, std::abs(s.x[th[k]] - q[k]));
       }
+      const double motor = std::min({s.time, command, stops[f]});
+      out.max_motor_difference = std::max(out.max_motor_difference, std::abs(s.x[g] - motor));
     }
-    const auto& last = r.samples.back().x;
-    out.final_theta.emplace_back(last[th[0]], last[th[1]], last[th[2]]);
+    const std::string contact = p + "contact";
     for (const EventRecord& e : r.events) {
-      for (const std::string& label : {e.label}) {
-        const std::string want = p + "contact";
-        if (label.rfind(want, 0) == 0) {
-          out.contacts.push_back({{"finger", p.empty() ? "" : p.substr(0, p.size() - 1)},
-                                  {"link", std::stoi(label.substr(want.size()))},
-                                  {"g", e.before[g]}});
-        }
-      }
+      if (e.label.rfind(contact, 0) != 0) continue;
+      json j = {{"link", std::stoi(e.label.substr(contact.size()))}, {"g", e.before[g]}};
+      if (!p.empty()) j["finger"] = p.substr(0, p.size() - 1);
+      out.contacts.push_back(j);
     }
   }
   return out;
+}
+
+bool Agrees(const Comparison& c) {
+  return c.status == SimulationStatus::kCompleted && c.max_angle_difference <= kAgreement &&
+         c.max_motor_difference <= kAgreement;
+}
+
+json SimulationJson(const Comparison& c) {
+  json j = {{"status", std::string(StatusName(c.status))},
+            {"contacts", c.contacts},
+            {"max_angle_difference_deg", c.max_angle_difference},
+            {"max_motor_difference", c.max_motor_difference},
+            {"agrees", Agrees(c)}};
+  if (!c.message.empty()) j["message"] = c.message;
+  return j;
 }
 
 std::vector<double> DefaultFrames(const std::vector<double>& at) {
@@ -250,14 +266,10 @@ int RunFinger(const FingerArgs& args) {
     for (int i = 0; i < 3 && !geometric; ++i) {
       system.SetParameter("gob" + std::to_string(i + 1), std::min(contacts.gob[i], 256.0));
     }
-    const Comparison c = SimulateClosing(system, {""}, {{"u", 255.0}}, {true},
+    const Comparison c = SimulateClosing(system, {""}, {{"u", 255.0}}, {closed.stop()}, {true},
                                          [&](int, double g) { return closed.At(g).theta; });
-    const bool agrees = c.status == SimulationStatus::kCompleted && c.max_difference <= kAgreement;
-    report["simulation"] = {{"status", std::string(StatusName(c.status))},
-                            {"contacts", c.contacts},
-                            {"max_angle_difference_deg", c.max_difference},
-                            {"agrees", agrees}};
-    if (!c.message.empty()) report["simulation"]["message"] = c.message;
+    report["simulation"] = SimulationJson(c);
+    const bool agrees = Agrees(c);
     if (!agrees) code = kExitDisagrees;
   }
   std::vector<std::pair<std::string, std::string>> files;
@@ -382,21 +394,20 @@ int RunHand(const HandArgs& args) {
     // only): fingers involved in one are not compared.
     std::vector<bool> compare(3, true);
     for (const auto& t : hand->touches()) compare[t.finger_a] = compare[t.finger_b] = false;
+    std::vector<double> stops;
+    for (int f = 0; f < 3; ++f) stops.push_back(hand->finger(f).closed_form().stop());
     const Comparison c = SimulateClosing(
-        system, {"A.", "B.", "C."}, inputs, compare,
+        system, {"A.", "B.", "C."}, inputs, stops, compare,
         [&](int f, double g) { return hand->finger(f).At(std::min(g, commands[f])).theta; });
-    const bool agrees = c.status == SimulationStatus::kCompleted && c.max_difference <= kAgreement;
+    const bool agrees = Agrees(c);
     json compared = json::array();
     for (int f = 0; f < 3; ++f) {
       if (compare[f]) compared.push_back(std::string(1, names[f]));
     }
+    report["simulation"] = SimulationJson(c);
+    report["simulation"]["compared_fingers"] = compared;
     // With every finger touching another there is nothing to compare: agrees is null.
-    report["simulation"] = {{"status", std::string(StatusName(c.status))},
-                            {"contacts", c.contacts},
-                            {"compared_fingers", compared},
-                            {"max_angle_difference_deg", c.max_difference},
-                            {"agrees", compared.empty() ? json(nullptr) : json(agrees)}};
-    if (!c.message.empty()) report["simulation"]["message"] = c.message;
+    if (compared.empty()) report["simulation"]["agrees"] = nullptr;
     if (!agrees) code = kExitDisagrees;
   }
   if (!args.draw.empty()) {
