@@ -219,6 +219,27 @@ void Automaton::SetGuard(TransitionId id, Constraint guard) {
   t.guard = std::move(guard);
 }
 
+void Automaton::SetInitialValue(int slot, const InitialValue& value) {
+  constexpr std::string_view kApi = "Automaton::SetInitialValue";
+  if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kVariable ||
+      value.slot != slot) {
+    Fail(kApi, "not a continuous variable, or the value is for another slot");
+  }
+  const std::string context = std::string(kApi) + ": value of '" + symbols_[slot].name + "'";
+  if (EvaluateConstant(value.range.lo, context) > EvaluateConstant(value.range.hi, context)) {
+    Fail(kApi, "empty initial range for '" + symbols_[slot].name + "'");
+  }
+  for (InitialState& state : initial_states_) {
+    auto it = std::lower_bound(state.values.begin(), state.values.end(), slot,
+                               [](const InitialValue& v, int s) { return v.slot < s; });
+    if (it != state.values.end() && it->slot == slot) {
+      *it = value;
+    } else {
+      state.values.insert(it, value);
+    }
+  }
+}
+
 void Automaton::AddInitialState(InitialState state) {
   constexpr std::string_view kApi = "Automaton::AddInitialState";
   if (!state.mode.is_valid() || state.mode.value() >= num_modes()) Fail(kApi, "unknown mode");

@@ -91,6 +91,11 @@ class Automaton {
   /// from geometry). Throws std::invalid_argument ("Automaton::SetGuard: ...") for an unknown
   /// transition or a guard reading undeclared slots.
   void SetGuard(TransitionId id, Constraint guard);
+  /// Sets the initial value of continuous variable `slot` in every initial state (replacing it
+  /// where given): for a variable added after the initial states. Throws std::invalid_argument
+  /// ("Automaton::SetInitialValue: ...") if `slot` is not a continuous variable or `value` is
+  /// empty or reads anything but parameters.
+  void SetInitialValue(int slot, const InitialValue& value);
   /// Every continuous variable must get exactly one value; bounds read parameters only.
   void AddInitialState(InitialState state);
   /// Comparisons may read variables, discrete variables and parameters, not inputs; `in` atoms

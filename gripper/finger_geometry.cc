@@ -44,6 +44,23 @@ std::array<Segment2, 3> FingerGeometry::Links(const Eigen::Vector3d& theta) cons
   return {Segment2{p[0], p[1]}, Segment2{p[1], p[2]}, Segment2{p[2], p[3]}};
 }
 
+std::array<std::array<Expression, 2>, 4> FingerGeometry::LocalPointExpressions(
+    const std::array<Expression, 3>& theta) const {
+  using E = Expression;
+  const E to_rad = E::Constant(std::numbers::pi / 180.0);
+  const std::array<E, 3> phi = {theta[0] * to_rad, (theta[0] + theta[1]) * to_rad,
+                                (theta[0] + theta[1] + theta[2]) * to_rad};
+  const std::array<double, 3> length = {lengths_.proximal, lengths_.medial, lengths_.distal};
+  std::array<std::array<E, 2>, 4> p;
+  p[0] = {E::Constant(0.0), E::Constant(0.0)};
+  for (int k = 0; k < 3; ++k) {
+    const E x = E::Constant(length[k]) * E::Unary(Op::kSin, phi[k]);
+    const E y = E::Constant(length[k]) * E::Unary(Op::kCos, phi[k]);
+    p[k + 1] = {k == 0 ? x : p[k][0] + x, k == 0 ? y : p[k][1] + y};
+  }
+  return p;
+}
+
 std::array<Segment2, 3> FingerGeometry::ContactSegments(const Eigen::Vector3d& theta) const {
   const auto p = LocalPoints(theta);
   std::array<Segment2, 3> links;

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <Eigen/Core>
+
+#include "automaton/expression.h"
 #include <array>
 
 namespace hybrid::gripper {
@@ -59,6 +61,10 @@ class FingerGeometry {
   /// object at the knuckle for a whole interval of g: a contact with no crossing.)
   std::array<Segment2, 3> ContactSegments(const Eigen::Vector3d& theta) const;
   static constexpr double kJointMargin = 0.002;
+  /// Points() in the finger's own frame (placement ignored) as expressions of the joint-angle
+  /// expressions `theta` (degrees): {x, y} of joint 1, joint 2, joint 3 and the fingertip.
+  std::array<std::array<Expression, 2>, 4> LocalPointExpressions(
+      const std::array<Expression, 3>& theta) const;
   /// Height of the palm surface (negative: below joint 1).
   double palm_y() const { return palm_y_; }
   const FingerLengths& lengths() const { return lengths_; }

@@ -134,18 +134,11 @@ Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obsta
   }
   using E = Expression;
   const E to_rad = E::Constant(std::numbers::pi / 180.0);
-  const E phi1 = theta[0] * to_rad;
   const E phi2 = (theta[0] + theta[1]) * to_rad;
   const E phi3 = (theta[0] + theta[1] + theta[2]) * to_rad;
-  const FingerLengths& l = geometry.lengths();
+  const auto points = geometry.LocalPointExpressions(theta);
   std::array<E, 4> x, y;
-  x[0] = E::Constant(0.0), y[0] = E::Constant(0.0);
-  x[1] = E::Constant(l.proximal) * E::Unary(Op::kSin, phi1);
-  y[1] = E::Constant(l.proximal) * E::Unary(Op::kCos, phi1);
-  x[2] = x[1] + E::Constant(l.medial) * E::Unary(Op::kSin, phi2);
-  y[2] = y[1] + E::Constant(l.medial) * E::Unary(Op::kCos, phi2);
-  x[3] = x[2] + E::Constant(l.distal) * E::Unary(Op::kSin, phi3);
-  y[3] = y[2] + E::Constant(l.distal) * E::Unary(Op::kCos, phi3);
+  for (int k = 0; k < 4; ++k) x[k] = points[k][0], y[k] = points[k][1];
   // Contact segments (FingerGeometry::ContactSegments): links 2 and 3 start kJointMargin after
   // their joint.
   const E margin = E::Constant(FingerGeometry::kJointMargin);

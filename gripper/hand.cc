@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -163,6 +164,27 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
     fingers_ = build();
     g0 = first->g;
   }
+  // Closest approach of every pair of links of different fingers over the closing.
+  for (auto& a : closest_) {
+    for (auto& b : a) {
+      for (auto& c : b) c.fill(std::numeric_limits<double>::infinity());
+    }
+  }
+  for (double g = 0.0; g <= 255.0; g += 0.25) {
+    std::array<std::array<Eigen::Vector3d, 4>, 3> p;
+    for (int f = 0; f < 3; ++f) p[f] = Points(f, At(f, g).theta);
+    for (int f1 = 0; f1 < 3; ++f1) {
+      for (int l1 = 0; l1 < 3; ++l1) {
+        for (int f2 = 0; f2 < 3; ++f2) {
+          for (int l2 = 0; l2 < 3; ++l2) {
+            if (f1 == f2) continue;
+            double& d = closest_[f1][l1][f2][l2];
+            d = std::min(d, SegmentDistance3(p[f1][l1], p[f1][l1 + 1], p[f2][l2], p[f2][l2 + 1]));
+          }
+        }
+      }
+    }
+  }
 }
 
 FingerConfiguration Hand::At(int f, double g) const {
@@ -170,6 +192,74 @@ FingerConfiguration Hand::At(int f, double g) const {
     throw std::out_of_range("Hand::At: g = " + std::to_string(g) + " is outside [0, 255]");
   }
   return fingers_.at(f).At(std::min(g, commands_[f]));
+}
+
+namespace {
+
+using E = Expression;
+using Point3 = std::array<E, 3>;
+
+E Dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Point3 Minus(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+E Clamp01(const E& v) {
+  return E::Binary(Op::kMax, E::Constant(0.0), E::Binary(Op::kMin, E::Constant(1.0), v));
+}
+
+E Norm(const Point3& a) { return E::Unary(Op::kSqrt, Dot(a, a)); }
+
+// Distance from point p to segment [a, b] in space.
+E PointSegmentExpression(const Point3& p, const Point3& a, const Point3& b) {
+  const Point3 d = Minus(b, a);
+  const E t = Clamp01(Dot(Minus(p, a), d) / Dot(d, d));
+  return Norm(Point3{p[0] - (a[0] + t * d[0]), p[1] - (a[1] + t * d[1]), p[2] - (a[2] + t * d[2])});
+}
+
+// SegmentDistance3 as an expression, without nesting one clamp inside another (the expression
+// grows with the nesting): the distance is the smallest of the four end-point-to-segment
+// distances (the minimum on the border of [0, 1]^2) and, when the lines' closest points (u*, v*)
+// lie inside both segments, the distance between the lines |w . n| / |n|, n = d1 x d2. Outside,
+// that candidate gets a penalty of 1 m (sign() of how far outside), so the minimum is exact;
+// it is continuous because on the border the line distance equals the border's. For parallel
+// segments the ends decide, which is exact for them.
+E SegmentDistanceExpression(const Point3& p, const Point3& q, const Point3& r, const Point3& s) {
+  const Point3 d1 = Minus(q, p), d2 = Minus(s, r), w = Minus(p, r);
+  const E a = Dot(d1, d1), e = Dot(d2, d2), b = Dot(d1, d2), c = Dot(d1, w), f = Dot(d2, w);
+  // (a e - b^2 = |n|^2, floored so that parallel links give finite u, v.)
+  const E denominator = E::Binary(Op::kMax, a * e - b * b, E::Constant(1e-30));
+  const E u = (b * f - c * e) / denominator;
+  const E v = (a * f - b * c) / denominator;
+  const Point3 n = {d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2],
+                    d1[0] * d2[1] - d1[1] * d2[0]};
+  const E length = Norm(n);
+  const E line = E::Unary(Op::kAbs, Dot(w, n)) / E::Binary(Op::kMax, length, E::Constant(1e-9));
+  const E zero = E::Constant(0.0), one = E::Constant(1.0);
+  auto positive = [&](const E& x) { return E::Unary(Op::kSign, E::Binary(Op::kMax, zero, x)); };
+  auto outside = [&](const E& x) { return positive(zero - x) + positive(x - one); };
+  // Penalties of 1 m: (u*, v*) outside the segments, or the links (nearly) parallel
+  // (|n| < 1e-9 m^2, an angle below about 1e-6 rad for these links), where the ends decide.
+  const E interior = line + outside(u) + outside(v) + positive(E::Constant(1e-9) - length);
+  E d = E::Binary(Op::kMin, PointSegmentExpression(p, r, s), PointSegmentExpression(q, r, s));
+  d = E::Binary(Op::kMin, d, PointSegmentExpression(r, p, q));
+  d = E::Binary(Op::kMin, d, PointSegmentExpression(s, p, q));
+  return E::Binary(Op::kMin, d, interior);
+}
+
+}  // namespace
+
+std::array<std::array<Expression, 3>, 4> Hand::PointExpressions(
+    int f, const std::array<Expression, 3>& theta) const {
+  const auto local = FingerGeometry().LocalPointExpressions(theta);
+  const auto [origin, direction] = Frame(f);
+  std::array<std::array<Expression, 3>, 4> out;
+  for (int k = 0; k < 4; ++k) {
+    for (int axis = 0; axis < 3; ++axis) {
+      // origin + x_local * direction + y_local * unit y
+      E v = E::Constant(origin[axis]) + local[k][0] * E::Constant(direction[axis]);
+      if (axis == 1) v = v + local[k][1];
+      out[k][axis] = v.FoldConstants();
+    }
+  }
+  return out;
 }
 
 System Hand::ComposedAutomata(const System& hand_model, bool shared_command) const {
@@ -183,10 +273,64 @@ System Hand::ComposedAutomata(const System& hand_model, bool shared_command) con
     throw std::invalid_argument("Hand::ComposedAutomata: the model '" + hand_model.name() +
                                 "' has no automaton named 'finger'");
   }
+  const std::string names = "ABC";
   System system("hand");
   if (shared_command) system.Share("u");
+  for (int o = 0; o < 3; ++o) {
+    for (int k = 1; k <= 3; ++k)
+      system.Share(std::string(1, names[o]) + ".theta" + std::to_string(k));
+  }
   for (int f = 0; f < 3; ++f) {
-    system.AddComponent(std::string(1, "ABC"[f]), fingers_[f].ContactAutomaton(*finger));
+    Automaton a = fingers_[f].ContactAutomaton(*finger);
+    // Each finger reads the other fingers' joint angles: variables named "B.theta1", ...,
+    // shared, without flow here (their own instance gives it).
+    std::array<std::array<Expression, 3>, 3> theta;
+    for (int o = 0; o < 3; ++o) {
+      for (int k = 0; k < 3; ++k) {
+        const std::string local = "theta" + std::to_string(k + 1);
+        if (o == f) {
+          theta[o][k] = E::Symbol(local, *a.symbols().Find(local));
+        } else {
+          const std::string name = std::string(1, names[o]) + "." + local;
+          const int slot = a.AddVariable(name, "deg");
+          // Every finger starts open; the owner's initial state gives the same value.
+          a.SetInitialValue(slot, InitialValue{slot, Range{E::Constant(0.0), E::Constant(0.0)}});
+          theta[o][k] = E::Symbol(name, slot);
+        }
+      }
+    }
+    std::array<std::array<std::array<Expression, 3>, 4>, 3> points;
+    for (int o = 0; o < 3; ++o) points[o] = PointExpressions(o, theta[o]);
+    // Clearance of link i to the other fingers' links, in millimetres like the object guards.
+    // Only pairs that come within kCandidateMargin of touching on the quasistatic closing are
+    // included (the guards grow by thousands of nodes per pair): while the simulated path agrees
+    // with the quasistatic one, the others stay that far apart and cannot touch.
+    std::array<std::optional<E>, 3> clearance;
+    for (int i = 0; i < 3; ++i) {
+      std::optional<E> nearest;
+      for (int o = 0; o < 3; ++o) {
+        if (o == f) continue;
+        for (int j = 0; j < 3; ++j) {
+          if (closest_[f][i][o][j] > layout_.link_width + kCandidateMargin) continue;
+          const E d = SegmentDistanceExpression(points[f][i], points[f][i + 1], points[o][j],
+                                                points[o][j + 1]);
+          nearest = nearest ? E::Binary(Op::kMin, *nearest, d) : d;
+        }
+      }
+      if (nearest) {
+        clearance[i] = E::Constant(1000.0) * (*nearest - E::Constant(layout_.link_width));
+      }
+    }
+    for (int t = 0; t < a.num_transitions(); ++t) {
+      const Transition& tr = a.transitions()[t];
+      if (tr.label.size() != 8 || tr.label.rfind("contact", 0) != 0) continue;
+      const int i = tr.label[7] - '1';
+      if (!clearance[i]) continue;
+      Constraint guard = tr.guard;
+      guard.comparisons[0].lhs = E::Binary(Op::kMin, guard.comparisons[0].lhs, *clearance[i]);
+      a.SetGuard(TransitionId(t), std::move(guard));
+    }
+    system.AddComponent(std::string(1, names[f]), a);
   }
   if (spread != nullptr) system.AddComponent("S", *spread);
   return system;
@@ -197,21 +341,21 @@ FingerGeometry Hand::FingerGeometryOf(int f) const {
   return FingerGeometry({}, FingerPlacement{layout_.half_span, -std::cos(phi_ * kDeg)});
 }
 
-std::array<Eigen::Vector3d, 4> Hand::Points(int f, const Eigen::Vector3d& theta) const {
-  const auto local = FingerGeometry().Points(theta);
-  Eigen::Vector3d origin, direction;
+std::pair<Eigen::Vector3d, Eigen::Vector3d> Hand::Frame(int f) const {
   const double c = std::cos(phi_ * kDeg), s = std::sin(phi_ * kDeg);
   switch (f) {
     case 0:
-      origin = {-layout_.half_span, 0, 0}, direction = {1, 0, 0};
-      break;
+      return {{-layout_.half_span, 0, 0}, {1, 0, 0}};
     case 1:  // B, on the +z side, turned towards z = 0 for phi > 0
-      origin = {layout_.half_span, 0, layout_.lateral}, direction = {-c, 0, -s};
-      break;
+      return {{layout_.half_span, 0, layout_.lateral}, {-c, 0, -s}};
     default:  // C, on the -z side
-      origin = {layout_.half_span, 0, -layout_.lateral}, direction = {-c, 0, s};
-      break;
+      return {{layout_.half_span, 0, -layout_.lateral}, {-c, 0, s}};
   }
+}
+
+std::array<Eigen::Vector3d, 4> Hand::Points(int f, const Eigen::Vector3d& theta) const {
+  const auto local = FingerGeometry().Points(theta);
+  const auto [origin, direction] = Frame(f);
   std::array<Eigen::Vector3d, 4> out;
   for (int k = 0; k < 4; ++k) {
     out[k] = origin + local[k].x() * direction + local[k].y() * Eigen::Vector3d::UnitY();

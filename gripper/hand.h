@@ -88,16 +88,34 @@ class Hand {
   FingerGeometry FingerGeometryOf(int f) const;
 
   /// The hand as composed automata, for simulation: instances A, B and C of the automaton named
-  /// "finger" in `hand_model` (spec/hand.ha) with this hand's geometric contact guards
-  /// (GeometricFinger::ContactAutomaton: objects and palm, not the other fingers), and instance
-  /// S of its "spread" automaton if it has one. One motor command `u` shared by the fingers when
-  /// `shared_command`, else one per finger (A.u, B.u, C.u). Throws std::invalid_argument
+  /// "finger" in `hand_model` (spec/hand.ha) with this hand's geometric contact guards, and
+  /// instance S of its "spread" automaton if it has one. Contact guard of link i of a finger:
+  /// `1000 min(d_i, c_i) <= 0 and u > 0` with d_i its distance to the objects and the palm
+  /// (GeometricFinger::ContactAutomaton) and c_i the distance of its centre line to the other
+  /// fingers' links minus link_width (the finger-finger rule of this class). For that every
+  /// finger automaton declares the other fingers' joint angles as variables named "B.theta1",
+  /// ..., shared, without flow (their own instance gives it) and starting at 0 like the owner.
+  /// Only link pairs that come within 2 mm of touching on this quasistatic closing enter the
+  /// guards (the others stay that far apart as long as the simulation follows the same path). One
+  /// motor command `u` shared by the fingers when `shared_command`, else one per finger (A.u, B.u,
+  /// C.u). Throws std::invalid_argument
   /// ("Hand::ComposedAutomata: ...") if `hand_model` has no automaton named "finger".
   System ComposedAutomata(const System& hand_model, bool shared_command) const;
 
  private:
+  /// Origin and closing direction of finger f in space.
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> Frame(int f) const;
+  /// Points() as expressions of joint-angle expressions.
+  std::array<std::array<Expression, 3>, 4> PointExpressions(
+      int f, const std::array<Expression, 3>& theta) const;
+
+  static constexpr double kCandidateMargin = 0.002;
+
   std::vector<Obstacle> objects_;
   HandLayout layout_;
+  // closest_[f1][l1][f2][l2]: smallest distance between the centre lines of link l1 of finger f1
+  // and link l2 of finger f2 over the closing (sampled every 0.25 counts).
+  std::array<std::array<std::array<std::array<double, 3>, 3>, 3>, 3> closest_;
   std::array<double, 3> commands_;
   double phi_;
   std::vector<GeometricFinger> fingers_;
