@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -60,6 +61,62 @@ TEST_F(AutomatonTest, ParameterEnvironmentEvaluatesInOrder) {
   const std::vector<double> env = a_.ParameterEnvironment();
   EXPECT_DOUBLE_EQ(env[Slot("g2")], 19.62);
   EXPECT_DOUBLE_EQ(env[Slot("h")], 0.0);
+}
+
+// SetParameter replaces a parameter by a constant; parameters defined from it follow, and a
+// value that makes one of them non-finite is refused with the old value kept.
+TEST_F(AutomatonTest, SetParameterReplacesTheValueAndDependentsFollow) {
+  a_.AddParameter("inv_g", Expression::Constant(1) / Sym(a_, "g"));
+  a_.SetParameter("g", 2.0);
+  EXPECT_EQ(a_.ParameterEnvironment()[Slot("g")], 2.0);
+  EXPECT_EQ(a_.ParameterEnvironment()[Slot("inv_g")], 0.5);
+  ExpectInvalid([&] { a_.SetParameter("g", 0.0); }, "Automaton::SetParameter",
+                "makes parameter 'inv_g' non-finite");
+  EXPECT_EQ(a_.ParameterEnvironment()[Slot("g")], 2.0);
+  ExpectInvalid([&] { a_.SetParameter("h", 1.0); }, "Automaton::SetParameter",
+                "'h' is not a parameter");
+  ExpectInvalid([&] { a_.SetParameter("g", std::nan("")); }, "Automaton::SetParameter",
+                "not finite");
+}
+
+// SetGuard replaces a transition's guard, validated like AddTransition.
+TEST_F(AutomatonTest, SetGuardReplacesAGuard) {
+  const TransitionId t = a_.AddTransition(
+      Transition{"bounce", falling_, falling_, "", {}, {}, Urgency::kUrgent});
+  Constraint guard;
+  guard.comparisons.push_back({Sym(a_, "h"), Relation::kLessEqual, Expression::Constant(0)});
+  a_.SetGuard(t, guard);
+  EXPECT_EQ(a_.transition(t).guard, guard);
+  Constraint bad;
+  bad.comparisons.push_back(
+      {Expression::Symbol("ghost", 42), Relation::kLessEqual, Expression::Constant(0)});
+  ExpectInvalid([&] { a_.SetGuard(t, bad); }, "Automaton::SetGuard", "guard of 'bounce'");
+  ExpectInvalid([&] { a_.SetGuard(TransitionId(7), guard); }, "Automaton::SetGuard",
+                "unknown transition");
+}
+
+// SetInitialValue gives a variable added after the initial states its value in every one.
+TEST_F(AutomatonTest, SetInitialValueCompletesInitialStates) {
+  const Expression zero = Expression::Constant(0);
+  a_.AddInitialState({falling_,
+                      {{Slot("h"), {Expression::Constant(10), Expression::Constant(10)}, true},
+                       {Slot("v"), {zero, zero}, true}}});
+  const int w = a_.AddVariable("w");
+  a_.SetInitialValue(w, {w, {Expression::Constant(3), Expression::Constant(3)}, true});
+  ASSERT_EQ(a_.initial_states()[0].values.size(), 3u);
+  EXPECT_EQ(a_.initial_states()[0].values[2].slot, w);
+  EXPECT_EQ(a_.initial_states()[0].values[2].range.lo, Expression::Constant(3));
+  // Replacing keeps one value per variable, sorted by slot.
+  a_.SetInitialValue(Slot("h"), {Slot("h"), {zero, zero}, true});
+  EXPECT_EQ(a_.initial_states()[0].values.size(), 3u);
+  EXPECT_EQ(a_.initial_states()[0].values[0].range.lo, zero);
+  ExpectInvalid([&] { a_.SetInitialValue(Slot("g"), {Slot("g"), {zero, zero}, true}); },
+                "Automaton::SetInitialValue", "not a continuous variable");
+  ExpectInvalid(
+      [&] {
+        a_.SetInitialValue(w, {w, {Expression::Constant(2), Expression::Constant(1)}, false});
+      },
+      "Automaton::SetInitialValue", "empty initial range");
 }
 
 TEST_F(AutomatonTest, RejectsDuplicateNames) {

@@ -156,6 +156,28 @@ TEST(System, DuplicateInstanceIsAnError) {
   EXPECT_EQ(s.components().size(), 1u);
 }
 
+// SetParameter sets a qualified parameter in its component only, and a shared one everywhere.
+TEST(System, SetParameterByQualifiedOrSharedName) {
+  const Automaton tank = Parse(kTank);
+  System s("plant");
+  s.AddComponent("A", tank);
+  s.AddComponent("B", tank);
+  s.SetParameter("A.k", 5.0);
+  EXPECT_EQ(s.components()[0].automaton.ParameterEnvironment()[0], 5.0);
+  EXPECT_EQ(s.components()[0].source.ParameterEnvironment()[0], 5.0);  // printed back as set
+  EXPECT_EQ(s.components()[1].automaton.ParameterEnvironment()[0], 2.0);
+  EXPECT_THROW(s.SetParameter("k", 1.0), std::invalid_argument);  // no component has plain k
+  EXPECT_THROW(s.SetParameter("A.x", 1.0), std::invalid_argument);  // a variable
+  System shared("plant");
+  shared.Share("k");
+  shared.AddComponent("A", tank);
+  shared.AddComponent("B", tank);
+  shared.SetParameter("k", 7.0);
+  for (const Component& c : shared.components()) {
+    EXPECT_EQ(c.automaton.ParameterEnvironment()[0], 7.0);
+  }
+}
+
 TEST(System, SharedVariablesAndInputsAreOneSymbol) {
   const Automaton tank = Parse(kTank);
   const Automaton reader = Parse(R"(

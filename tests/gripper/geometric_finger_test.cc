@@ -21,19 +21,6 @@ Eigen::Vector2d Polar(double rho, double alpha_deg) {
   return rho * Eigen::Vector2d(std::sin(alpha_deg * kDeg), std::cos(alpha_deg * kDeg));
 }
 
-TEST(FingerGeometryTest, ForwardKinematics) {
-  const FingerGeometry f;
-  const auto open = f.Points(Eigen::Vector3d::Zero());
-  EXPECT_NEAR(open[3].y(), 0.05715 + 0.03894 + 0.038, 1e-15);
-  EXPECT_NEAR(open[3].x(), 0.0, 1e-15);
-  // Phase 1 keeps link 3 vertical.
-  const auto p = f.Points(Eigen::Vector3d(30, 0, -30));
-  EXPECT_NEAR(p[3].x(), p[2].x(), 1e-15);
-  // Decision G1: the palm is where the fingertip is at (70, 90, -55).
-  EXPECT_NEAR(f.palm_y(), -0.0269, 5e-5);
-  EXPECT_EQ(f.palm_y(), f.Points(Eigen::Vector3d(70, 90, -55))[3].y());
-}
-
 // A circle met by link 1 in phase 1: the perpendicular distance from its centre (rho, alpha) to
 // link 1 equals the radius when theta1 = alpha - asin(r / rho), so gob1 = theta1 / m1.
 TEST(GeometricFingerTest, CircleOnLink1AtTheAnalyticMotorPosition) {
