@@ -80,12 +80,12 @@ void BM_HandClosing(benchmark::State& state) {
 }
 BENCHMARK(BM_HandClosing)->Unit(benchmark::kMillisecond);
 
-// The same closing simulated: three finger automata with distance guards (objects and palm)
-// composed with the spread automaton of spec/hand.ha, one shared command u = 1 until 255. The
-// Simulator is built once; each iteration is one run.
-void BM_HandClosingSimulated(benchmark::State& state) {
-  const Hand hand({Obstacle::Circle({0.0, 0.06}, 0.02)}, Hand::SpreadPosition(SpreadMode::kBasic),
-                  {255, 255, 255});
+// The same closing simulated: three finger automata with distance guards (objects, palm and,
+// for link pairs that come within 2 mm, the other fingers) composed with the spread automaton of
+// spec/hand.ha, one shared command u = 1 until 255. The Simulator is built once; each iteration
+// is one run. Basic mode (no finger touches) and pinch mode (fingers touch each other).
+void HandClosingSimulated(benchmark::State& state, double spread) {
+  const Hand hand({Obstacle::Circle({0.0, 0.06}, 0.02)}, spread, {255, 255, 255});
   const hybrid::System system = hand.ComposedAutomata(
       hybrid::ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha"), true);
   const hybrid::Simulator simulator(system);
@@ -104,8 +104,16 @@ void BM_HandClosingSimulated(benchmark::State& state) {
   }
   state.counters["events"] = static_cast<double>(check.events.size());
   state.counters["steps"] = static_cast<double>(check.steps);
+  state.counters["touches"] = static_cast<double>(hand.touches().size());
+}
+void BM_HandClosingSimulated(benchmark::State& state) {
+  HandClosingSimulated(state, Hand::SpreadPosition(SpreadMode::kBasic));
 }
 BENCHMARK(BM_HandClosingSimulated)->Unit(benchmark::kMillisecond);
+void BM_HandClosingSimulated_Pinch(benchmark::State& state) {
+  HandClosingSimulated(state, Hand::SpreadPosition(SpreadMode::kPinch));
+}
+BENCHMARK(BM_HandClosingSimulated_Pinch)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
