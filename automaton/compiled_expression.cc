@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace hybrid {
 
@@ -37,6 +38,8 @@ enum class CompiledExpression::Code : std::uint32_t {
   kRSubV,  // acc = env[slot] - acc
   kRDivC,
   kRDivV,
+  kStoreR,  // registers[slot] = acc (a shared subexpression, computed once)
+  kLoadR,   // push acc; acc = registers[slot]
   kEnd,
 };
 #undef HYBRID_BINARY_CODES
@@ -109,8 +112,25 @@ double PowInt(double x, int n) {
 CompiledExpression::CompiledExpression() : CompiledExpression(Expression::Constant(0.0)) {}
 
 CompiledExpression::CompiledExpression(const Expression& expression) {
+  // Count the parents of every node of the DAG (children are visited once, on the first visit);
+  // nodes with several parents get a register.
+  std::unordered_map<const void*, int> parents;
+  std::vector<const Expression*> todo = {&expression};
+  while (!todo.empty()) {
+    const Expression* e = todo.back();
+    todo.pop_back();
+    for (const Expression& a : e->args()) {
+      if (a.is_constant() || a.is_symbol()) continue;
+      if (parents[a.node_id()]++ == 0) todo.push_back(&a);
+    }
+  }
+  for (const auto& [id, count] : parents) {
+    if (count > 1) registers_.emplace(id, -1);
+  }
   Emit(expression, 1);
   code_.push_back({Code::kEnd, 0, 0.0});
+  num_registers_ = next_register_;
+  registers_.clear();
 }
 
 // Emits code that leaves the value of `e` in the accumulator; `depth` counts the stack entries
@@ -127,6 +147,23 @@ void CompiledExpression::Emit(const Expression& e, int depth) {
     default:
       break;
   }
+  // A shared subexpression: computed the first time, then read from its register.
+  auto shared = registers_.find(e.node_id());
+  if (shared != registers_.end()) {
+    if (shared->second >= 0) {
+      code_.push_back({Code::kLoadR, shared->second, 0.0});
+      return;
+    }
+    EmitOperation(e, depth);
+    shared->second = next_register_++;
+    code_.push_back({Code::kStoreR, shared->second, 0.0});
+    return;
+  }
+  EmitOperation(e, depth);
+}
+
+// Emits the operation of the non-leaf `e` (its arguments through Emit).
+void CompiledExpression::EmitOperation(const Expression& e, int depth) {
   Emit(e.args()[0], depth);
   if (Arity(e.op()) == 1) {
     code_.push_back({UnaryCode(e.op()), 0, 0.0});
@@ -183,22 +220,24 @@ void CompiledExpression::Emit(const Expression& e, int depth) {
 }
 
 double CompiledExpression::Evaluate(const double* env) const {
-  if (max_depth_ <= kMaxInlineStack) {
-    double stack[kMaxInlineStack];
-    return Run(env, stack);
+  // The value stack, then the registers, in one buffer.
+  const int size = max_depth_ + num_registers_;
+  if (size <= kMaxInlineStack) {
+    double buffer[kMaxInlineStack];
+    return Run(env, buffer, buffer + max_depth_);
   }
-  std::vector<double> stack(max_depth_);
-  return Run(env, stack.data());
+  std::vector<double> buffer(size);
+  return Run(env, buffer.data(), buffer.data() + max_depth_);
 }
 
-double CompiledExpression::Run(const double* env, double* stack) const {
+double CompiledExpression::Run(const double* env, double* stack, double* registers) const {
   // Direct threading (GCC/Clang "labels as values"): each handler jumps straight to the next.
   static const void* const kDispatch[] = {
-      &&push_c,  &&push_v,  &&neg,    &&sin_,   &&cos_,   &&tan_,   &&exp_,  &&log_,  &&sqrt_,
-      &&abs_,    &&sign_,   &&sq,     &&cube,   &&powint, &&add_s,  &&add_c, &&add_v, &&sub_s,
-      &&sub_c,   &&sub_v,   &&mul_s,  &&mul_c,  &&mul_v,  &&div_s,  &&div_c, &&div_v, &&pow_s,
-      &&pow_c,   &&pow_v,   &&min_s,  &&min_c,  &&min_v,  &&max_s,  &&max_c, &&max_v, &&atan2_s,
-      &&atan2_c, &&atan2_v, &&rsub_c, &&rsub_v, &&rdiv_c, &&rdiv_v, &&end};
+      &&push_c,  &&push_v,  &&neg,    &&sin_,   &&cos_,   &&tan_,   &&exp_,    &&log_,   &&sqrt_,
+      &&abs_,    &&sign_,   &&sq,     &&cube,   &&powint, &&add_s,  &&add_c,   &&add_v,  &&sub_s,
+      &&sub_c,   &&sub_v,   &&mul_s,  &&mul_c,  &&mul_v,  &&div_s,  &&div_c,   &&div_v,  &&pow_s,
+      &&pow_c,   &&pow_v,   &&min_s,  &&min_c,  &&min_v,  &&max_s,  &&max_c,   &&max_v,  &&atan2_s,
+      &&atan2_c, &&atan2_v, &&rsub_c, &&rsub_v, &&rdiv_c, &&rdiv_v, &&store_r, &&load_r, &&end};
   static_assert(sizeof(kDispatch) / sizeof(kDispatch[0]) ==
                 static_cast<std::size_t>(Code::kEnd) + 1);
   const Instruction* pc = code_.data();
@@ -290,6 +329,13 @@ rdiv_c:
   NEXT;
 rdiv_v:
   acc = env[pc->slot] / acc;
+  NEXT;
+store_r:
+  registers[pc->slot] = acc;
+  NEXT;
+load_r:
+  *sp++ = acc;
+  acc = registers[pc->slot];
   NEXT;
 end:
   return acc;

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "automaton/expression.h"
@@ -16,6 +17,10 @@ namespace hybrid {
 /// than kMaxInlineStack use a heap buffer). Binary operations whose right operand is a constant
 /// or a symbol read it straight from the instruction, and `x^n` for a small integer constant n
 /// becomes repeated multiplication.
+///
+/// A subexpression shared by several parents (Expression::node_id, e.g. a point of a linkage used
+/// in several distances) is computed once into a register and then read from it, so the program
+/// is linear in the number of distinct nodes.
 ///
 /// The result equals Expression::Evaluate bit for bit, except that `x^n` with integer n in
 /// [-4, 4] is computed by multiplication (like the C++ compilers' own expansion of std::pow with
@@ -45,10 +50,15 @@ class CompiledExpression {
     double value;
   };
   void Emit(const Expression& e, int depth);
-  double Run(const double* env, double* stack) const;
+  void EmitOperation(const Expression& e, int depth);
+  double Run(const double* env, double* stack, double* registers) const;
 
   std::vector<Instruction> code_;
   int max_depth_ = 0;
+  int num_registers_ = 0;
+  // While compiling: register of each shared node (-1 until its value has been computed).
+  std::unordered_map<const void*, int> registers_;
+  int next_register_ = 0;
 };
 
 }  // namespace hybrid

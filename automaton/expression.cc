@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace hybrid {
 
@@ -231,7 +232,9 @@ AffineForm Combine(const AffineForm& a, const AffineForm& b, double sign) {
 /// FoldConstants() of `e`, with the value of `e` when it reads no symbol. A symbol-free subtree
 /// whose value is not finite stays unfolded but still passes its value up, so that a finite
 /// result above it (`sign(log(0))`, `min(1 / 0, 2)`) folds like any other symbol-free subtree.
-std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e) {
+using FoldMemo = std::unordered_map<const void*, std::pair<Expression, std::optional<double>>>;
+
+std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e, FoldMemo& memo) {
   switch (e.op()) {
     case Op::kConstant:
       return {e, e.constant()};
@@ -240,21 +243,48 @@ std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e) 
     default:
       break;
   }
+  if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
   std::vector<Expression> args;
   std::vector<double> values;
   for (const Expression& a : e.args()) {
-    auto [folded, value] = FoldWithValue(a);
+    auto [folded, value] = FoldWithValue(a, memo);
     args.push_back(std::move(folded));
     if (value) values.push_back(*value);
   }
   const bool unary = Arity(e.op()) == 1;
   std::optional<double> value;
+  std::pair<Expression, std::optional<double>> out;
   if (values.size() == args.size()) {
     value = unary ? ApplyUnary(e.op(), values[0]) : ApplyBinary(e.op(), values[0], values[1]);
-    if (std::isfinite(*value)) return {Expression::Constant(*value), value};
   }
-  return {unary ? Expression::Unary(e.op(), args[0]) : Expression::Binary(e.op(), args[0], args[1]),
-          value};
+  if (value && std::isfinite(*value)) {
+    out = {Expression::Constant(*value), value};
+  } else {
+    out = {
+        unary ? Expression::Unary(e.op(), args[0]) : Expression::Binary(e.op(), args[0], args[1]),
+        value};
+  }
+  memo.emplace(e.node_id(), out);
+  return out;
+}
+
+using SubstituteMemo = std::unordered_map<const void*, Expression>;
+
+Expression SubstituteShared(
+    const Expression& e, const std::function<std::optional<Expression>(const std::string&, int)>& f,
+    SubstituteMemo& memo) {
+  if (e.op() == Op::kConstant) return e;
+  if (e.op() == Op::kSymbol) {
+    auto replacement = f(e.symbol_name(), e.slot());
+    return replacement ? *replacement : e;
+  }
+  if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
+  Expression out = Arity(e.op()) == 1
+                       ? Expression::Unary(e.op(), SubstituteShared(e.args()[0], f, memo))
+                       : Expression::Binary(e.op(), SubstituteShared(e.args()[0], f, memo),
+                                            SubstituteShared(e.args()[1], f, memo));
+  memo.emplace(e.node_id(), out);
+  return out;
 }
 
 }  // namespace
@@ -529,17 +559,14 @@ std::optional<AffineForm> Expression::AsAffine() const {
 
 Expression Expression::Substitute(
     const std::function<std::optional<Expression>(const std::string&, int)>& f) const {
-  const Node& n = *node_;
-  if (n.op == Op::kConstant) return *this;
-  if (n.op == Op::kSymbol) {
-    auto replacement = f(n.name, n.slot);
-    return replacement ? *replacement : *this;
-  }
-  if (Arity(n.op) == 1) return Unary(n.op, n.args[0].Substitute(f));
-  return Binary(n.op, n.args[0].Substitute(f), n.args[1].Substitute(f));
+  SubstituteMemo memo;
+  return SubstituteShared(*this, f, memo);
 }
 
-Expression Expression::FoldConstants() const { return FoldWithValue(*this).first; }
+Expression Expression::FoldConstants() const {
+  FoldMemo memo;
+  return FoldWithValue(*this, memo).first;
+}
 
 std::string Expression::ToString() const {
   std::string out;

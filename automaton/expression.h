@@ -91,6 +91,10 @@ class Expression {
   int slot() const;
   /// The arguments (empty for leaves).
   std::span<const Expression> args() const;
+  /// Identity of the shared, immutable node behind this expression: equal for copies of one
+  /// expression and for a subexpression used in several places (expressions built from shared
+  /// parts are DAGs). CompiledExpression uses it to evaluate a shared subexpression once.
+  const void* node_id() const { return node_.get(); }
 
   /// Reference evaluation by walking the tree; `env[slot]` must exist for every slot read.
   double Evaluate(std::span<const double> env) const;
@@ -107,9 +111,12 @@ class Expression {
   /// Constant subexpressions are folded, so `2 * (x + 3) / 4` is 0.5 x + 1.5.
   std::optional<AffineForm> AsAffine() const;
   /// Replaces each symbol for which `f(name, slot)` returns an expression; other symbols stay.
+  /// A subexpression shared in this expression is rewritten once and stays shared (so the cost
+  /// is linear in the number of distinct nodes, not in the size of the expanded tree).
   Expression Substitute(
       const std::function<std::optional<Expression>(const std::string&, int)>& f) const;
-  /// Folds every subtree without symbols into a constant (when the result is finite).
+  /// Folds every subtree without symbols into a constant (when the result is finite). Shared
+  /// subexpressions stay shared, as in Substitute.
   Expression FoldConstants() const;
 
   /// The expression in the model language, with the fewest parentheses that parse back to the

@@ -24,6 +24,9 @@ const Expression y = Expression::Symbol("y", 1);
 const Expression z = Expression::Symbol("z", 2);
 const Expression w = Expression::Symbol("w", 3);
 
+// One more level of the chain e * e + e (shares e three times).
+Expression E2(const Expression& e) { return e * e + e; }
+
 Expression C(double v) { return Expression::Constant(v); }
 
 /// Same bits, or both NaN (NaN payloads and signs are not specified by the C library).
@@ -199,6 +202,31 @@ std::vector<double> RandomEnvironment() {
   return env;
 }
 
+// A subexpression shared by several parents is computed once: the chain e_{k+1} = e_k * e_k + e_k
+// has 2^k leaves when expanded but k distinct nodes, and the program stays linear in k.
+TEST(CompiledExpressionTest, SharedSubexpressionsAreComputedOnce) {
+  Expression e = x + y;
+  double expected = 0.3 + 0.4;
+  for (int k = 0; k < 12; ++k) {
+    e = e * e + e;
+    expected = expected * expected + expected;
+  }
+  const CompiledExpression c(e);
+  EXPECT_LT(c.size(), 12 * 8);
+  const std::vector<double> env = {0.3, 0.4};
+  EXPECT_EQ(c(env), e.Evaluate(env));  // the tree walk (4096 leaves) gives the same bits
+  EXPECT_EQ(c(env), expected);
+  // Sixty levels: 2^60 leaves expanded; Substitute and FoldConstants keep the sharing.
+  for (int k = 0; k < 48; ++k) e = E2(e);
+  const Expression renamed = e.Substitute([](const std::string&, int slot) {
+    return std::optional<Expression>(Expression::Symbol(slot == 0 ? "a" : "b", 1 - slot));
+  });
+  const CompiledExpression big(renamed.FoldConstants());
+  EXPECT_LT(big.size(), 60 * 8);
+  const std::vector<double> small = {1e-3, 0.0};  // a = x (slot 1), b = y (slot 0)
+  EXPECT_TRUE(std::isfinite(big(small)));
+}
+
 RC_GTEST_PROP(CompiledExpressionProperty, EvaluatesLikeTheTreeBitForBit, ()) {
   const Expression e = *GenExpression(6);
   const CompiledExpression c(e);
@@ -209,6 +237,22 @@ RC_GTEST_PROP(CompiledExpressionProperty, EvaluatesLikeTheTreeBitForBit, ()) {
     const double actual = c.Evaluate(env.data());
     RC_ASSERT(SameDouble(actual, Reference(e, env)));
     if (exact) RC_ASSERT(SameDouble(actual, e.Evaluate(env)));
+  }
+}
+
+// Random DAGs: two random expressions, each used several times (shared nodes), give the same
+// bits compiled as walked.
+RC_GTEST_PROP(CompiledExpressionProperty, SharedSubexpressionsEvaluateLikeTheTree, ()) {
+  const Expression e = *GenExpression(4);
+  const Expression f = *GenExpression(4);
+  RC_PRE(!HasSmallIntegerPower(e) && !HasSmallIntegerPower(f));
+  const Expression ef = e * f;
+  const Expression dag =
+      Expression::Binary(Op::kMin, ef + e, ef - f) / (Expression::Unary(Op::kAbs, e) + ef);
+  const CompiledExpression c(dag);
+  for (int k = 0; k < 8; ++k) {
+    const std::vector<double> env = RandomEnvironment();
+    RC_ASSERT(SameDouble(c.Evaluate(env.data()), dag.Evaluate(env)));
   }
 }
 
