@@ -60,7 +60,9 @@ std::string FingerModeName(const FingerConfiguration& q);
 ///   the configuration no longer changes and `motor` stays at the stopping position.
 ///
 /// Events at the same g are taken in the model's declaration order (contact before limit, link 1
-/// before 2 before 3), as the simulator does. Every value is finite for every g in [0, 255],
+/// before 2 before 3), as the simulator does for events at exactly the same instant. (A contact
+/// that coincides with theta3 reaching theta3_max in phase 3, a root found numerically, may be
+/// taken in the other order by the simulator: the angles agree, the flags differ.) Every value is finite for every g in [0, 255],
 /// including g = 255 (the report's law divides by 255 - g; the pieces end before that except
 /// when g_s = 255, where theta3 stays at theta3_s).
 class FingerClosedForm {

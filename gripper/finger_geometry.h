@@ -1,9 +1,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 #include "automaton/expression.h"
-#include <array>
 
 namespace hybrid::gripper {
 

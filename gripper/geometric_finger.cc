@@ -9,13 +9,15 @@
 namespace hybrid::gripper {
 
 GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeometry& geometry,
-                                 const FingerParameters& parameters, const FingerContacts& imposed)
+                                 const FingerParameters& parameters, const FingerContacts& imposed,
+                                 double up_to)
     : objects_(std::move(objects)),
       geometry_(geometry),
       parameters_(parameters),
       closed_form_(FingerContacts{}, parameters) {
   const Obstacle palm_bar = palm();
-  const auto open_links = geometry_.ContactSegments(Eigen::Vector3d::Zero());
+  // The whole links (knuckles included) must be clear of the objects at g = 0.
+  const auto open_links = geometry_.Links(Eigen::Vector3d::Zero());
   for (size_t k = 0; k < objects_.size(); ++k) {
     const Obstacle& o = objects_[k];
     const double lowest = std::min(o.a().y(), o.b().y()) - o.radius();
@@ -41,17 +43,31 @@ GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeom
   double g = 0.0;
   for (int round = 0; round < 3; ++round) {
     const FingerClosedForm cf(contacts, parameters_);
-    const double end = std::min(cf.stop(), parameters_.motor_max);
-    // Sample points: a regular grid plus every breakpoint, in [g, end].
-    std::vector<double> grid;
-    for (double s = g; s < end; s += kResolution) grid.push_back(s);
+    const double end = std::min({cf.stop(), parameters_.motor_max, up_to});
+    // Sample points in [g, end]: every kResolution counts, except in phase 3, where theta3's
+    // rate grows without bound towards g = 255 and the samples are every kResolution * m1
+    // degrees of theta3 instead (so no joint turns more than 0.045 degrees between samples);
+    // plus every breakpoint.
+    std::vector<double> grid = {g, end};
     for (const auto& piece : cf.pieces()) {
-      for (double b : {piece.g0, piece.g1}) {
-        if (b > g && b < end) grid.push_back(b);
+      const double lo = std::max(piece.g0, g), hi = std::min(piece.g1, end);
+      if (lo >= hi) continue;
+      grid.push_back(lo);
+      grid.push_back(hi);
+      if (piece.phase != FingerPhase::k3) {
+        for (double s = lo; s < hi; s += kResolution) grid.push_back(s);
+        continue;
+      }
+      // theta3 = theta3_s + span3 phi with phi = (g - g0) / (255 - g), so g = (g0 + 255 phi) /
+      // (1 + phi).
+      const double step = kResolution * parameters_.m1() / piece.span3;
+      for (double phi = 0.0; phi < 1.0; phi += step) {
+        const double s = (piece.g0 + parameters_.motor_max * phi) / (1.0 + phi);
+        if (s > lo && s < hi) grid.push_back(s);
       }
     }
-    grid.push_back(end);
     std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
     struct Hit {
       double g;
       int link;

@@ -19,23 +19,28 @@ namespace hybrid::gripper {
 /// the signed distance from its contact segment (FingerGeometry::ContactSegments) to some
 /// obstacle reaches 0 while it moves; the closed form is then
 /// continued with that contact (FingerClosedForm), and the search goes on for the other links.
-/// The search samples the path every kResolution counts (and at every breakpoint) and bisects
-/// each sign change to 1e-10 counts, so a contact is missed only if a link enters and leaves an
-/// object between two samples (a graze shallower than the motion of 0.05 counts, at most
-/// 0.045 degrees of a joint). Contacts with the palm at or after the free-space stop (g = 240,
-/// decision D3, where the fingertip touches the palm by construction) are not counted.
+/// The search samples the path every kResolution counts (in phase 3, whose theta3 rate grows
+/// without bound towards g = 255, every 0.025 degrees of theta3), so no point of the finger
+/// moves more than 0.105 mm between samples, and it bisects each sign change to 1e-10 counts.
+/// Objects are at least 0.2 mm across (Obstacle::kMinimumRadius), so a link cannot cross one
+/// between samples; a contact is missed only if a link dips into an object by less than its
+/// motion between two samples and leaves again (a graze). Contacts with the palm at or after
+/// the free-space stop (g = 240, decision D3, where the fingertip touches the palm by
+/// construction) are not counted.
 class GeometricFinger {
  public:
   static constexpr double kResolution = 0.05;
 
   /// `imposed`: contacts found outside this finger (another finger touching link i at
   /// imposed.gob[i], see gripper/hand.h); each competes with the geometric contacts (the first
-  /// one blocks the link). Throws std::invalid_argument ("GeometricFinger: ...") if an object
-  /// overlaps the palm or the open finger (g = 0).
+  /// one blocks the link). `up_to`: contacts are searched for motor positions up to this one
+  /// (the motor command; the closed form beyond it assumes no further contact). Throws
+  /// std::invalid_argument ("GeometricFinger: ...") if an object overlaps the palm or the open
+  /// finger (g = 0).
   explicit GeometricFinger(std::vector<Obstacle> objects,
                            const FingerGeometry& geometry = FingerGeometry(),
                            const FingerParameters& parameters = {},
-                           const FingerContacts& imposed = {});
+                           const FingerContacts& imposed = {}, double up_to = 255.0);
 
   const FingerClosedForm& closed_form() const { return closed_form_; }
   FingerConfiguration At(double g) const { return closed_form_.At(g); }

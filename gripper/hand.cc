@@ -97,7 +97,8 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
     std::vector<GeometricFinger> fingers;
     for (int f = 0; f < 3; ++f) {
       try {
-        fingers.emplace_back(objects_, FingerGeometryOf(f), FingerParameters{}, imposed[f]);
+        fingers.emplace_back(objects_, FingerGeometryOf(f), FingerParameters{}, imposed[f],
+                             commands_[f]);
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(std::string("Hand: finger ") + "ABC"[f] + ": " + e.what());
       }

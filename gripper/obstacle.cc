@@ -23,15 +23,17 @@ Obstacle::Obstacle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double ra
     : a_(a), b_(b), radius_(radius) {}
 
 Obstacle Obstacle::Circle(const Eigen::Vector2d& centre, double radius) {
-  if (!Finite(centre) || !(radius > 0.0) || !std::isfinite(radius)) {
-    throw std::invalid_argument("Obstacle: a circle needs a finite centre and a radius > 0");
+  if (!Finite(centre) || !(radius >= kMinimumRadius) || !std::isfinite(radius)) {
+    throw std::invalid_argument(
+        "Obstacle: a circle needs a finite centre and a radius of at least 0.0001 m");
   }
   return Obstacle(centre, centre, radius);
 }
 
 Obstacle Obstacle::Bar(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius) {
-  if (!Finite(a) || !Finite(b) || !(radius > 0.0) || !std::isfinite(radius)) {
-    throw std::invalid_argument("Obstacle: a segment needs finite ends and a radius > 0");
+  if (!Finite(a) || !Finite(b) || !(radius >= kMinimumRadius) || !std::isfinite(radius)) {
+    throw std::invalid_argument(
+        "Obstacle: a segment needs finite ends and a radius of at least 0.0001 m");
   }
   return Obstacle(a, b, radius);
 }
@@ -45,19 +47,30 @@ Obstacle Obstacle::Parse(std::string_view text) {
   std::vector<Number> numbers;
   size_t at = colon + 1;
   while (true) {
-    const char* begin = text.data() + at;
+    const char* field = text.data() + at;
     const char* end = text.data() + text.size();
-    const char* stop = std::find(begin, end, ',');
+    const char* stop = std::find(field, end, ',');
+    // The number itself: without surrounding spaces, and without a leading '+'.
+    const char* begin = field;
+    while (begin < stop && *begin == ' ') ++begin;
+    const char* last = stop;
+    while (last > begin && last[-1] == ' ') --last;
+    const char* digits = begin < last && *begin == '+' ? begin + 1 : begin;
     double value = 0.0;
-    const auto [ptr, ec] = std::from_chars(begin, stop, value);
-    const int column = static_cast<int>(at) + 1;
-    if (begin == stop) throw ObstacleParseError(column, "expected a number");
-    if (ec != std::errc() || ptr != stop) {
-      throw ObstacleParseError(column + static_cast<int>((ec == std::errc() ? ptr : begin) - begin),
-                               "malformed number '" + std::string(begin, stop) + "'");
+    const auto [ptr, ec] = std::from_chars(digits, last, value);
+    const int column = static_cast<int>(begin - text.data()) + 1;
+    const std::string shown(begin, last);
+    if (begin == last) throw ObstacleParseError(column, "expected a number");
+    if (ec == std::errc::result_out_of_range) {
+      throw ObstacleParseError(column, "number '" + shown + "' is out of the range of a double");
+    }
+    if (ec != std::errc() || ptr != last) {
+      throw ObstacleParseError(
+          column + static_cast<int>((ec == std::errc() ? ptr : digits) - begin),
+          "malformed number '" + shown + "'");
     }
     if (!std::isfinite(value)) {
-      throw ObstacleParseError(column, "number '" + std::string(begin, stop) + "' is not finite");
+      throw ObstacleParseError(column, "number '" + shown + "' is not finite");
     }
     numbers.push_back({value, column});
     if (stop == end) break;
@@ -66,6 +79,11 @@ Obstacle Obstacle::Parse(std::string_view text) {
   const int end_column = static_cast<int>(text.size()) + 1;
   auto radius_of = [&](const Number& r) {
     if (!(r.value > 0.0)) throw ObstacleParseError(r.column, "radius must be > 0");
+    if (r.value < kMinimumRadius) {
+      throw ObstacleParseError(r.column,
+                               "radius must be at least 0.0001 m (0.1 mm: thinner objects could "
+                               "be crossed between two samples of the contact search)");
+    }
     return r.value;
   };
   if (kind == "circle") {

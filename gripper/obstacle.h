@@ -25,17 +25,24 @@ class ObstacleParseError : public std::invalid_argument {
 /// [a, b] (a capsule). A circle is a capsule with a = b; a bar is a segment with a thickness.
 ///
 /// Contact is Distance(link) reaching 0: the distance from the link (a segment) to the core,
-/// minus the radius. It is negative when the link is inside the object; the radius must be
-/// positive so that a link moving into the object makes it cross 0 (not only touch it).
+/// minus the radius. It is negative when the link is inside the object. The radius must be at
+/// least kMinimumRadius: so that a link moving into the object makes it cross 0 (not only touch
+/// it), and so that no link can cross the object between two samples of the contact search
+/// (GeometricFinger moves every point of the finger by at most 0.105 mm per sample, less than
+/// the 0.2 mm diameter).
 class Obstacle {
  public:
-  /// Throws std::invalid_argument ("Obstacle: ...") unless the centre is finite and radius > 0.
+  static constexpr double kMinimumRadius = 1e-4;
+  /// Throws std::invalid_argument ("Obstacle: ...") unless the centre is finite and the radius
+  /// finite and >= kMinimumRadius.
   static Obstacle Circle(const Eigen::Vector2d& centre, double radius);
-  /// Throws std::invalid_argument ("Obstacle: ...") unless the ends are finite and radius > 0.
+  /// Throws std::invalid_argument ("Obstacle: ...") unless the ends are finite and the radius
+  /// finite and >= kMinimumRadius.
   static Obstacle Bar(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius);
 
   /// Parses "circle:X,Y,R" or "segment:X1,Y1,X2,Y2[,R]" (metres, finger frame; R of a segment
-  /// defaults to kDefaultBarRadius). Throws ObstacleParseError naming the column.
+  /// defaults to kDefaultBarRadius; numbers may carry a sign and surrounding spaces). Throws
+  /// ObstacleParseError naming the column.
   static Obstacle Parse(std::string_view text);
   static constexpr double kDefaultBarRadius = 0.005;
 

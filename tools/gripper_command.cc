@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -57,27 +58,12 @@ void CheckMotor(const std::string& option, double g) {
 // GeometricFinger: object ..." -> "finger A: object ...").
 std::string UserMessage(const std::string& what) {
   std::string out = what;
-  for (const std::string prefix : {"Hand: ", "GeometricFinger: "}) {
+  for (const std::string prefix : {"Hand::ComposedAutomata: ", "Hand: ", "GeometricFinger: "}) {
     for (auto at = out.find(prefix); at != std::string::npos; at = out.find(prefix)) {
       out.erase(at, prefix.size());
     }
   }
   return out;
-}
-
-// Writes every (path, text) pair; if one fails, removes the files already written, so a failed
-// run leaves no output.
-void WriteAll(const std::vector<std::pair<std::string, std::string>>& files) {
-  std::vector<std::string> written;
-  try {
-    for (const auto& [path, text] : files) {
-      WriteOutput(path, text);
-      written.push_back(path);
-    }
-  } catch (const OutputError&) {
-    for (const std::string& path : written) std::remove(path.c_str());
-    throw;
-  }
 }
 
 json ConfigurationJson(double g, const FingerConfiguration& q) {
@@ -113,11 +99,14 @@ std::string BlockerName(const std::optional<int>& by, const std::string& imposed
   return "object " + std::to_string(*by + 1);
 }
 
-json ContactsJson(const FingerContacts& contacts, const std::array<std::optional<int>, 3>& by,
+// The contacts that take effect while closing (a given contact position beyond where a link
+// stops moving, e.g. --gob1 200 with link 1 at its limit since 140, does not).
+json ContactsJson(const FingerClosedForm& closed, const std::array<std::optional<int>, 3>& by,
                   const std::array<std::string, 3>& imposed_names) {
+  const FingerContacts& contacts = closed.contacts();
   json out = json::array();
   for (int i = 0; i < 3; ++i) {
-    if (contacts.gob[i] > 255.0) continue;
+    if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
     out.push_back(
         {{"link", i + 1}, {"g", contacts.gob[i]}, {"by", BlockerName(by[i], imposed_names[i])}});
   }
@@ -202,21 +191,42 @@ json SimulationJson(const Comparison& c) {
   return j;
 }
 
+// `hybrid finger/hand --simulate` needs the finger automaton of spec/finger.ha: variables
+// theta1..3 and g, input u, parameters gob1..3, contact transitions. Throws InputError (exit 1).
+void CheckFingerModel(const Automaton& a, const std::string& file) {
+  const std::vector<std::pair<std::string, SymbolKind>> needed = {
+      {"theta1", SymbolKind::kVariable}, {"theta2", SymbolKind::kVariable},
+      {"theta3", SymbolKind::kVariable}, {"g", SymbolKind::kVariable},
+      {"u", SymbolKind::kInput},         {"gob1", SymbolKind::kParameter},
+      {"gob2", SymbolKind::kParameter},  {"gob3", SymbolKind::kParameter}};
+  for (const auto& [name, kind] : needed) {
+    const auto slot = a.symbols().Find(name);
+    if (!slot || a.symbols()[*slot].kind != kind) {
+      throw InputError(file + ": not a finger model like spec/finger.ha (automaton '" + a.name() +
+                       "' has no " + std::string(KindName(kind)) + " '" + name + "')");
+    }
+  }
+}
+
 std::vector<double> DefaultFrames(const std::vector<double>& at) {
   return at.empty() ? std::vector<double>{0, 30, 70, 110, 150, 180, 210, 255} : at;
 }
 
 }  // namespace
 
-int RunFinger(const FingerArgs& args) {
-  if (args.g) CheckMotor("--g", *args.g);
+int RunFinger(const FingerArgs& args_in) {
+  FingerArgs args = args_in;
+  if (args.g) {
+    CheckMotor("--g", *args.g);
+    *args.g += 0.0;  // -0 -> 0
+  }
   for (double g : args.draw_at) CheckMotor("--at", g);
   FingerContacts contacts;
   bool any_gob = false;
-  for (int i = 0; i < 3 && i < static_cast<int>(args.gob.size()); ++i) {
-    if (std::isnan(args.gob[i])) continue;
-    CheckMotor("--gob" + std::to_string(i + 1), args.gob[i]);
-    contacts.gob[i] = args.gob[i];
+  for (int i = 0; i < 3; ++i) {
+    if (!args.gob[i]) continue;
+    CheckMotor("--gob" + std::to_string(i + 1), *args.gob[i]);
+    contacts.gob[i] = *args.gob[i];
     any_gob = true;
   }
   if (any_gob && !args.objects.empty()) {
@@ -245,7 +255,7 @@ int RunFinger(const FingerArgs& args) {
   if (geometric) by = geometric->blocked_by();
   json report;
   if (args.g) report = ConfigurationJson(*args.g, closed.At(*args.g));
-  report["contacts"] = ContactsJson(closed.contacts(), by, {"", "", ""});
+  report["contacts"] = ContactsJson(closed, by, {"", "", ""});
   report["stop"] = StopJson(closed.stop());
   if (!objects.empty()) {
     json list = json::array();
@@ -256,11 +266,17 @@ int RunFinger(const FingerArgs& args) {
   if (args.simulate) {
     const System model = ParseModelFile(args.model);
     if (model.components().size() != 1) {
-      throw std::invalid_argument(args.model + " is not a single finger automaton");
+      throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
+                       std::to_string(model.components().size()) + " components)");
     }
-    System system =
-        System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
-                             : model.components()[0].automaton);
+    CheckFingerModel(model.components()[0].automaton, args.model);
+    System system("finger");
+    try {
+      system = System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
+                                    : model.components()[0].automaton);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(args.model + ": " + e.what());
+    }
     for (int i = 0; i < 3 && !geometric; ++i) {
       system.SetParameter("gob" + std::to_string(i + 1), std::min(contacts.gob[i], 256.0));
     }
@@ -288,7 +304,7 @@ int RunFinger(const FingerArgs& args) {
     }
     files.emplace_back(args.plot, gripper::AnglePlotSvg(closed, title));
   }
-  WriteAll(files);
+  WriteOutputs(files);
   if (args.json) {
     WriteOutput("-", report.dump(2) + "\n");
     return code;
@@ -363,8 +379,11 @@ int RunHand(const HandArgs& args) {
     json j = {{"finger", std::string(1, names[f])}, {"command", commands[f]}};
     j.update(ConfigurationJson(commands[f], hand->At(f, 255.0)));
     j.erase("g");
-    j["contacts"] = ContactsJson(hand->finger(f).contacts(), hand->finger(f).blocked_by(), imposed);
-    j["stop"] = StopJson(hand->finger(f).closed_form().stop());
+    j["contacts"] =
+        ContactsJson(hand->finger(f).closed_form(), hand->finger(f).blocked_by(), imposed);
+    // Where the finger stops by itself (phase 4), if before its command; else null.
+    const double stop = hand->finger(f).closed_form().stop();
+    j["stop"] = StopJson(stop <= commands[f] ? stop : std::numeric_limits<double>::infinity());
     fingers.push_back(j);
   }
   json touches = json::array();
@@ -380,8 +399,16 @@ int RunHand(const HandArgs& args) {
                  {"finger_touches", touches}};
   int code = 0;
   if (args.simulate) {
-    const System system =
-        hand->ComposedAutomata(ParseModelFile(args.model), /*shared_command=*/!per_finger);
+    const System model = ParseModelFile(args.model);
+    System system("hand");
+    try {
+      for (const Component& c : model.components()) {
+        if (c.source.name() == "finger") CheckFingerModel(c.source, args.model);
+      }
+      system = hand->ComposedAutomata(model, /*shared_command=*/!per_finger);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(args.model + ": " + UserMessage(e.what()));
+    }
     std::vector<std::pair<std::string, double>> inputs;
     if (per_finger) {
       for (int f = 0; f < 3; ++f) inputs.emplace_back(std::string(1, names[f]) + ".u", commands[f]);

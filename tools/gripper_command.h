@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -9,9 +10,9 @@ namespace hybrid::cli {
 
 /// Options of `hybrid finger` (see docs/cli.md).
 struct FingerArgs {
-  std::optional<double> g;           ///< commanded motor position (required unless drawing)
-  std::vector<double> gob;           ///< --gob1..3 as given (nan = not given)
-  std::vector<std::string> objects;  ///< --object descriptions (finger frame)
+  std::optional<double> g;                   ///< commanded motor position (required unless drawing)
+  std::array<std::optional<double>, 3> gob;  ///< --gob1..3 when given
+  std::vector<std::string> objects;          ///< --object descriptions (finger frame)
   bool json = false;
   std::string draw;             ///< SVG of the finger at `draw_at`
   std::vector<double> draw_at;  ///< motor positions of the drawing's panels

@@ -318,10 +318,11 @@ int main(int argc, char** argv) {
       "One Robotiq finger, closed form (report section 4): joint angles at motor position G, "
       "against objects given by contact positions or by geometry");
   auto* g_option = finger->add_option("--g", g_value, "Motor position in [0, 255]");
+  std::array<CLI::Option*, 3> gob_options{};
   for (int i = 0; i < 3; ++i) {
-    finger->add_option("--gob" + std::to_string(i + 1), gob[i],
-                       "Motor position where link " + std::to_string(i + 1) +
-                           " is blocked by an object (the report's g_ob)");
+    gob_options[i] = finger->add_option("--gob" + std::to_string(i + 1), gob[i],
+                                        "Motor position where link " + std::to_string(i + 1) +
+                                            " is blocked by an object (the report's g_ob)");
   }
   finger->add_option("--object", finger_args.objects,
                      "An object in the finger plane (metres; x towards the palm centre, y along "
@@ -380,7 +381,9 @@ int main(int argc, char** argv) {
     try {
       if (finger->parsed()) {
         if (g_option->count() > 0) finger_args.g = g_value;
-        finger_args.gob.assign(gob.begin(), gob.end());
+        for (int i = 0; i < 3; ++i) {
+          if (gob_options[i]->count() > 0) finger_args.gob[i] = gob[i];
+        }
         return hybrid::cli::RunFinger(finger_args);
       }
       if (spread_option->count() > 0) hand_args.spread = spread;

@@ -47,4 +47,38 @@ void WriteOutput(const std::string& path, const std::string& text) {
   }
 }
 
+void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::filesystem::path> temps;
+  auto discard = [&]() {
+    std::error_code ignored;
+    for (const auto& t : temps) std::filesystem::remove(t, ignored);
+  };
+  for (const auto& [path, text] : files) {
+    std::error_code status_error;
+    const auto status = std::filesystem::status(path, status_error);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+      discard();  // renaming over a directory or a device would fail or replace it
+      throw OutputError("cannot write '" + path + "': not a regular file");
+    }
+    const std::filesystem::path temp =
+        path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (out) temps.push_back(temp);
+    out << text;
+    out.close();
+    if (!out || path.empty() || path == "-") {
+      discard();
+      throw OutputError("cannot write '" + path + "'");
+    }
+  }
+  for (size_t k = 0; k < files.size(); ++k) {
+    std::error_code ec;
+    std::filesystem::rename(temps[k], files[k].first, ec);
+    if (ec) {
+      discard();
+      throw OutputError("cannot write '" + files[k].first + "'");
+    }
+  }
+}
+
 }  // namespace hybrid::cli

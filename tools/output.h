@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace hybrid::cli {
 
@@ -15,5 +17,11 @@ struct OutputError : std::runtime_error {
 /// target that is not a regular file (a device such as /dev/stdout, a FIFO) is written directly.
 /// Throws OutputError.
 void WriteOutput(const std::string& path, const std::string& text);
+
+/// Writes several files all or nothing: every text goes to a temporary file next to its target
+/// first; only when all are written are they renamed into place. If one cannot be written, the
+/// temporaries are removed and no target is touched (existing files keep their content). Paths
+/// must be regular files or new ("-" is not allowed here). Throws OutputError.
+void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace hybrid::cli

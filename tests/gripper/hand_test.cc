@@ -158,6 +158,16 @@ RC_GTEST_PROP(HandProperty, NoInterpenetrationOnRandomHands, ()) {
   }
 }
 
+// A finger commanded to 30 never reaches the cylinder (its link 2 would meet it near 43): no
+// contact is found beyond the command, and the finger stays at its command.
+TEST(HandTest, ContactsAreSearchedUpToTheCommand) {
+  const Hand hand({Obstacle::Circle({0.0, 0.06}, 0.02)}, Hand::SpreadPosition(SpreadMode::kBasic),
+                  {30, 255, 255});
+  EXPECT_FALSE(hand.finger(0).touches_object());
+  EXPECT_EQ(hand.At(0, 255).motor, 30.0);
+  EXPECT_TRUE(hand.finger(1).touches_object());
+}
+
 TEST(HandTest, BadInput) {
   EXPECT_THROW(Hand({}, -1, kClose), std::invalid_argument);
   EXPECT_THROW(Hand({}, 137, {0, 256, 0}), std::invalid_argument);

@@ -22,6 +22,9 @@ TEST(ObstacleTest, ParsesCirclesAndSegments) {
   EXPECT_EQ(s.radius(), Obstacle::kDefaultBarRadius);
   EXPECT_EQ(Obstacle::Parse("segment:0.04,0,0.04,0.1,0.002").radius(), 0.002);
   EXPECT_EQ(Obstacle::Parse(s.ToString()), s);
+  // Signs and spaces around numbers.
+  EXPECT_EQ(Obstacle::Parse("circle: +0.05, 0.08 ,0.01"), c);
+  EXPECT_EQ(Obstacle::Parse("circle:-0.05,0.08,0.01").a(), Eigen::Vector2d(-0.05, 0.08));
 }
 
 TEST(ObstacleTest, MalformedDescriptionsNameTheColumn) {
@@ -39,7 +42,8 @@ TEST(ObstacleTest, MalformedDescriptionsNameTheColumn) {
                         Case{"circle:0.1,0.2,0.3,0.4", 20, "a circle takes 3 numbers"},
                         Case{"circle:0.1,0.2,-1", 16, "radius must be > 0"},
                         Case{"circle:0.1,0.2,0", 16, "radius must be > 0"},
-                        Case{"circle:1e999,0,1", 8, "malformed number"},
+                        Case{"circle:1e999,0,1", 8, "out of the range of a double"},
+                        Case{"circle:0,0,0.00005", 12, "radius must be at least 0.0001 m"},
                         Case{"segment:0,0,1", 14, "a segment takes 4 or 5 numbers"},
                         Case{"segment:0,0,1,1,0", 17, "radius must be > 0"},
                         Case{"circle:0.1,0.2,0.3,", 20, "expected a number"}}) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -250,6 +251,39 @@ TEST(HybridFinger, UnwritableOutputIsExit3AndLeavesNoFile) {
   EXPECT_TRUE(fs::is_empty(dir.path() / "a_directory"));
 }
 
+// A run that fails on its second output leaves the first output's existing file untouched (the
+// outputs are renamed into place only when all are written).
+TEST(HybridFinger, FailedRunKeepsExistingFiles) {
+  TempDir dir;
+  const std::string keep = dir.File("keep.svg");
+  { std::ofstream(keep) << "OLD"; }
+  ExpectRejected(
+      "finger --g 10 --draw " + Quote(keep) + " --plot " + Quote(dir.File("no_such_dir/p.svg")), 3,
+      {"cannot write"});
+  EXPECT_EQ(ReadAll(keep), "OLD");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"keep.svg"});  // no temporaries left
+}
+
+// A given contact position that is never reached (link 1 is at its limit from g = 140) does not
+// take effect and is not listed.
+TEST(HybridFinger, ContactsListOnlyThoseThatTakeEffect) {
+  const json j = RunJson("finger --g 255 --gob1 200");
+  EXPECT_TRUE(j["contacts"].empty()) << j.dump(2);
+  EXPECT_EQ(j["mode"], "c000_l11n");
+  EXPECT_EQ(RunJson("finger --g 255 --gob1 100")["contacts"].size(), 1u);
+}
+
+// --simulate with a model that is not a finger automaton: exit 1, naming the file.
+TEST(HybridFinger, SimulateWithAModelThatIsNotAFingerIsExit1) {
+  const std::string spec = std::string(HYBRID_SOURCE_DIR) + "/spec/";
+  ExpectRejected("finger --g 10 --gob1 5 --simulate --model " + Quote(spec + "thermostat.ha"), 1,
+                 {"thermostat.ha", "not a finger model", "theta1"});
+  ExpectRejected("finger --g 10 --simulate --model " + Quote(spec + "hand.ha"), 1,
+                 {"hand.ha", "not a finger model"});
+  ExpectRejected("hand --simulate --model " + Quote(spec + "bouncing_ball.ha"), 1,
+                 {"bouncing_ball.ha", "no automaton named 'finger'"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input to `hybrid finger`.
 
@@ -259,6 +293,7 @@ TEST(HybridFinger, BadOptionValuesAreExit2) {
   ExpectRejected("finger --g -1", 2, {"--g", "[0, 255]"});
   ExpectRejected("finger --g nan", 2, {"--g", "nan"});
   ExpectRejected("finger --gob1 300 --g 10", 2, {"--gob1"});
+  ExpectRejected("finger --gob2 nan --g 10", 2, {"--gob2", "nan"});
   TempDir dir;
   ExpectRejected("finger --draw " + Quote(dir.File("x.svg")) + " --at 0,300", 2, {"--at", "300"});
   EXPECT_TRUE(dir.Files().empty());
@@ -282,6 +317,11 @@ TEST(HybridFinger, ObjectsTheFingerCannotHoldAreExit1) {
   ExpectRejected("finger --g 100 --object circle:0.05,-0.03,0.01", 1, {"overlaps the palm"});
   ExpectRejected("finger --g 100 --object circle:0,0.05,0.01", 1, {"overlaps", "open finger"});
   ExpectRejected("finger --g 100 --object circle:-0.2,0.05,0.01", 1, {"cannot reach"});
+  // Inside the open finger at the knuckle of joint 2 (0.05715 m up), where contact segments
+  // leave a 2 mm gap: still an overlap.
+  ExpectRejected("finger --g 100 --object circle:0,0.05815,0.0005", 1, {"overlaps", "open finger"});
+  // Thinner than 0.1 mm: could be crossed between two samples of the contact search.
+  ExpectRejected("finger --g 100 --object circle:0.03,0.05,0.00005", 1, {"at least 0.0001 m"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -376,6 +416,16 @@ TEST(HybridHand, NoObjectClosesFreely) {
 }
 
 // Bad options (exit 2) and an object overlapping the palm (exit 1).
+// Each finger's contacts are searched only up to its command: with g = 10 no finger reaches the
+// cylinder (link 2 meets it at about 43), so the hand is rejected as not reaching it.
+TEST(HybridHand, ContactsBeyondTheCommandDoNotCount) {
+  ExpectRejected("hand --g 10 --object " + kHandObject, 1, {"no finger reaches"});
+  const json j = RunJson("hand --g-a 30 --object " + kHandObject);
+  EXPECT_TRUE(j["fingers"][0]["contacts"].empty()) << j["fingers"][0].dump(2);
+  EXPECT_TRUE(j["fingers"][0]["stop"].is_null());
+  EXPECT_EQ(j["fingers"][1]["contacts"].size(), 1u);
+}
+
 TEST(HybridHand, BadInputIsRejected) {
   ExpectRejected("hand --mode bogus", 2, {"bogus"});
   ExpectRejected("hand --g-b 400", 2, {"--g-b", "400"});
