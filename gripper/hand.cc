@@ -338,8 +338,9 @@ System Hand::ComposedAutomata(const System& hand_model, bool shared_command) con
 }
 
 FingerGeometry Hand::FingerGeometryOf(int f) const {
-  if (f == 0) return FingerGeometry({}, FingerPlacement{-layout_.half_span, 1.0});
-  return FingerGeometry({}, FingerPlacement{layout_.half_span, -std::cos(phi_ * kDeg)});
+  // The projection of the finger's frame onto the x-y plane.
+  const auto [origin, direction] = Frame(f);
+  return FingerGeometry({}, FingerPlacement{origin.x(), direction.x()});
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> Hand::Frame(int f) const {

@@ -26,57 +26,49 @@ void WriteOutput(const std::string& path, const std::string& text) {
     if (!out) throw OutputError("cannot write '" + path + "'");
     return;
   }
-  const std::filesystem::path temp =
-      target.string() + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OutputError("cannot write '" + path + "'");
-    out << text;
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temp, ignored);
-      throw OutputError("cannot write '" + path + "'");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, target, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    throw OutputError("cannot write '" + path + "'");
-  }
+  WriteOutputs({{path, text}});
 }
 
 void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files) {
   std::vector<std::filesystem::path> temps;
+  std::vector<std::pair<std::string, std::string>> renames;  // (temp, target)
+  std::vector<const std::pair<std::string, std::string>*> direct;
   auto discard = [&]() {
     std::error_code ignored;
     for (const auto& t : temps) std::filesystem::remove(t, ignored);
   };
-  for (const auto& [path, text] : files) {
+  for (const auto& file : files) {
+    const auto& [path, text] = file;
     std::error_code status_error;
     const auto status = std::filesystem::status(path, status_error);
-    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-      discard();  // renaming over a directory or a device would fail or replace it
-      throw OutputError("cannot write '" + path + "': not a regular file");
+    if (path.empty() || path == "-" ||
+        (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))) {
+      direct.push_back(&file);  // standard output, a device, a pipe, or a directory (fails)
+      continue;
     }
-    const std::filesystem::path temp =
-        path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
+    const std::string temp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (out) temps.push_back(temp);
     out << text;
     out.close();
-    if (!out || path.empty() || path == "-") {
+    if (!out) {
       discard();
       throw OutputError("cannot write '" + path + "'");
     }
+    renames.emplace_back(temp, path);
   }
-  for (size_t k = 0; k < files.size(); ++k) {
+  try {
+    for (const auto* file : direct) WriteOutput(file->first, file->second);
+  } catch (const OutputError&) {
+    discard();
+    throw;
+  }
+  for (const auto& [temp, target] : renames) {
     std::error_code ec;
-    std::filesystem::rename(temps[k], files[k].first, ec);
+    std::filesystem::rename(temp, target, ec);
     if (ec) {
       discard();
-      throw OutputError("cannot write '" + files[k].first + "'");
+      throw OutputError("cannot write '" + target + "'");
     }
   }
 }

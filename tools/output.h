@@ -18,10 +18,11 @@ struct OutputError : std::runtime_error {
 /// Throws OutputError.
 void WriteOutput(const std::string& path, const std::string& text);
 
-/// Writes several files all or nothing: every text goes to a temporary file next to its target
-/// first; only when all are written are they renamed into place. If one cannot be written, the
-/// temporaries are removed and no target is touched (existing files keep their content). Paths
-/// must be regular files or new ("-" is not allowed here). Throws OutputError.
+/// Writes several files all or nothing: every text for a regular (or new) file goes to a
+/// temporary file next to its target first; only when all are written (and the outputs that
+/// cannot be renamed over, "-" and devices, have been written directly) are they renamed into
+/// place. If one cannot be written, the temporaries are removed and no regular target is touched
+/// (existing files keep their content). Throws OutputError.
 void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace hybrid::cli
