@@ -293,6 +293,9 @@ int main(int argc, char** argv) {
   simulate->add_option("--input", sim_args.inputs,
                        "NAME=SIGNAL, SIGNAL a number, step(t: v, ...) or linear(t: v, ...); "
                        "repeatable; overrides the scenario's signal for NAME");
+  simulate->add_option("--set", sim_args.parameters,
+                       "NAME=VALUE: give parameter NAME the value VALUE (e.g. gob1=80 for the "
+                       "finger; A.gob1 in a system); repeatable");
   simulate->add_option("--input-csv", sim_args.input_csv,
                        "CSV with a 'time' column and one column per input");
   simulate->add_option("--csv-shape", sim_args.csv_shape,

@@ -224,7 +224,24 @@ std::string SummaryText(const Simulator& sim, const SimulationResult& r, double 
 }  // namespace
 
 int RunSimulate(const SimulateArgs& args) {
-  const System system = ParseModelFile(args.model);
+  System system = ParseModelFile(args.model);
+  for (const std::string& spec : args.parameters) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw std::invalid_argument("--set '" + spec + "': expected NAME=VALUE");
+    }
+    const std::string name = spec.substr(0, eq), text = spec.substr(eq + 1);
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value)) {
+      throw std::invalid_argument("--set " + name + ": '" + text + "' is not a finite number");
+    }
+    try {
+      system.SetParameter(name, value);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--set " + name + ": " + e.what());
+    }
+  }
   const SymbolTable& symbols = system.symbols();
   std::vector<InputSignal> signals;
   if (!args.input_csv.empty()) {

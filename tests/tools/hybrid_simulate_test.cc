@@ -160,6 +160,26 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   EXPECT_EQ(std::stod(log[1][0]), j["events"][0]["time"].get<double>());
 }
 
+// --set overrides a parameter: an object blocking link 1 at g = 80 (the finger's gob1) gives the
+// closed form's events: contact at 80, theta3 at its minimum at 80 + (55 - 40) / 0.9, link 2 at
+// its limit at 180, theta3 at its maximum half way to 255 (217.5).
+TEST(HybridSimulate, SetOverridesAParameter) {
+  const json j = SimulateJson(Quote(Spec("finger")) + " --set gob1=80 --until 255");
+  EXPECT_EQ(j["status"], "completed");
+  ASSERT_EQ(j["events"].size(), 4u) << j.dump(2);
+  const std::vector<double> times = {80.0, 80.0 + 15.0 / 0.9, 180.0, 217.5};
+  for (size_t k = 0; k < times.size(); ++k) {
+    EXPECT_NEAR(j["events"][k]["time"].get<double>(), times[k], 1e-6) << k;
+  }
+  const Result unknown = Simulate(Quote(Spec("finger")) + " --set nope=1");
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_NE(unknown.err.find("--set nope"), std::string::npos) << unknown.err;
+  const Result bad = Simulate(Quote(Spec("finger")) + " --set gob1=abc");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("not a finite number"), std::string::npos) << bad.err;
+  EXPECT_EQ(Simulate(Quote(Spec("finger")) + " --set gob1").exit_code, 1);
+}
+
 TEST(HybridSimulate, InputOverridesTheScenario) {
   // Close for 10 s only: no joint reaches a limit.
   const json j = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=step(0: 1, 10: 0)") +
