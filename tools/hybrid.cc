@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -37,6 +38,7 @@ using json = nlohmann::ordered_json;
 constexpr int kExitModelError = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitOutput = 3;
+constexpr int kExitInternal = 4;
 
 json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
   json out = json::array();
@@ -256,6 +258,32 @@ std::string InfoText(const json& info) {
   return out.str();
 }
 
+// The message and exit code of an exception from a command (docs/cli.md): bad input (InputError,
+// ParseError) 1, an unwritable output 3, std::invalid_argument `invalid_code` (1 for a model
+// that fails validation, 2 for a bad option value), anything else an internal error (4).
+int ExitFor(std::exception_ptr error, const std::string& prefix, int invalid_code) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const hybrid::cli::InputError& e) {
+    std::cerr << prefix << ": " << e.what() << "\n";
+    return kExitModelError;
+  } catch (const hybrid::ParseError& e) {
+    std::cerr << e.what() << "\n";
+    return kExitModelError;
+  } catch (const OutputError& e) {
+    std::cerr << "hybrid: " << e.what() << "\n";
+    return kExitOutput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << prefix << ": " << e.what() << "\n";
+    return invalid_code;
+  } catch (const std::exception& e) {
+    std::cerr << "hybrid: internal error: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "hybrid: internal error\n";
+  }
+  return kExitInternal;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -394,21 +422,8 @@ int main(int argc, char** argv) {
       if (gb->count() > 0) hand_args.g_b = g_b;
       if (gc->count() > 0) hand_args.g_c = g_c;
       return hybrid::cli::RunHand(hand_args);
-    } catch (const hybrid::cli::InputError& e) {
-      std::cerr << name << ": " << e.what() << "\n";
-      return kExitModelError;
-    } catch (const hybrid::ParseError& e) {
-      std::cerr << e.what() << "\n";
-      return kExitModelError;
-    } catch (const OutputError& e) {
-      std::cerr << "hybrid: " << e.what() << "\n";
-      return kExitOutput;
-    } catch (const std::invalid_argument& e) {
-      std::cerr << name << ": " << e.what() << "\n";
-      return kExitUsage;
-    } catch (const std::exception& e) {
-      std::cerr << "hybrid: internal error: " << e.what() << "\n";
-      return 4;
+    } catch (...) {
+      return ExitFor(std::current_exception(), name, kExitUsage);
     }
   }
 
@@ -439,18 +454,8 @@ int main(int argc, char** argv) {
       }
       WriteOutput(output, text);
     }
-  } catch (const hybrid::ParseError& e) {
-    std::cerr << e.what() << "\n";
-    return kExitModelError;
-  } catch (const OutputError& e) {
-    std::cerr << "hybrid: " << e.what() << "\n";
-    return kExitOutput;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << model << ": " << e.what() << "\n";
-    return kExitModelError;
-  } catch (const std::exception& e) {
-    std::cerr << "hybrid: internal error: " << e.what() << "\n";
-    return 4;
+  } catch (...) {
+    return ExitFor(std::current_exception(), model, kExitModelError);
   }
   return 0;
 }
