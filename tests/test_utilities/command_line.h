@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -95,6 +96,19 @@ inline Result RunHybrid(const std::string& args, const std::string& stdout_targe
   r.out = ReadAll(out);
   r.err = ReadAll(err);
   return r;
+}
+
+/// Runs `hybrid ARGS --json`, expects exit code `expected_exit`, and parses standard output (an
+/// output that is not JSON is a test failure and gives an empty object).
+inline nlohmann::json RunHybridJson(const std::string& args, int expected_exit = 0) {
+  const Result r = RunHybrid(args + " --json");
+  EXPECT_EQ(r.exit_code, expected_exit) << "hybrid " << args << "\n" << r.err;
+  try {
+    return nlohmann::json::parse(r.out);
+  } catch (const nlohmann::json::exception& e) {
+    ADD_FAILURE() << "hybrid " << args << ": not JSON (" << e.what() << "):\n" << r.out;
+    return nlohmann::json::object();
+  }
 }
 
 }  // namespace hybrid::testing

@@ -30,16 +30,8 @@ using testing::Result;
 using testing::RunHybrid;
 using testing::TempDir;
 
-// Runs `hybrid ARGS --json`, expects `expected_exit`, and parses standard output.
 json RunJson(const std::string& args, int expected_exit = 0) {
-  const Result r = RunHybrid(args + " --json");
-  EXPECT_EQ(r.exit_code, expected_exit) << "hybrid " << args << "\n" << r.err;
-  try {
-    return json::parse(r.out);
-  } catch (const json::exception& e) {
-    ADD_FAILURE() << "hybrid " << args << ": not JSON (" << e.what() << "):\n" << r.out;
-    return json::object();
-  }
+  return testing::RunHybridJson(args, expected_exit);
 }
 
 bool Contains(const std::string& text, const std::string& part) {

@@ -41,14 +41,7 @@ std::string Spec(const std::string& name) {
 Result Simulate(const std::string& args) { return RunHybrid("simulate " + args); }
 
 json SimulateJson(const std::string& args, int expected_exit = 0) {
-  const Result r = Simulate(args + " --json");
-  EXPECT_EQ(r.exit_code, expected_exit) << "hybrid simulate " << args << "\n" << r.err;
-  try {
-    return json::parse(r.out);
-  } catch (const json::exception& e) {
-    ADD_FAILURE() << "not JSON (" << e.what() << "):\n" << r.out;
-    return json::object();
-  }
+  return testing::RunHybridJson("simulate " + args, expected_exit);
 }
 
 // Rows of a CSV file, split at commas.
