@@ -12,6 +12,11 @@ namespace {
   throw std::invalid_argument(std::string(api) + ": " + message);
 }
 
+// "[lo, hi]" in shortest round-trip form.
+std::string RangeText(double lo, double hi) {
+  return "[" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+}
+
 template <class T, class Key>
 bool SortedUnique(const std::vector<T>& items, Key key) {
   for (size_t i = 1; i < items.size(); ++i) {
@@ -94,16 +99,36 @@ int Automaton::AddInput(std::string name, Range bounds, std::string unit) {
   return slot;
 }
 
-int Automaton::AddParameter(std::string name, Expression value, std::string unit) {
-  EvaluateConstant(value, "Automaton::AddParameter: value of " + name);
+int Automaton::AddParameter(std::string name, Expression value, std::string unit,
+                            std::optional<Range> range) {
+  constexpr std::string_view kApi = "Automaton::AddParameter";
+  const double v = EvaluateConstant(value, std::string(kApi) + ": value of " + name);
+  if (range) {
+    const std::string context = std::string(kApi) + ": range of '" + name + "'";
+    const double lo = EvaluateConstant(range->lo, context);
+    const double hi = EvaluateConstant(range->hi, context);
+    if (lo > hi) Fail(kApi, "empty range " + RangeText(lo, hi) + " for parameter '" + name + "'");
+    if (v < lo || v > hi) {
+      Fail(kApi, "value " + FormatNumber(v) + " of parameter '" + name + "' is outside its range " +
+                     RangeText(lo, hi));
+    }
+  }
   int slot;
   try {
     slot = symbols_.Add({std::move(name), SymbolKind::kParameter, std::move(unit)});
   } catch (const std::invalid_argument& e) {
-    Fail("Automaton::AddParameter", e.what());
+    Fail(kApi, e.what());
   }
   parameters_.emplace_back(slot, std::move(value));
+  parameter_ranges_.push_back(std::move(range));
   return slot;
+}
+
+std::optional<Range> Automaton::ParameterRange(int slot) const {
+  for (size_t i = 0; i < parameters_.size(); ++i) {
+    if (parameters_[i].first == slot) return parameter_ranges_[i];
+  }
+  return std::nullopt;
 }
 
 void Automaton::SetParameter(std::string_view name, double value) {
@@ -117,12 +142,35 @@ void Automaton::SetParameter(std::string_view name, double value) {
                          [&](const auto& p) { return p.first == *slot; });
   const Expression old = it->second;
   it->second = Expression::Constant(value);
+  auto fail = [&](const std::string& message) {
+    it->second = old;
+    Fail(kApi, message);
+  };
+  const std::string setting = "setting '" + std::string(name) + "' to " + FormatNumber(value);
+  // Every parameter and range bound is evaluated in the new environment; ranges read only
+  // earlier parameters, so the range of `name` itself is unchanged.
   const std::vector<double> env = ParameterEnvironment();
-  for (const auto& [s, e] : parameters_) {
+  for (size_t i = 0; i < parameters_.size(); ++i) {
+    const int s = parameters_[i].first;
+    const std::string& p = symbols_[s].name;
     if (!std::isfinite(env[s])) {
-      it->second = old;
-      Fail(kApi, "setting '" + std::string(name) + "' makes parameter '" + symbols_[s].name +
-                     "' non-finite");
+      fail("setting '" + std::string(name) + "' makes parameter '" + p + "' non-finite");
+    }
+    const std::optional<Range>& range = parameter_ranges_[i];
+    if (!range) continue;
+    const double lo = range->lo.Evaluate(env);
+    const double hi = range->hi.Evaluate(env);
+    if (!std::isfinite(lo) || !std::isfinite(hi)) {
+      fail(setting + " makes the range of parameter '" + p + "' non-finite");
+    }
+    if (lo > hi) fail(setting + " makes the range of parameter '" + p + "' empty");
+    if (env[s] < lo || env[s] > hi) {
+      if (s == *slot) {
+        fail("value " + FormatNumber(value) + " of parameter '" + p + "' is outside its range " +
+             RangeText(lo, hi));
+      }
+      fail(setting + " puts parameter '" + p + "' (" + FormatNumber(env[s]) +
+           ") outside its range " + RangeText(lo, hi));
     }
   }
 }

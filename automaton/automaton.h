@@ -75,12 +75,18 @@ class Automaton {
   int AddVariable(std::string name, std::string unit = "", std::optional<Range> domain = {});
   int AddDiscreteVariable(std::string name);
   int AddInput(std::string name, Range bounds, std::string unit = "");
-  /// `value` may read only parameters declared earlier; it must evaluate to a finite number.
-  int AddParameter(std::string name, Expression value, std::string unit = "");
+  /// Declares parameter `name` with nominal value `value` (what simulation uses) and, optionally,
+  /// the `range` of values a verifier must cover (`param k = 2 in [1, 3];`). `value` and the range
+  /// bounds may read only parameters declared earlier and must evaluate to finite numbers, with
+  /// lo <= value <= hi. Returns the slot. Throws std::invalid_argument
+  /// ("Automaton::AddParameter: ...", naming the parameter) otherwise, or on a duplicate name.
+  int AddParameter(std::string name, Expression value, std::string unit = "",
+                   std::optional<Range> range = {});
   /// Replaces the defining expression of parameter `name` by the constant `value`; parameters
-  /// defined from it follow (they are evaluated in declaration order). Throws
-  /// std::invalid_argument ("Automaton::SetParameter: ...") if `name` is not a parameter, `value`
-  /// is not finite, or a parameter defined from it becomes non-finite (the old value is kept).
+  /// defined from it follow (they are evaluated in declaration order); declared ranges are kept.
+  /// Throws std::invalid_argument ("Automaton::SetParameter: ...") if `name` is not a parameter,
+  /// `value` is not finite or outside the declared range of `name`, or a parameter defined from
+  /// it (or a range bound) becomes non-finite or leaves its range; the old value is then kept.
   void SetParameter(std::string_view name, double value);
   /// Flows must be sorted by slot and name continuous variables; every discrete variable must
   /// get a value; the mode name must be new.
@@ -115,6 +121,10 @@ class Automaton {
   std::span<const InputInfo> inputs() const { return inputs_; }
   /// Slots of the parameters in declaration order, with their defining expressions.
   std::span<const std::pair<int, Expression>> parameters() const { return parameters_; }
+  /// The declared range of the parameter at `slot` (expressions over earlier parameters, to be
+  /// evaluated in ParameterEnvironment()), or nullopt if it has none or `slot` is not a
+  /// parameter. Never throws.
+  std::optional<Range> ParameterRange(int slot) const;
   std::span<const int> discrete_variables() const { return discrete_; }
   std::span<const InitialState> initial_states() const { return initial_states_; }
   std::span<const Property> properties() const { return properties_; }
@@ -139,6 +149,8 @@ class Automaton {
   std::vector<int> discrete_;
   std::vector<InputInfo> inputs_;
   std::vector<std::pair<int, Expression>> parameters_;
+  // The declared range of each parameter, parallel to parameters_.
+  std::vector<std::optional<Range>> parameter_ranges_;
   std::vector<Mode> modes_;
   std::vector<Transition> transitions_;
   // Name -> index look-ups (derived from modes_ and transitions_).

@@ -146,11 +146,21 @@ struct comparison : seq<expression, relation, must<expression>> {};
 struct no_or : not_at<kw_or> {};
 struct conjunction : sor<kw_true, seq<comparison, star<kw_and, must<comparison>>>> {};
 struct predicate;
-struct paren_predicate : seq<lparen, predicate, rparen> {};
+// An operator or relation after `( ... )` makes the parenthesis part of an expression, so a
+// parenthesised predicate must not be followed by one (`(x + 1) >= 0` is a comparison).
+struct continues_expression
+    : sor<relation, plus_op, minus_op, times_op, divide_op, power_op, one<'='>> {};
+struct paren_predicate : seq<lparen, predicate, rparen, not_at<continues_expression>> {};
 struct in_mode : seq<kw_in, must<name_tok>> {};
+// An expression where a predicate operand was expected (`always x + 1;`): accepted by the grammar
+// only where nothing else matches, so that the builder reports it with its text. `x = 1` is
+// reported here: '=' is not a comparison.
+struct not_single_equals : not_at<equals> {};
+struct non_predicate : seq<expression, must<not_single_equals>> {};
 struct not_predicate;
 struct negated : seq<kw_not, must<not_predicate>> {};
-struct not_predicate : sor<negated, paren_predicate, in_mode, kw_true, kw_false, comparison> {};
+struct not_predicate
+    : sor<negated, paren_predicate, in_mode, kw_true, kw_false, comparison, non_predicate> {};
 struct and_predicate : seq<not_predicate, star<kw_and, must<not_predicate>>> {};
 struct predicate : seq<and_predicate, star<kw_or, must<and_predicate>>> {};
 
@@ -162,8 +172,10 @@ struct var_item : seq<ident_tok, opt<unit>, opt<kw_in, must<range>>> {};
 struct var_decl : seq<kw_var, must<var_item>, star<comma, must<var_item>>, must<semi>> {};
 struct discrete_decl : seq<kw_discrete, must<ident_tok>, star<comma, must<ident_tok>>, must<semi>> {
 };
-struct param_decl
-    : seq<kw_param, must<ident_tok>, opt<unit>, must<equals>, must<expression>, must<semi>> {};
+struct param_range : seq<kw_in, must<range>> {};
+struct param_end : semi {};
+struct param_decl : seq<kw_param, must<ident_tok>, opt<unit>, must<equals>, must<expression>,
+                        opt<param_range>, must<param_end>> {};
 struct input_decl
     : seq<kw_input, must<ident_tok>, opt<unit>, must<kw_in>, must<range>, must<semi>> {};
 
@@ -293,6 +305,11 @@ inline constexpr auto kMessage<predicate> = "expected a predicate";
 template <>
 inline constexpr auto kMessage<not_predicate> = "expected a predicate";
 template <>
+inline constexpr auto kMessage<not_single_equals> =
+    "'=' is not a comparison: write '==' for equality";
+template <>
+inline constexpr auto kMessage<param_end> = "expected ';' or a range 'in [lo, hi]'";
+template <>
 inline constexpr auto kMessage<and_predicate> = "expected a predicate";
 template <>
 inline constexpr auto kMessage<unit_text> = "expected a unit such as [deg] or [m/s]";
@@ -369,12 +386,13 @@ using selector = parse_tree::selector<
                                   kw_lazy, kw_step, kw_linear, kw_always, kw_never, kw_reach,
                                   kw_true, kw_false>,
     parse_tree::remove_content::on<
-        call, negation, comparison, conjunction, paren_predicate, in_mode, negated, unit, range,
-        var_item, var_decl, discrete_decl, param_decl, input_decl, discrete_value, flow, invariant,
-        mode_decl, transition_name, source_mode, target_mode, guard, assignment, reset, label,
-        urgency, transition_decl, init_point, init_range, init_item, init_decl, point, signal_shape,
-        until_item, signal_item, scenario_decl, horizon, property_decl, automaton_decl,
-        instance_alias, instance_item, share_item, system_decl, import_decl, power, arguments>,
+        call, negation, comparison, conjunction, paren_predicate, in_mode, negated, non_predicate,
+        param_range, unit, range, var_item, var_decl, discrete_decl, param_decl, input_decl,
+        discrete_value, flow, invariant, mode_decl, transition_name, source_mode, target_mode,
+        guard, assignment, reset, label, urgency, transition_decl, init_point, init_range,
+        init_item, init_decl, point, signal_shape, until_item, signal_item, scenario_decl, horizon,
+        property_decl, automaton_decl, instance_alias, instance_item, share_item, system_decl,
+        import_decl, power, arguments>,
     parse_tree::fold_one::on<sum, product, and_predicate, predicate>>;
 
 template <class Rule>
@@ -606,17 +624,26 @@ class Builder {
     return c;
   }
 
+  // The predicate of property `property` (named in messages).
   Predicate Pred(const Node& n, const Scope& scope,
-                 const std::function<bool(const std::string&)>& is_mode) const {
+                 const std::function<bool(const std::string&)>& is_mode,
+                 const std::string& property) const {
     int depth = 0;
-    return Pred(n, scope, is_mode, &depth);
+    return Pred(n, scope, is_mode, property, &depth);
   }
 
   // Sets `*depth` to the depth of the predicate tree, counting its comparisons' expressions.
   Predicate Pred(const Node& n, const Scope& scope,
-                 const std::function<bool(const std::string&)>& is_mode, int* depth) const {
+                 const std::function<bool(const std::string&)>& is_mode,
+                 const std::string& property, int* depth) const {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
     *depth = 1;
+    if (n.is_type<non_predicate>()) {
+      const Expression e = Expr(*n.children.at(0), scope);
+      Fail(n, "property '" + property + "': '" + e.ToString() +
+                  "' is not a predicate (expected a comparison such as x >= 0, 'in MODE', true or "
+                  "false)");
+    }
     if (n.is_type<kw_true>()) return Predicate::True();
     if (n.is_type<kw_false>()) return Predicate::False();
     if (n.is_type<comparison>()) {
@@ -630,17 +657,19 @@ class Builder {
       return Predicate::InMode(m);
     }
     if (n.is_type<negated>()) {
-      Predicate operand = Pred(*n.children.at(0), scope, is_mode, depth);
+      Predicate operand = Pred(*n.children.at(0), scope, is_mode, property, depth);
       *depth = Deeper(n, *depth);
       return Predicate::Not(std::move(operand));
     }
-    if (n.is_type<paren_predicate>()) return Pred(*n.children.at(0), scope, is_mode, depth);
+    if (n.is_type<paren_predicate>()) {
+      return Pred(*n.children.at(0), scope, is_mode, property, depth);
+    }
     if (n.is_type<and_predicate>() || n.is_type<predicate>()) {
       // Left-associative, like sums.
-      Predicate acc = Pred(*n.children.at(0), scope, is_mode, depth);
+      Predicate acc = Pred(*n.children.at(0), scope, is_mode, property, depth);
       for (size_t i = 1; i < n.children.size(); ++i) {
         int d = 0;
-        Predicate rhs = Pred(*n.children[i], scope, is_mode, &d);
+        Predicate rhs = Pred(*n.children[i], scope, is_mode, property, &d);
         *depth = Deeper(*n.children[i], std::max(*depth, d));
         acc = n.is_type<and_predicate>() ? Predicate::And(acc, rhs) : Predicate::Or(acc, rhs);
       }
@@ -694,7 +723,7 @@ class Builder {
     p.kind = kind.is_type<grammar::kw_always>()  ? Property::Kind::kAlways
              : kind.is_type<grammar::kw_never>() ? Property::Kind::kNever
                                                  : Property::Kind::kReach;
-    p.predicate = Pred(*n.children.at(2), scope, is_mode);
+    p.predicate = Pred(*n.children.at(2), scope, is_mode, p.name);
     if (n.children.size() > 3) p.horizon = Number(*n.children.at(3)->children.at(0));
     return p;
   }
@@ -794,9 +823,15 @@ class Builder {
           At(*id, [&] { return a.AddDiscreteVariable(Text(*id)); });
         }
       } else if (item.is_type<param_decl>()) {
+        // Children: the name, the unit if any, the value, the range if any.
         const Node& id = *item.children.at(0);
-        const Expression value = Expr(*item.children.back(), scope);
-        At(id, [&] { return a.AddParameter(Text(id), value, Unit(item)); });
+        const size_t value_index = item.children.at(1)->is_type<unit>() ? 2 : 1;
+        const Expression value = Expr(*item.children.at(value_index), scope);
+        std::optional<Range> declared;
+        if (const Node* r = Child(item, param_range{})) {
+          declared = RangeOf(*r->children.at(0), scope);
+        }
+        At(id, [&] { return a.AddParameter(Text(id), value, Unit(item), declared); });
       } else if (item.is_type<input_decl>()) {
         const Node& id = *item.children.at(0);
         const Range bounds = RangeOf(*Child(item, range{}), scope);

@@ -65,10 +65,15 @@ std::string PrintAutomaton(const Automaton& a) {
         out << "  input " << sym.name << UnitSuffix(sym) << " in "
             << RangeText(a.inputs()[input++].bounds) << ";\n";
         break;
-      case SymbolKind::kParameter:
+      case SymbolKind::kParameter: {
         out << "  param " << sym.name << UnitSuffix(sym) << " = "
-            << a.parameters()[param++].second.ToString() << ";\n";
+            << a.parameters()[param++].second.ToString();
+        if (const std::optional<Range> range = a.ParameterRange(s)) {
+          out << " in " << RangeText(*range);
+        }
+        out << ";\n";
         break;
+      }
     }
   }
   for (const Mode& m : a.modes()) {

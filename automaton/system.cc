@@ -20,6 +20,14 @@ std::string WithArticle(std::string_view noun) {
   return (vowel ? "an " : "a ") + std::string(noun);
 }
 
+// The evaluated range of parameter `slot` of `a` ("[0, 256]"), or "none".
+std::string RangeText(const Automaton& a, int slot) {
+  const std::optional<Range> r = a.ParameterRange(slot);
+  if (!r) return "none";
+  const std::vector<double> env = a.ParameterEnvironment();
+  return "[" + FormatNumber(r->lo.Evaluate(env)) + ", " + FormatNumber(r->hi.Evaluate(env)) + "]";
+}
+
 // Rewrites every symbol of `e` through `slot_map` (old slot -> new slot) with new names.
 Expression Remap(const Expression& e, const std::vector<int>& slot_map, const SymbolTable& names) {
   return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
@@ -86,9 +94,12 @@ Automaton Renamed(const Automaton& a, const std::function<std::string(const std:
       case SymbolKind::kInput:
         out.AddInput(sym.name, range(a.inputs()[next_input++].bounds), sym.unit);
         break;
-      case SymbolKind::kParameter:
-        out.AddParameter(sym.name, expr(a.parameters()[next_param++].second), sym.unit);
+      case SymbolKind::kParameter: {
+        std::optional<Range> declared = a.ParameterRange(s);
+        if (declared) declared = range(*declared);
+        out.AddParameter(sym.name, expr(a.parameters()[next_param++].second), sym.unit, declared);
         break;
+      }
     }
   }
   for (const Mode& m : a.modes()) {
@@ -163,16 +174,23 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
                        " elsewhere");
       }
       if (local[s].kind == SymbolKind::kParameter) {
-        // A shared parameter is one constant: its values must agree.
+        // A shared parameter is one constant: its values and declared ranges must agree.
         for (const Component& other : components_) {
           auto it = std::find(other.global_slot.begin(), other.global_slot.end(), *g);
           if (it == other.global_slot.end()) continue;
-          const double theirs =
-              other.automaton.ParameterEnvironment()[it - other.global_slot.begin()];
+          const int other_slot = static_cast<int>(it - other.global_slot.begin());
+          const double theirs = other.automaton.ParameterEnvironment()[other_slot];
           if (theirs != parameters[s]) {
             Fail(kApi, "shared parameter '" + local[s].name + "' is " +
                            FormatNumber(parameters[s]) + " in '" + automaton.name() + "' but " +
                            FormatNumber(theirs) + " in '" + other.automaton.name() + "'");
+          }
+          const std::string ours = RangeText(c.automaton, s);
+          const std::string their_range = RangeText(other.automaton, other_slot);
+          if (ours != their_range) {
+            Fail(kApi, "shared parameter '" + local[s].name + "' has range " + ours + " in '" +
+                           automaton.name() + "' but " + their_range + " in '" +
+                           other.automaton.name() + "'");
           }
           break;
         }
@@ -264,8 +282,11 @@ std::pair<double, double> System::InputBounds(int slot) const {
 
 void System::SetParameter(std::string_view name, double value) {
   constexpr std::string_view kApi = "System::SetParameter";
+  // Set on copies and commit only if every component accepts the value: a shared parameter must
+  // not be left set in some components only.
+  std::vector<Component> updated = components_;
   int found = 0;
-  for (Component& c : components_) {
+  for (Component& c : updated) {
     const std::optional<int> slot = c.automaton.symbols().Find(name);
     if (!slot || c.automaton.symbols()[*slot].kind != SymbolKind::kParameter) continue;
     try {
@@ -277,6 +298,32 @@ void System::SetParameter(std::string_view name, double value) {
     ++found;
   }
   if (found == 0) Fail(kApi, "no component has a parameter '" + std::string(name) + "'");
+  components_ = std::move(updated);
+}
+
+void System::SetInitialValue(std::string_view variable, double value) {
+  constexpr std::string_view kApi = "System::SetInitialValue";
+  if (!std::isfinite(value)) {
+    Fail(kApi, "initial value of '" + std::string(variable) + "' is not finite");
+  }
+  int found = 0;
+  for (Component& c : components_) {
+    const std::optional<int> slot = c.automaton.symbols().Find(variable);
+    if (!slot || c.automaton.symbols()[*slot].kind != SymbolKind::kVariable) continue;
+    // Renaming preserves slots, so the slot is also the variable's slot in `source`.
+    const Expression point = Expression::Constant(value);
+    const InitialValue initial{*slot, Range{point, point}, true};
+    try {
+      c.automaton.SetInitialValue(*slot, initial);
+      c.source.SetInitialValue(*slot, initial);
+    } catch (const std::invalid_argument& e) {
+      Fail(kApi, e.what());
+    }
+    ++found;
+  }
+  if (found == 0) {
+    Fail(kApi, "no component has a continuous variable '" + std::string(variable) + "'");
+  }
 }
 
 void System::SetScenario(Scenario scenario) {
@@ -352,7 +399,10 @@ Automaton System::Product(int max_modes) const {
           break;
         case SymbolKind::kParameter:
           for (const auto& [slot, value] : a.parameters()) {
-            if (slot == local) out.AddParameter(sym.name, global(c, value), sym.unit);
+            if (slot != local) continue;
+            std::optional<Range> range = a.ParameterRange(slot);
+            if (range) range = Range{global(c, range->lo), global(c, range->hi)};
+            out.AddParameter(sym.name, global(c, value), sym.unit, range);
           }
           break;
       }

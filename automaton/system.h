@@ -47,10 +47,11 @@ class System {
   const std::string& name() const { return name_; }
   /// Declares `name` (a symbol or a label) shared by every component added afterwards.
   void Share(std::string name);
-  /// Adds a renamed copy of `automaton` (see the class comment). Throws std::invalid_argument
-  /// ("System::AddComponent: ...") on a duplicate instance name, a shared name used with
-  /// different kinds, a shared variable given a flow by two components, or a shared parameter
-  /// whose value differs from the one it already has.
+  /// Adds a renamed copy of `automaton` (see the class comment); parameter ranges are renamed
+  /// with it. Throws std::invalid_argument ("System::AddComponent: ...") on a duplicate instance
+  /// name, a shared name used with different kinds, a shared variable given a flow by two
+  /// components, or a shared parameter whose value or declared range (evaluated; both absent
+  /// counts as equal) differs from the one it already has.
   void AddComponent(std::string instance, const Automaton& automaton);
   /// A system-level property over System slots; `in` atoms name component modes qualified by the
   /// instance (`A.open`) or, for an unqualified component, plainly.
@@ -63,8 +64,15 @@ class System {
   /// Sets parameter `name` (a System name: "A.gob1", or a shared or unqualified "gob1") to
   /// `value` in every component that declares it (Automaton::SetParameter). Throws
   /// std::invalid_argument ("System::SetParameter: ...") if no component declares such a
-  /// parameter, or as Automaton::SetParameter does.
+  /// parameter, or as Automaton::SetParameter does (e.g. `value` outside the parameter's declared
+  /// range); the system is then unchanged.
   void SetParameter(std::string_view name, double value);
+  /// Sets the initial value of continuous variable `variable` (a System name: "A.theta1", or a
+  /// shared or unqualified "theta1") to the point `value` in every initial state of every
+  /// component that declares it (Automaton::SetInitialValue, in both `automaton` and `source`).
+  /// Throws std::invalid_argument ("System::SetInitialValue: ...") if `value` is not finite or no
+  /// component has such a continuous variable.
+  void SetInitialValue(std::string_view variable, double value);
 
   const SymbolTable& symbols() const { return symbols_; }
   std::span<const Component> components() const { return components_; }

@@ -90,6 +90,16 @@ def rate(flow):
     return M3 if flow == "m3 * u" else flow
 
 
+def pushes(flow, direction):
+    """The input condition under which `flow` moves its joint in `direction` (+1 up, -1 down).
+    Every rate is a coefficient times u whose sign is known: m1, m2 > 0, and the phase-3
+    coefficient (theta3_max - theta3_s)(255 - g_s)/(255 - g)^2 >= 0 because theta3_s <= 0 <
+    theta3_max (see the property phase3_law). Writing `u > 0` rather than `RATE > 0` keeps every
+    guard affine, which `hybrid check` needs to encode urgency exactly."""
+    sign = -1 if flow.startswith("-") else 1
+    return "u > 0" if sign * direction > 0 else "u < 0"
+
+
 def release_guard(i):
     """Transitions 2 and 4 (D2): link i leaves its contact or limit when the motor reverses and
     link i + 1 is back where it was when link i stopped: theta2 at its minimum for link 1,
@@ -120,13 +130,16 @@ def transitions(all_states):
                 extra = "theta3_s := theta3, g_s := g"
                 resets = f"{resets}, {extra}" if resets else extra
             releases_link2 = (s[1] or s[4]) and not (target[1] or target[4])
-            if releases_link2 and target[5] == 0 and phase(target) in ("1", "2"):
-                # Decision C2: back in phase 1 or 2, link 3 is at its lower limit (the primed
-                # phase) when it was there when link 2 stopped.
+            primed = target[:5] + (-1,)
+            if releases_link2 and target[5] == 0 and (phase(target) in ("1", "2") or
+                                                      primed in known):
+                # Decision C2: back in phase 1 or 2 (or in phase 4 with link 3 in contact), link 3
+                # is at its lower limit (the primed state) when it was there when link 2 stopped.
+                # (`hybrid check` found the phase-4 case: without it, releasing link 2 from
+                # c111_l000 left theta3 at its limit with l3 = 0, breaking distal_coupling.)
                 # The primed twin comes first: at the crossing the simulator tests a guard in
                 # its closure, where `theta3_s > theta3_min` holds for theta3_s = theta3_min
                 # too; declaration order then gives the primed phase priority.
-                primed = target[:5] + (-1,)
                 out.append((f"t{kind}_{name(s)}_to_{name(primed)}", s, primed,
                             f"{guard} and theta3_s <= theta3_min", label, resets))
                 out.append((f"t{kind}_{name(s)}_to_{name(target)}", s, target,
@@ -155,7 +168,7 @@ def transitions(all_states):
             if li == 0 and ci == 0 and theta in flows:
                 t = c + l
                 t[3 + i - 1] = 1
-                emit(3, i, t, f"{theta} >= {theta}_max and {rate(flows[theta])} > 0", "",
+                emit(3, i, t, f"{theta} >= {theta}_max and {pushes(flows[theta], +1)}", "",
                      f"{theta} := {theta}_max")
             # 4. l_i: 1 -> 0 when the motor reverses. Decision D2: like transition 2, links 1 and 2
             #    leave their limits only once the next link is back at its minimum
@@ -168,7 +181,7 @@ def transitions(all_states):
         #    primed phase to go to).
         if l[2] == 0 and c[2] == 0 and "theta3" in flows and p in ("1", "2"):
             emit(5, 3, c + l[:2] + [-1],
-                 f"theta3 <= theta3_min and {rate(flows['theta3'])} < 0", "",
+                 f"theta3 <= theta3_min and {pushes(flows['theta3'], -1)}", "",
                  "theta3 := theta3_min")
         # 6. l3: -1 -> 0. Decision D1: when the motor reverses and the vertical-orientation
         #    coupling theta3 = -(theta1 + theta2) of phases 1 and 2 lifts theta3 off its limit,
@@ -204,9 +217,10 @@ automaton finger {
   param m2 [deg/count] = theta2_max / 100;
   # Motor position at which link i first touches an object; 256 (beyond the motor range) = no
   # object. Issue-level scenarios set these; geometry-based contact replaces them later.
-  param gob1 [count] = 256;
-  param gob2 [count] = 256;
-  param gob3 [count] = 256;
+  # `in [0, 256]`: `hybrid check` proves properties for every object position (and none).
+  param gob1 [count] = 256 in [0, 256];
+  param gob2 [count] = 256 in [0, 256];
+  param gob3 [count] = 256 in [0, 256];
   var theta1 [deg] in [theta1_min, theta1_max];
   var theta2 [deg] in [theta2_min, theta2_max];
   var theta3 [deg] in [theta3_min, theta3_max];
@@ -217,9 +231,9 @@ automaton finger {
   var g_s [count] in [0, 255];
   discrete c1, c2, c3, l1, l2, l3;
   input u [count/s] in [-1, 1];""")
-    invariant = ("theta1 >= theta1_min and theta1 <= theta1_max and theta2 >= theta2_min and "
-                 "theta2 <= theta2_max and theta3 >= theta3_min and theta3 <= theta3_max and "
-                 "g >= 0 and g <= 255")
+    # Only the motor range is an invariant (the controller stops the motor at its ends). The joint
+    # ranges are properties: the limit transitions must keep them, and `hybrid check` proves it.
+    invariant = "g >= 0 and g <= 255"
     for s in all_states:
         c1, c2, c3, l1, l2, l3 = s
         p = phase(s)
@@ -260,6 +274,20 @@ automaton finger {
   property theta2_range: always theta2 >= theta2_min and theta2 <= theta2_max;
   property theta3_range: always theta3 >= theta3_min and theta3 <= theta3_max;
   property motor_range: always g >= 0 and g <= 255;
+  # The closed form's couplings (section 4), invariants of every run. They are what makes the
+  # joint ranges provable by induction: `hybrid check spec/finger.ha` proves all of them together.
+  # Link i at its limit sits exactly at it.
+  property limits_exact: always (l1 == 0 or theta1 == theta1_max) and (l2 == 0 or theta2 == theta2_max) and (l3 <= 0 or theta3 == theta3_max) and (l3 >= 0 or theta3 == theta3_min);
+  # The transmission: the motor counts spent on links 1 and 2 (m1, m2 degrees per count) add up
+  # to g while link 2 moves, and to g_s once it is blocked.
+  property transmission: always (c2 == 0 and l2 == 0 and theta1 / m1 + theta2 / m2 == g) or ((c2 == 1 or l2 == 1) and theta1 / m1 + theta2 / m2 == g_s);
+  # Link 2 moves only once link 1 is blocked.
+  property link2_waits_for_link1: always c1 == 1 or l1 == 1 or theta2 == theta2_min;
+  # While link 2 moves, link 3 keeps its orientation: theta1 + theta2 + theta3 = 0, or theta3 at
+  # its lower limit.
+  property distal_coupling: always c2 == 1 or l2 == 1 or (l3 == 0 and theta1 + theta2 + theta3 == 0) or (l3 == -1 and theta1 + theta2 + theta3_min >= 0);
+  # Once link 2 is blocked, theta3 follows section 4's law from (theta3_s, g_s) (decision C2).
+  property phase3_law: always (c2 == 0 and l2 == 0) or ((theta3 - theta3_s) * (255 - g) == (theta3_max - theta3_s) * (g - g_s) and g >= g_s and theta3_s >= theta3_min and theta1 + theta2 + theta3_s >= 0 and (theta3_s == theta3_min or theta1 + theta2 + theta3_s == 0));
   # Reachability questions.
   property can_close_fully: reach l1 == 1 and l2 == 1;
 }""")

@@ -23,6 +23,7 @@
 #include "automaton/system.h"
 #include "tools/gripper_command.h"
 #include "tools/output.h"
+#include "tools/check_command.h"
 #include "tools/simulate_command.h"
 
 namespace {
@@ -91,10 +92,14 @@ json Info(const System& s, const std::string& file) {
     }
     json parameters = json::array();
     for (const auto& [slot, value] : a.parameters()) {
-      parameters.push_back({{"name", sym[slot].name},
-                            {"unit", sym[slot].unit},
-                            {"value", env[slot]},
-                            {"expression", value.ToString()}});
+      json p = {{"name", sym[slot].name},
+                {"unit", sym[slot].unit},
+                {"value", env[slot]},
+                {"expression", value.ToString()}};
+      if (const auto range = a.ParameterRange(slot)) {
+        p["range"] = {range->lo.Evaluate(env), range->hi.Evaluate(env)};
+      }
+      parameters.push_back(p);
     }
     json modes = json::array();
     for (const auto& m : a.modes()) {
@@ -337,6 +342,30 @@ int main(int argc, char** argv) {
   simulate->add_option("--events", sim_args.events, "Event log CSV");
   simulate->add_flag("--json", sim_args.json, "JSON summary with every event on standard output");
 
+  hybrid::cli::CheckArgs check_args;
+  auto* check = app.add_subcommand(
+      "check",
+      "Prove a model's properties for every input (--method prove: SMT bounded model checking "
+      "and k-induction) or search for counterexamples (--method sample); every trace found is "
+      "replayed by the simulator");
+  check->add_option("MODEL", check_args.model, "Model file (.ha)")->required();
+  check->add_option("--property", check_args.properties,
+                    "Check only this property (repeatable; default: every declared property, "
+                    "components' ones named INSTANCE.NAME)");
+  check->add_option("--method", check_args.method, "prove or sample")->capture_default_str();
+  check->add_flag("--json", check_args.json, "Machine-readable output");
+  check->add_flag("--modes", check_args.modes,
+                  "Also report which modes (discrete states) some run reaches");
+  check->add_option("--depth", check_args.depth,
+                    "prove: longest counterexample or witness searched, in steps (flow segments "
+                    "and jumps)")
+      ->capture_default_str();
+  check->add_option("--induction", check_args.induction, "prove: largest k of k-induction")
+      ->capture_default_str();
+  check->add_option("--runs", check_args.runs, "sample: random runs per property")
+      ->capture_default_str();
+  check->add_option("--seed", check_args.seed, "sample: random seed")->capture_default_str();
+
   // The gripper (gripper/): closed form, objects by geometry, the hand.
   const std::string default_finger = std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha";
   const std::string default_hand = std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha";
@@ -424,6 +453,16 @@ int main(int argc, char** argv) {
       return hybrid::cli::RunHand(hand_args);
     } catch (...) {
       return ExitFor(std::current_exception(), name, kExitUsage);
+    }
+  }
+
+  if (check->parsed()) {
+    // The model is validated by the parser (ParseError: exit 1); std::invalid_argument here is
+    // a bad option value (exit 2).
+    try {
+      return hybrid::cli::RunCheck(check_args);
+    } catch (...) {
+      return ExitFor(std::current_exception(), "hybrid check", kExitUsage);
     }
   }
 

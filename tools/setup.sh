@@ -9,7 +9,8 @@ packages=(
   libeigen3-dev          # vectors and matrices at the API
   libboost-graph-dev     # the mode graph
   libgtest-dev libgmock-dev
-  librapidcheck-dev      # property tests
+  librapidcheck-dev      # property tests; sampling in `hybrid check`
+  libz3-dev              # Z3: SMT proofs in `hybrid check --method prove`
   libbenchmark-dev       # Google Benchmark
   tao-pegtl-dev          # the model-language grammar
   libcli11-dev           # the `hybrid` command line

@@ -132,6 +132,107 @@ TEST_F(AutomatonTest, ParametersReadOnlyEarlierParameters) {
                 "Automaton::AddParameter", "not finite");
 }
 
+// The std::invalid_argument message `f` throws ("" and a test failure if none).
+template <class F>
+std::string InvalidArgumentMessage(F f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::invalid_argument";
+  return "";
+}
+
+// A parameter may declare the range of values a verifier must cover; the nominal value must lie
+// in it, the bounds read earlier parameters only and must be finite.
+TEST_F(AutomatonTest, ParameterRangeIsStoredAndValidated) {
+  const Expression C0 = Expression::Constant(0);
+  const int gmax = a_.AddParameter("gmax", Expression::Constant(256));
+  const Range range{C0, Sym(a_, "gmax")};
+  const int gob1 = a_.AddParameter("gob1", Expression::Constant(256), "count", range);
+  EXPECT_EQ(a_.ParameterRange(gob1), range);
+  EXPECT_EQ(a_.ParameterRange(gmax), std::nullopt);       // a parameter without a range
+  EXPECT_EQ(a_.ParameterRange(Slot("h")), std::nullopt);  // not a parameter
+  EXPECT_EQ(a_.ParameterRange(-1), std::nullopt);
+  EXPECT_EQ(a_.ParameterRange(99), std::nullopt);
+  EXPECT_EQ(a_.ParameterEnvironment()[gob1], 256.0);  // the nominal value
+
+  const Expression C1 = Expression::Constant(1), C2 = Expression::Constant(2);
+  EXPECT_EQ(InvalidArgumentMessage([&] {
+              a_.AddParameter("k", C1, "", Range{C2, C1});
+            }),
+            "Automaton::AddParameter: empty range [2, 1] for parameter 'k'");
+  EXPECT_EQ(
+      InvalidArgumentMessage([&] { a_.AddParameter("k", Expression::Constant(300), "", range); }),
+      "Automaton::AddParameter: value 300 of parameter 'k' is outside its range [0, 256]");
+  EXPECT_EQ(InvalidArgumentMessage([&] {
+              a_.AddParameter("k", C0, "", Range{C1, C2});
+            }),
+            "Automaton::AddParameter: value 0 of parameter 'k' is outside its range [1, 2]");
+  EXPECT_EQ(InvalidArgumentMessage([&] {
+              a_.AddParameter("k", C0, "", Range{C0, C1 / C0});
+            }),
+            "Automaton::AddParameter: range of 'k': '1 / 0' is not finite");
+  EXPECT_EQ(InvalidArgumentMessage([&] {
+              a_.AddParameter("k", C0, "", Range{Sym(a_, "h"), C1});
+            }),
+            "Automaton::AddParameter: range of 'k': variable 'h' is not allowed here");
+  EXPECT_FALSE(a_.symbols().Find("k"));  // nothing was declared
+  // The bounds may be equal to the value.
+  const int k = a_.AddParameter("k", C1, "", Range{C1, C1});
+  EXPECT_EQ(a_.ParameterRange(k), (Range{C1, C1}));
+}
+
+// SetParameter keeps the range and refuses values outside it, for the parameter set and for
+// every parameter defined from it, keeping the old value.
+TEST_F(AutomatonTest, SetParameterStaysInTheDeclaredRange) {
+  const Expression C0 = Expression::Constant(0);
+  a_.AddParameter("gmax", Expression::Constant(256));
+  const Range range{C0, Sym(a_, "gmax")};
+  const int gob1 = a_.AddParameter("gob1", Expression::Constant(256), "count", range);
+  a_.SetParameter("gob1", 80.0);
+  EXPECT_EQ(a_.ParameterEnvironment()[gob1], 80.0);
+  EXPECT_EQ(a_.ParameterRange(gob1), range);
+  a_.SetParameter("gob1", 0.0);  // the bounds themselves are in the range
+  a_.SetParameter("gob1", 200.0);
+  EXPECT_EQ(InvalidArgumentMessage([&] { a_.SetParameter("gob1", 300.0); }),
+            "Automaton::SetParameter: value 300 of parameter 'gob1' is outside its range [0, 256]");
+  EXPECT_EQ(InvalidArgumentMessage([&] { a_.SetParameter("gob1", -1.0); }),
+            "Automaton::SetParameter: value -1 of parameter 'gob1' is outside its range [0, 256]");
+  EXPECT_EQ(a_.ParameterEnvironment()[gob1], 200.0);
+  // Setting the parameter a range reads: the range follows.
+  EXPECT_EQ(
+      InvalidArgumentMessage([&] { a_.SetParameter("gmax", 100.0); }),
+      "Automaton::SetParameter: setting 'gmax' to 100 puts parameter 'gob1' (200) outside its "
+      "range [0, 100]");
+  EXPECT_EQ(InvalidArgumentMessage([&] { a_.SetParameter("gmax", -5.0); }),
+            "Automaton::SetParameter: setting 'gmax' to -5 makes the range of parameter 'gob1' "
+            "empty");
+  EXPECT_EQ(a_.ParameterEnvironment()[Slot("gmax")], 256.0);
+  a_.SetParameter("gmax", 255.0);
+  EXPECT_EQ(a_.ParameterEnvironment()[Slot("gmax")], 255.0);
+  // A parameter defined from the one set must stay in its own range.
+  a_.SetParameter("gob1", 100.0);
+  a_.AddParameter("half", Sym(a_, "gob1") / Expression::Constant(2), "",
+                  Range{C0, Expression::Constant(100)});
+  EXPECT_EQ(InvalidArgumentMessage([&] { a_.SetParameter("gob1", 250.0); }),
+            "Automaton::SetParameter: setting 'gob1' to 250 puts parameter 'half' (125) outside "
+            "its range [0, 100]");
+  EXPECT_EQ(a_.ParameterEnvironment()[gob1], 100.0);
+}
+
+TEST_F(AutomatonTest, EqualityComparesParameterRanges) {
+  Automaton with = a_, without = a_;
+  const Expression C1 = Expression::Constant(1);
+  with.AddParameter("k", C1, "", Range{Expression::Constant(0), C1});
+  without.AddParameter("k", C1);
+  EXPECT_NE(with, without);
+  Automaton same = a_;
+  same.AddParameter("k", C1, "", Range{Expression::Constant(0), C1});
+  EXPECT_EQ(with, same);
+}
+
 TEST_F(AutomatonTest, RejectsFlowsOfNonVariablesAndUnsortedFlows) {
   Mode m;
   m.name = "m";

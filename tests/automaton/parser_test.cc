@@ -499,6 +499,54 @@ automaton arm {
   EXPECT_EQ(init.values[1].range, (Range{C(0), C(0)}));
 }
 
+// `param NAME [unit] = VALUE in [LO, HI];`: the range is optional, its bounds read earlier
+// parameters; the value stays the nominal one.
+TEST(Parser, ParameterRanges) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton gripper {
+  param gmax [count] = 256;
+  param gob1 [count] = 256 in [0, gmax];
+  param k = 2 in [-1, 2 * gmax]; # no unit
+  param plain = 3;
+  param e = 1in[1,1];
+  var g;
+  mode m { g' = 1; }
+  init m { g = 0; }
+})");
+  const int gmax = *a.symbols().Find("gmax"), gob1 = *a.symbols().Find("gob1");
+  EXPECT_EQ(a.symbols()[gob1], (Symbol{"gob1", SymbolKind::kParameter, "count"}));
+  EXPECT_EQ(a.parameters()[1].second, C(256));
+  EXPECT_EQ(a.ParameterRange(gmax), std::nullopt);
+  EXPECT_EQ(a.ParameterRange(gob1), (Range{C(0), Sym(a, "gmax")}));
+  EXPECT_EQ(a.ParameterRange(*a.symbols().Find("k")), (Range{C(-1), C(2) * Sym(a, "gmax")}));
+  EXPECT_EQ(a.ParameterRange(*a.symbols().Find("plain")), std::nullopt);
+  EXPECT_EQ(a.ParameterRange(*a.symbols().Find("e")), (Range{C(1), C(1)}));
+  EXPECT_EQ(a.ParameterEnvironment()[gob1], 256.0);
+}
+
+// Each bad range is reported at the offending token: the parameter for a range the value does
+// not satisfy, the name read for a bound that reads a non-parameter.
+TEST(ParseErrors, BadParameterRanges) {
+  auto error = [](const std::string& declaration) {
+    const ParseError e = ParseFailure("automaton a {\n  param gmax = 256;\n  var x;\n  " +
+                                      declaration + "\n  mode m { }\n  init m { x = 0; }\n}\n");
+    return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.message();
+  };
+  EXPECT_EQ(error("param gob1 = 2 in [3, 1];"), "4:9: empty range [3, 1] for parameter 'gob1'");
+  EXPECT_EQ(error("param gob1 [count] = 300 in [0, gmax];"),
+            "4:9: value 300 of parameter 'gob1' is outside its range [0, 256]");
+  EXPECT_EQ(error("param gob1 = -1 in [0, gmax];"),
+            "4:9: value -1 of parameter 'gob1' is outside its range [0, 256]");
+  EXPECT_EQ(error("param gob1 = 1 in [0, x];"),
+            "4:25: variable 'x' is not allowed here: a parameter value, domain, bound or initial "
+            "value may read only parameters");
+  EXPECT_EQ(error("param gob1 = 1 in [0, gob1];"), "4:25: undefined name 'gob1'");
+  EXPECT_EQ(error("param gob1 = 1 in [0, 1 / 0];"), "4:9: range of 'gob1': '1 / 0' is not finite");
+  EXPECT_EQ(error("param gob1 = 1 in [0, 2;"), "4:26: expected ']'");
+  EXPECT_EQ(error("param gob1 = 1 in 0, 2;"), "4:21: expected a range '[lo, hi]'");
+  EXPECT_EQ(error("param gob1 = 1 within [0, 2];"), "4:18: expected ';' or a range 'in [lo, hi]'");
+}
+
 TEST(Parser, ExpressionsFollowPrecedenceAndAssociativity) {
   const Automaton a = OnlyAutomaton(R"(
 automaton e {
@@ -640,6 +688,78 @@ automaton p {
             Predicate::And(Predicate::Not(Predicate::InMode("low")),
                            Predicate::Or(Predicate::Compare({x, Relation::kGreater, C(1)}),
                                          Predicate::False())));
+}
+
+// `property p: ...` with a body that names an unknown variable or mode, reads an input or is
+// not a predicate: the message says which, at the offending token.
+TEST(ParseErrors, BadPropertyBodies) {
+  auto error = [](const std::string& property) {
+    const ParseError e = ParseFailure(
+        "automaton a {\n  var theta1;\n  input u in [0, 1];\n  mode m { theta1' = u; }\n"
+        "  init m { theta1 = 0; }\n  property p: " +
+        property + ";\n}\n");
+    return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.message();
+  };
+  EXPECT_EQ(error("always x_unknown >= 0"), "6:22: undefined name 'x_unknown'");
+  EXPECT_EQ(error("reach in no_such_mode"), "6:24: unknown mode 'no_such_mode'");
+  EXPECT_EQ(error("always u >= 0"),
+            "6:22: input 'u' is not allowed here: a property may not read inputs");
+  const std::string not_a_predicate =
+      "' is not a predicate (expected a comparison such as x >= 0, 'in MODE', true or false)";
+  EXPECT_EQ(error("always theta1 + 1"), "6:22: property 'p': 'theta1 + 1" + not_a_predicate);
+  EXPECT_EQ(error("always theta1"), "6:22: property 'p': 'theta1" + not_a_predicate);
+  EXPECT_EQ(error("never sin(theta1) within 5"),
+            "6:21: property 'p': 'sin(theta1)" + not_a_predicate);
+  EXPECT_EQ(error("always theta1 >= 0 and theta1 * 2"),
+            "6:38: property 'p': 'theta1 * 2" + not_a_predicate);
+  EXPECT_EQ(error("reach in m or 1"), "6:29: property 'p': '1" + not_a_predicate);
+  EXPECT_EQ(error("always not (theta1)"), "6:27: property 'p': 'theta1" + not_a_predicate);
+  EXPECT_EQ(error("always theta1 = 1"), "6:29: '=' is not a comparison: write '==' for equality");
+  EXPECT_EQ(error("always"), "6:21: expected a predicate");
+  EXPECT_EQ(error("always theta1 >= 0 and"), "6:37: expected a predicate");
+}
+
+// Expressions in parentheses still start comparisons: only a whole operand that is an
+// expression is an error.
+TEST(Parser, ParenthesesInPropertiesGroupExpressionsOrPredicates) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton a {
+  var x;
+  mode m { x' = 1; }
+  init m { x = 0; }
+  property p: always (x + 1) >= 0 and ((x)) * 2 <= 4 or (x >= 1 and (in m));
+  property q: never -(x) > 3 or not (x) == 2;
+})");
+  const Expression x = Sym(a, "x");
+  EXPECT_EQ(
+      a.properties()[0].predicate,
+      Predicate::Or(Predicate::And(Predicate::Compare({x + C(1), Relation::kGreaterEqual, C(0)}),
+                                   Predicate::Compare({x * C(2), Relation::kLessEqual, C(4)})),
+                    Predicate::And(Predicate::Compare({x, Relation::kGreaterEqual, C(1)}),
+                                   Predicate::InMode("m"))));
+  EXPECT_EQ(a.properties()[1].predicate,
+            Predicate::Or(Predicate::Compare({-x, Relation::kGreater, C(3)}),
+                          Predicate::Not(Predicate::Compare({x, Relation::kEqual, C(2)}))));
+}
+
+// The same for properties of a system: names and modes are qualified by the instance.
+TEST(ParseErrors, BadSystemPropertyBodies) {
+  auto error = [](const std::string& property) {
+    const ParseError e = ParseFailure(
+        "automaton a {\n  var theta1;\n  input u in [0, 1];\n  mode m { theta1' = u; }\n"
+        "  init m { theta1 = 0; }\n}\nsystem s {\n  instance A = a;\n  property p: " +
+        property + ";\n}\n");
+    return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.message();
+  };
+  EXPECT_EQ(error("always A.nope >= 0"), "9:22: undefined name 'A.nope'");
+  EXPECT_EQ(error("always theta1 >= 0"), "9:22: undefined name 'theta1'");
+  EXPECT_EQ(error("reach in A.nope"), "9:24: unknown mode 'A.nope'");
+  EXPECT_EQ(error("reach in m"), "9:24: unknown mode 'm'");
+  EXPECT_EQ(error("always A.u <= 1"),
+            "9:22: input 'A.u' is not allowed here: a property may not read inputs");
+  EXPECT_EQ(error("always A.theta1 + 1"),
+            "9:22: property 'p': 'A.theta1 + 1' is not a predicate (expected a comparison such as "
+            "x >= 0, 'in MODE', true or false)");
 }
 
 TEST(Parser, SystemWithInstancesAndShare) {

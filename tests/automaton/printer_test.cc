@@ -147,6 +147,39 @@ TEST(PrinterTest, StepSignalsNotAtTimeZeroUseTheLongForm) {
   EXPECT_TRUE(ParseAutomaton(text2, "a.ha") == a) << text2;
 }
 
+TEST(PrinterTest, ParameterRangesFollowTheValue) {
+  Automaton a("gripper");
+  const int gmax = a.AddParameter("gmax", C(256), "count");
+  a.AddParameter("gob1", C(256), "count", Range{C(0), Expression::Symbol("gmax", gmax)});
+  a.AddParameter("k", -C(0.5), "", Range{-C(1), C(0)});
+  a.AddParameter("m", C(1));
+  const int x = a.AddVariable("x");
+  Mode m;
+  m.name = "m";
+  a.AddMode(m);
+  a.AddInitialState({ModeId(0), {{x, Range{C(0.0), C(0.0)}, true}}});
+  const std::string text = PrintAutomaton(a);
+  EXPECT_EQ(text, R"(automaton gripper {
+  param gmax [count] = 256;
+  param gob1 [count] = 256 in [0, gmax];
+  param k = -0.5 in [-1, 0];
+  param m = 1;
+  var x;
+
+  mode m {
+  }
+
+  init m { x = 0; }
+}
+)");
+  EXPECT_TRUE(ParseAutomaton(text, "gripper.ha") == a) << text;
+  // A value set later is printed with the range kept.
+  a.SetParameter("gob1", 80);
+  const std::string set = PrintAutomaton(a);
+  EXPECT_NE(set.find("param gob1 [count] = 80 in [0, gmax];"), std::string::npos) << set;
+  EXPECT_TRUE(ParseAutomaton(set, "gripper.ha") == a) << set;
+}
+
 TEST(PrinterTest, PrintSystemOfOneAutomatonIsTheAutomaton) {
   const System s = System::Of(Tank());
   EXPECT_EQ(PrintSystem(s), kTankText);
@@ -163,6 +196,9 @@ void AssertSameAutomaton(const Automaton& parsed, const Automaton& a) {
   RC_ASSERT(std::ranges::equal(parsed.discrete_variables(), a.discrete_variables()));
   RC_ASSERT(std::ranges::equal(parsed.inputs(), a.inputs()));
   RC_ASSERT(std::ranges::equal(parsed.parameters(), a.parameters()));
+  for (const auto& [slot, value] : a.parameters()) {
+    RC_ASSERT(parsed.ParameterRange(slot) == a.ParameterRange(slot));
+  }
   RC_ASSERT(std::ranges::equal(parsed.modes(), a.modes()));
   RC_ASSERT(std::ranges::equal(parsed.transitions(), a.transitions()));
   RC_ASSERT(std::ranges::equal(parsed.initial_states(), a.initial_states()));
@@ -173,6 +209,10 @@ void AssertSameAutomaton(const Automaton& parsed, const Automaton& a) {
 
 RC_GTEST_PROP(PrinterProperty, PrintThenParseGivesAnEqualAutomaton, ()) {
   const Automaton a = *GenAutomaton();
+  RC_CLASSIFY(
+      std::ranges::any_of(a.parameters(),
+                          [&](const auto& p) { return a.ParameterRange(p.first).has_value(); }),
+      "a parameter with a range");
   const std::string text = PrintAutomaton(a);
   RC_LOG() << text;
   const Automaton parsed = ParseAutomaton(text, "x.ha");

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -260,6 +261,150 @@ TEST(System, OnlyOneComponentMayGiveASharedVariableAFlow) {
     EXPECT_NO_THROW(s.AddComponent("B", writer));
     EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"A.x", "B.x"}));
   }
+}
+
+// A gripper-like component with an uncertain parameter whose range reads another parameter.
+const char* const kContact = R"(
+automaton contact {
+  param gmax [count] = 256;
+  param gob1 [count] = 256 in [0, gmax];
+  var theta1 [deg], g;
+  mode moving { theta1' = 1; g' = 1; inv g <= gob1; }
+  init moving { theta1 = 0; g = 0; }
+}
+)";
+
+// Renaming qualifies the range's expressions with the parameter; SetParameter keeps it and
+// refuses values outside it; the product keeps it too.
+TEST(System, ParameterRangeSurvivesComposition) {
+  const Automaton contact = Parse(kContact);
+  System s("hand");
+  s.AddComponent("A", contact);
+  s.AddComponent("B", contact);
+  const Component& a = s.components()[0];
+  const int gob1 = *a.automaton.symbols().Find("A.gob1");
+  const std::optional<Range> range = a.automaton.ParameterRange(gob1);
+  ASSERT_TRUE(range.has_value());
+  EXPECT_EQ(range->lo, Expression::Constant(0));
+  EXPECT_EQ(range->hi, Expression::Symbol("A.gmax", 0));
+  EXPECT_EQ(a.source.ParameterRange(gob1), contact.ParameterRange(gob1));
+  EXPECT_FALSE(a.automaton.ParameterRange(0).has_value());  // A.gmax has none
+
+  s.SetParameter("A.gob1", 80.0);
+  EXPECT_EQ(s.components()[0].automaton.ParameterEnvironment()[gob1], 80.0);
+  EXPECT_EQ(s.components()[0].source.ParameterEnvironment()[gob1], 80.0);
+  EXPECT_EQ(s.components()[0].automaton.ParameterRange(gob1), range);
+  EXPECT_EQ(InvalidArgument([&] { s.SetParameter("A.gob1", 300.0); }),
+            "System::SetParameter: Automaton::SetParameter: value 300 of parameter 'A.gob1' is "
+            "outside its range [0, 256]");
+  EXPECT_EQ(s.components()[0].automaton.ParameterEnvironment()[gob1], 80.0);
+
+  const Automaton product = s.Product();
+  const int global = *product.symbols().Find("B.gob1");
+  const std::optional<Range> product_range = product.ParameterRange(global);
+  ASSERT_TRUE(product_range.has_value());
+  EXPECT_EQ(product_range->hi, Expression::Symbol("B.gmax", *product.symbols().Find("B.gmax")));
+  EXPECT_EQ(product.ParameterEnvironment()[*product.symbols().Find("A.gob1")], 80.0);
+  EXPECT_EQ(product.ParameterRange(*product.symbols().Find("A.gob1")),
+            (Range{Expression::Constant(0),
+                   Expression::Symbol("A.gmax", *product.symbols().Find("A.gmax"))}));
+}
+
+// A shared parameter is one constant: its range must be the same (or absent) everywhere.
+TEST(System, SharedParameterRangesMustAgree) {
+  auto with_range = [](const std::string& name, const std::string& range) {
+    return Parse("automaton " + name + " { param k = 2" + range +
+                 "; var x; mode m { x' = k; } init m { x = 0; } }");
+  };
+  System s("s");
+  s.Share("k");
+  s.AddComponent("A", with_range("a", " in [0, 4]"));
+  EXPECT_NO_THROW(s.AddComponent("B", with_range("b", " in [0, 2 * 2]")));
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("C", with_range("c", " in [1, 4]")); }),
+            "System::AddComponent: shared parameter 'k' has range [1, 4] in 'c' but [0, 4] in "
+            "'a'");
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("D", with_range("d", "")); }),
+            "System::AddComponent: shared parameter 'k' has range none in 'd' but [0, 4] in 'a'");
+  s.SetParameter("k", 3.0);
+  EXPECT_EQ(InvalidArgument([&] { s.SetParameter("k", 5.0); }),
+            "System::SetParameter: Automaton::SetParameter: value 5 of parameter 'k' is outside "
+            "its range [0, 4]");
+}
+
+// A value one component refuses (a parameter defined from it would leave its range) is set in
+// none: a shared parameter stays one value.
+TEST(System, SetParameterIsAllOrNothing) {
+  System s("s");
+  s.Share("k");
+  s.AddComponent("B", Parse("automaton b { param k = 2; var x; mode m { x' = k; } "
+                            "init m { x = 0; } }"));
+  s.AddComponent("A", Parse("automaton a { param k = 2; param half = k / 2 in [0, 1]; var x; "
+                            "mode m { x' = half; } init m { x = 0; } }"));
+  EXPECT_EQ(InvalidArgument([&] { s.SetParameter("k", 4.0); }),
+            "System::SetParameter: Automaton::SetParameter: setting 'k' to 4 puts parameter "
+            "'A.half' (2) outside its range [0, 1]");
+  for (const Component& c : s.components()) {
+    EXPECT_EQ(c.automaton.ParameterEnvironment()[0], 2.0) << c.instance;
+    EXPECT_EQ(c.source.ParameterEnvironment()[0], 2.0) << c.instance;
+  }
+  s.SetParameter("k", 1.0);
+  EXPECT_EQ(s.components()[0].automaton.ParameterEnvironment()[0], 1.0);
+  EXPECT_EQ(s.components()[1].automaton.ParameterEnvironment()[1], 0.5);
+}
+
+// SetInitialValue sets a variable's initial point in every initial state of every component
+// that has it, in the renamed automaton and the source alike.
+TEST(System, SetInitialValueByQualifiedOrSharedName) {
+  const Automaton contact = Parse(kContact);
+  // Reads the shared g without giving it a flow; g is its slot 0.
+  const Automaton watch =
+      Parse("automaton watch { var g; mode w { inv g <= 300; } init w { g = 5; } }");
+  System s("hand");
+  s.AddComponent("B", contact);  // before the share: B.g is its own
+  s.Share("g");
+  s.AddComponent("A", contact);
+  s.AddComponent("W", watch);
+  const int theta1 = *contact.symbols().Find("theta1");
+  const int g = *contact.symbols().Find("g");
+  // The value of `slot` in the first initial state of `a`.
+  auto initial_of = [](const Automaton& a, int slot) {
+    const InitialState& init = a.initial_states()[0];
+    const auto it = std::find_if(init.values.begin(), init.values.end(),
+                                 [&](const InitialValue& v) { return v.slot == slot; });
+    return it == init.values.end() ? InitialValue{} : *it;
+  };
+  auto initial = [&](int component, int slot) {
+    return initial_of(s.components()[component].automaton, slot);
+  };
+  s.SetInitialValue("A.theta1", 12.5);
+  const Expression point = Expression::Constant(12.5);
+  EXPECT_EQ(initial(1, theta1), (InitialValue{theta1, Range{point, point}, true}));
+  EXPECT_EQ(initial(0, theta1).range.lo, Expression::Constant(0));  // B untouched
+  EXPECT_EQ(s.components()[1].source.initial_states()[0].values,
+            s.components()[1].automaton.initial_states()[0].values);
+  s.SetInitialValue("g", -3.0);  // shared: A and W
+  EXPECT_EQ(initial(1, g).range.lo, Expression::Constant(-3));
+  EXPECT_EQ(initial(2, 0).range.lo, Expression::Constant(-3));
+  EXPECT_EQ(initial(0, g).range.lo, Expression::Constant(0));  // B.g untouched
+  s.SetInitialValue("B.g", 7.0);
+  EXPECT_EQ(initial(0, g).range.lo, Expression::Constant(7));
+  EXPECT_EQ(initial_of(s.components()[2].source, 0).range.hi, Expression::Constant(-3));
+  // The product starts there.
+  const Automaton product = s.Product();
+  EXPECT_EQ(initial_of(product, *product.symbols().Find("A.theta1")).range.lo, point);
+  EXPECT_EQ(initial_of(product, *product.symbols().Find("B.theta1")).range.lo,
+            Expression::Constant(0));
+  EXPECT_EQ(initial_of(product, *product.symbols().Find("g")).range.lo, Expression::Constant(-3));
+
+  EXPECT_EQ(InvalidArgument([&] { s.SetInitialValue("theta1", 1.0); }),
+            "System::SetInitialValue: no component has a continuous variable 'theta1'");
+  EXPECT_EQ(InvalidArgument([&] { s.SetInitialValue("A.nope", 1.0); }),
+            "System::SetInitialValue: no component has a continuous variable 'A.nope'");
+  EXPECT_EQ(InvalidArgument([&] { s.SetInitialValue("A.gob1", 1.0); }),
+            "System::SetInitialValue: no component has a continuous variable 'A.gob1'");
+  EXPECT_EQ(InvalidArgument([&] { s.SetInitialValue("A.theta1", std::nan("")); }),
+            "System::SetInitialValue: initial value of 'A.theta1' is not finite");
+  EXPECT_EQ(initial(1, theta1).range.lo, point);
 }
 
 TEST(System, SharedParametersMustAgree) {

@@ -224,6 +224,18 @@ std::pair<Range, std::pair<double, double>> ParameterRange(const Automaton& a,
   return {Range{lo, hi}, {lo_value, hi_value}};
 }
 
+/// A range [lo, hi] over `params` containing `v`: each bound an expression over parameters when
+/// one on the right side of `v` comes up, otherwise a constant (sometimes `v` itself).
+Range RangeAround(const Automaton& a, const std::vector<Leaf>& params, double v) {
+  // A constant that parses back to itself: non-negative constants, negated when negative.
+  auto constant = [](double c) { return c < 0 ? -Num(-c) : Num(c == 0 ? 0.0 : c); };
+  auto [lo, lo_value] = ParameterExpression(a, params);
+  if (!(lo_value <= v)) lo = constant(Chance(30) ? v : std::floor(v) - Uniform(0, 4));
+  auto [hi, hi_value] = ParameterExpression(a, params);
+  if (!(hi_value >= v)) hi = constant(Chance(30) ? v : std::ceil(v) + Uniform(0, 4));
+  return Range{lo, hi};
+}
+
 Constraint RandomConstraint(const std::vector<Leaf>& leaves) {
   Constraint c;
   const int n = Uniform(0, 4);
@@ -319,7 +331,10 @@ Automaton BuildAutomaton() {
         break;
       }
       case Decl::kParameter: {
-        const int slot = a.AddParameter(name, ParameterExpression(a, params).first, RandomUnit());
+        auto [value, nominal] = ParameterExpression(a, params);
+        std::optional<Range> range;
+        if (Chance(40)) range = RangeAround(a, params, nominal);
+        const int slot = a.AddParameter(name, value, RandomUnit(), range);
         params.push_back({name, slot});
         readable.push_back({name, slot});
         all.push_back({name, slot});

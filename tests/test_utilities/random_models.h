@@ -37,9 +37,9 @@ rc::Gen<Expression> GenExpression(int depth = 4);
 /// (+, -, *, sin, cos, exp of bounded arguments, integer powers), for derivative checks.
 rc::Gen<Expression> GenSmoothExpression(int depth = 4);
 
-/// A random valid automaton: variables, discrete variables, inputs, parameters, modes with flows
-/// and invariants, transitions with guards, resets, labels and urgency, initial states,
-/// properties and a scenario.
+/// A random valid automaton: variables, discrete variables, inputs, parameters (some with a
+/// range of values), modes with flows and invariants, transitions with guards, resets, labels
+/// and urgency, initial states, properties and a scenario.
 rc::Gen<Automaton> GenAutomaton();
 
 /// A random non-negative finite constant as GenExpression uses them: small integers, decimals

@@ -1,0 +1,518 @@
+#include "solvers/property_prover.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+#include <cmath>
+#include <functional>
+#include <set>
+#include <stdexcept>
+
+#include "solvers/smt_encoding.h"
+
+namespace hybrid {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+Predicate Remap(const Predicate& p, const std::function<Expression(const Expression&)>& expr,
+                const std::function<std::string(const std::string&)>& mode) {
+  switch (p.kind()) {
+    case Predicate::Kind::kTrue:
+    case Predicate::Kind::kFalse:
+      return p;
+    case Predicate::Kind::kComparison: {
+      const Comparison& c = p.comparison();
+      return Predicate::Compare({expr(c.lhs), c.relation, expr(c.rhs)});
+    }
+    case Predicate::Kind::kInMode:
+      return Predicate::InMode(mode(p.mode()));
+    case Predicate::Kind::kNot:
+      return Predicate::Not(Remap(p.operands()[0], expr, mode));
+    case Predicate::Kind::kAnd:
+      return Predicate::And(Remap(p.operands()[0], expr, mode),
+                            Remap(p.operands()[1], expr, mode));
+    case Predicate::Kind::kOr:
+      return Predicate::Or(Remap(p.operands()[0], expr, mode), Remap(p.operands()[1], expr, mode));
+  }
+  return p;
+}
+
+// A property to decide on one automaton (its own slots and mode names).
+struct Goal {
+  Property property;   // local
+  int result = -1;     // index into the results, -1 for a lemma only
+  Property original;   // as asked (System names), for the replay
+};
+
+struct Job {
+  const Automaton* automaton = nullptr;
+  // automaton slot -> System slot
+  std::vector<int> to_system;
+  std::vector<Goal> goals;
+};
+
+// Prints a path of a model (HYBRID_CHECK_DEBUG).
+void DebugPath(SmtEncoding& enc, const z3::model& model, int n) {
+  const auto path = enc.ReadPath(model, n);
+  for (const auto& [name, v] : enc.ReadParameters(model)) std::cerr << "  " << name << " = " << v;
+  std::cerr << "\n";
+  for (int k = 0; k <= n; ++k) {
+    const auto& s = path[k];
+    std::cerr << "  s" << k << " " << enc.automaton().modes()[s.mode].name;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      std::cerr << " " << enc.automaton().symbols()[enc.automaton().variables()[i].slot].name
+                << "=" << s.x[i];
+    }
+    for (double u : s.input) std::cerr << " u=" << u;
+    if (k < n) {
+      if (s.flow) std::cerr << "  --flow d=" << s.duration;
+      else std::cerr << "  --jump " << enc.automaton().transitions()[s.transition].name;
+    }
+    std::cerr << "\n";
+  }
+}
+
+class Engine {
+ public:
+  Engine(const System& system, const PropertyProver::Options& options, Clock::time_point start,
+         std::vector<CheckResult>& results)
+      : system_(system), options_(options), start_(start), results_(results) {}
+
+  void Run(const Job& job);
+
+ private:
+  struct Candidate {
+    const Goal* goal;
+    Predicate bad;         // a state that is a counterexample / witness
+    bool invariant;        // always/never (else reach)
+    bool decided = false;  // a verdict is in results_ (or a lemma was refuted)
+    bool refuted = false;  // the encoding reaches `bad`: not a lemma
+    int replays = 0;
+  };
+
+  bool TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth,
+                Candidate& c);
+  void Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace = {});
+
+  const System& system_;
+  const PropertyProver::Options& options_;
+  Clock::time_point start_;
+  std::vector<CheckResult>& results_;
+};
+
+void Engine::Decide(const Candidate& c, Verdict v, std::string reason,
+                    std::optional<Trace> trace) {
+  if (c.goal->result < 0) return;
+  CheckResult& r = results_[c.goal->result];
+  r.verdict = v;
+  r.reason = std::move(reason);
+  r.trace = std::move(trace);
+  r.seconds = Since(start_);
+}
+
+bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth,
+                      Candidate& c) {
+  const Automaton& a = *job.automaton;
+  const auto path = enc.ReadPath(model, depth);
+  Trace trace;
+  trace.parameters = enc.ReadParameters(model);
+  // Initial values where the model's initial state is a box.
+  for (const InitialState& init : a.initial_states()) {
+    if (init.mode.value() != path[0].mode) continue;
+    for (const InitialValue& iv : init.values) {
+      if (iv.is_point) continue;
+      int index = 0;
+      for (const VariableInfo& v : a.variables()) {
+        if (v.slot == iv.slot) break;
+        ++index;
+      }
+      trace.initial_values.emplace_back(system_.symbols()[job.to_system[iv.slot]].name,
+                                        path[0].x[index]);
+    }
+  }
+  // The input schedule: one step piece per flow segment of positive duration.
+  const int ni = static_cast<int>(a.inputs().size());
+  std::vector<InputSignal> signals(ni);
+  double t = 0.0;
+  for (int i = 0; i < ni; ++i) {
+    signals[i].slot = job.to_system[a.inputs()[i].slot];
+    signals[i].shape = InputSignal::Shape::kStep;
+  }
+  auto add_piece = [&](const std::vector<double>& u, double duration) {
+    for (int i = 0; i < ni; ++i) {
+      auto& pts = signals[i].points;
+      if (pts.empty() || pts.back().second != u[i]) {
+        if (!pts.empty() && pts.back().first == t) pts.back().second = u[i];
+        else pts.emplace_back(t, u[i]);
+      }
+    }
+    t += duration;
+  };
+  for (int k = 0; k < depth; ++k) {
+    if (path[k].flow && path[k].duration > 0) add_piece(path[k].input, path[k].duration);
+  }
+  // A short tail with the inputs at rest (where 0 is allowed) so that jumps at the end happen.
+  std::vector<double> rest(ni, 0.0);
+  for (int i = 0; i < ni; ++i) {
+    const auto [lo, hi] = system_.InputBounds(signals[i].slot);
+    if (lo > 0 || hi < 0) rest[i] = path.back().input[i];
+  }
+  const double tail = std::max(1e-6, 1e-6 * t);
+  add_piece(rest, tail);
+  trace.inputs.until = t;
+  for (auto& s : signals) {
+    if (s.points.empty()) s.points.emplace_back(0.0, 0.0);
+    trace.inputs.inputs.push_back(s);
+  }
+  ++c.replays;
+  bool replayed = false;
+  try {
+    replayed = ReplayTrace(system_, c.goal->original, trace);
+  } catch (const std::exception&) {
+  }
+  if (!replayed) {
+    if (std::getenv("HYBRID_CHECK_DEBUG")) {
+      std::cerr << "path of " << depth << " steps for " << c.goal->property.name
+                << " does not replay:\n";
+      DebugPath(enc, model, depth);
+    }
+    return false;
+  }
+  Decide(c, c.invariant ? Verdict::kViolated : Verdict::kReachable,
+         std::string(c.invariant ? "counterexample" : "witness") + " of " +
+             std::to_string(depth) + " steps found by bounded model checking, replayed by " +
+             "the simulator",
+         std::move(trace));
+  c.decided = true;
+  return true;
+}
+
+void Engine::Run(const Job& job) {
+  const Automaton& a = *job.automaton;
+  z3::context ctx;
+  z3::params params(ctx);
+  params.set("timeout", options_.timeout_ms);
+  SmtEncoding enc(ctx, a);
+  std::vector<Candidate> cands;
+  for (const Goal& g : job.goals) {
+    const Property& p = g.property;
+    switch (p.kind) {
+      case Property::Kind::kAlways:
+        cands.push_back({&g, Predicate::Not(p.predicate), true});
+        break;
+      case Property::Kind::kNever:
+        cands.push_back({&g, p.predicate, true});
+        break;
+      case Property::Kind::kReach:
+        cands.push_back({&g, p.predicate, false});
+        break;
+    }
+  }
+  // Bounded properties are checked like unbounded ones (sound for `proved`); their traces are
+  // replayed with the horizon.
+  auto pending = [&](const Candidate& c) { return !c.decided && c.replays < 3; };
+
+  // 1. Base case: no violation within max_induction - 1 steps (what k-induction needs).
+  z3::solver bmc(ctx);
+  bmc.set(params);
+  bmc.add(enc.Initial());
+  bmc.add(enc.State(0));
+  bool bmc_complete = true;
+  int bmc_depth = -1;  // paths up to this length are in `bmc`
+  auto search = [&](int n, bool invariants_only) {
+    while (bmc_depth < n) {
+      ++bmc_depth;
+      if (bmc_depth > 0) {
+        bmc.add(enc.Transition(bmc_depth - 1));
+        bmc.add(enc.State(bmc_depth));
+      }
+    }
+    z3::expr_vector any(ctx);
+    for (Candidate& c : cands) {
+      if (!pending(c) || (invariants_only && !c.invariant)) continue;
+      any.push_back(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, 0.0)
+                                : enc.Holds(c.bad, n, 0.0));
+    }
+    if (any.empty()) return;
+    bmc.push();
+    bmc.add(z3::mk_or(any));
+    const z3::check_result r = bmc.check();
+    bmc.pop();
+    if (r == z3::unknown) bmc_complete = false;
+    if (r != z3::sat) return;
+    for (Candidate& c : cands) {
+      if (!pending(c) || (invariants_only && !c.invariant)) continue;
+      // Robust violations first (they replay clear of rounding), then exact ones.
+      for (double margin : {options_.robust_margin, 0.0}) {
+        if (!pending(c)) break;
+        bmc.push();
+        bmc.add(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
+                            : enc.Holds(c.bad, n, 0.0));
+        const z3::check_result rc = bmc.check();
+        if (rc == z3::sat) {
+          c.refuted = c.refuted || c.invariant;
+          const z3::model model = bmc.get_model();
+          TryTrace(job, enc, model, n, c);
+        } else if (rc == z3::unknown) {
+          bmc_complete = false;
+        }
+        bmc.pop();
+        if (rc == z3::sat || !c.invariant) break;
+      }
+    }
+  };
+  for (int n = 0; n < options_.max_induction && n <= options_.max_depth; ++n) search(n, true);
+  const bool base_complete = bmc_complete;
+
+  // 2. k-induction with Houdini over the surviving invariants (and negated reach targets).
+  auto open = [&]() {
+    for (const Candidate& c : cands) {
+      if (!c.decided && c.goal->result >= 0) return true;
+    }
+    return false;
+  };
+  for (int k = 1; k <= options_.max_induction && open() && base_complete; ++k) {
+    std::vector<Candidate*> set;
+    for (Candidate& c : cands) {
+      if (!c.refuted && !c.decided) set.push_back(&c);
+    }
+    z3::solver s(ctx);
+    s.set(params);
+    for (int i = 0; i <= k; ++i) s.add(enc.State(i));
+    for (int i = 0; i < k; ++i) s.add(enc.Transition(i));
+    std::vector<z3::expr> guard;
+    for (std::size_t j = 0; j < set.size(); ++j) {
+      z3::expr lit =
+          ctx.bool_const(("lemma#" + std::to_string(k) + "#" + std::to_string(j)).c_str());
+      z3::expr hyp = ctx.bool_val(true);
+      for (int i = 0; i < k; ++i) hyp = hyp && !enc.Holds(set[j]->bad, i, 0.0);
+      s.add(z3::implies(lit, hyp));
+      guard.push_back(lit);
+    }
+    std::vector<bool> alive(set.size(), true);
+    bool changed = true;
+    while (changed) {
+      changed = false;
+      for (std::size_t j = 0; j < set.size(); ++j) {
+        if (!alive[j]) continue;
+        z3::expr_vector assumptions(ctx);
+        for (std::size_t i = 0; i < set.size(); ++i) {
+          if (alive[i]) assumptions.push_back(guard[i]);
+        }
+        s.push();
+        s.add(enc.Holds(set[j]->bad, k, 0.0));
+        const z3::check_result r = s.check(assumptions);
+        if (r == z3::sat && std::getenv("HYBRID_CHECK_DEBUG")) {
+          std::cerr << "induction k=" << k << " fails for " << set[j]->goal->property.name
+                    << ":\n";
+          DebugPath(enc, s.get_model(), k);
+        }
+        s.pop();
+        if (r != z3::unsat) {
+          alive[j] = false;
+          changed = true;
+        }
+      }
+    }
+    std::size_t lemmas = 0;
+    for (std::size_t j = 0; j < set.size(); ++j) lemmas += alive[j] ? 1 : 0;
+    for (std::size_t j = 0; j < set.size(); ++j) {
+      if (!alive[j]) continue;
+      Candidate& c = *set[j];
+      const std::string how = std::to_string(k) + "-induction, together with " +
+                              std::to_string(lemmas - 1) + " other invariant(s) as lemmas";
+      Decide(c, c.invariant ? Verdict::kProved : Verdict::kUnreachable, "proved by " + how);
+      c.decided = true;
+    }
+  }
+
+  // 3. Counterexamples and witnesses for what is still open, up to max_depth steps.
+  for (int n = 0; n <= options_.max_depth && open(); ++n) search(n, false);
+  for (Candidate& c : cands) {
+    if (!c.decided && c.refuted) {
+      Decide(c, Verdict::kUnknown,
+             "the encoding (an over-approximation) reaches a violation, but no path of at most " +
+                 std::to_string(options_.max_depth) + " steps found replays in the simulator");
+      c.decided = true;
+    }
+  }
+  for (Candidate& c : cands) {
+    if (c.decided) continue;
+    std::string why = bmc_complete ? "" : "an SMT query timed out; ";
+    if (c.invariant) {
+      why += "not proved by k-induction for k <= " + std::to_string(options_.max_induction) +
+             " and no counterexample within " + std::to_string(options_.max_depth) + " steps";
+    } else {
+      why += "no witness within " + std::to_string(options_.max_depth) +
+             " steps that replays, and unreachability not proved by k-induction";
+    }
+    Decide(c, Verdict::kUnknown, why);
+  }
+}
+
+// Slots and modes a predicate reads.
+void Collect(const Predicate& p, std::set<int>& slots, std::set<std::string>& modes) {
+  p.ForEachComparison([&](const Comparison& c) {
+    for (int s : c.lhs.Slots()) slots.insert(s);
+    for (int s : c.rhs.Slots()) slots.insert(s);
+  });
+  p.ForEachMode([&](const std::string& m) { modes.insert(m); });
+}
+
+}  // namespace
+
+std::vector<CheckResult> PropertyProver::Check(const System& system,
+                                               std::span<const Property> properties) const {
+  const Clock::time_point start = Clock::now();
+  std::vector<CheckResult> results(properties.size());
+  const auto components = system.components();
+  // Which components write each System slot (continuous variables).
+  std::vector<std::vector<int>> owners(system.symbols().size());
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    for (const VariableInfo& v : components[c].automaton.variables()) {
+      owners[components[c].global_slot[v.slot]].push_back(static_cast<int>(c));
+    }
+  }
+  std::vector<Job> jobs(components.size());
+  std::optional<Automaton> product;
+  Job product_job;
+  for (std::size_t i = 0; i < properties.size(); ++i) {
+    const Property& p = properties[i];
+    results[i].property = p.name;
+    results[i].kind = p.kind;
+    results[i].method = "prove";
+    std::set<int> slots;
+    std::set<std::string> modes;
+    Collect(p.predicate, slots, modes);
+    std::set<int> comps;
+    for (int s : slots) {
+      const SymbolKind kind = system.symbols()[s].kind;
+      if (kind == SymbolKind::kInput) {
+        throw std::invalid_argument("PropertyProver::Check: property '" + p.name +
+                                    "' reads input '" + system.symbols()[s].name + "'");
+      }
+      if (kind == SymbolKind::kParameter) continue;
+      for (std::size_t c = 0; c < components.size(); ++c) {
+        const auto& g = components[c].global_slot;
+        if (std::find(g.begin(), g.end(), s) != g.end()) comps.insert(static_cast<int>(c));
+      }
+    }
+    for (const std::string& m : modes) {
+      if (auto found = system.FindMode(m)) comps.insert(found->first);
+    }
+    if (comps.empty()) comps.insert(0);
+    bool alone = comps.size() == 1;
+    if (alone) {
+      const int c = *comps.begin();
+      for (const VariableInfo& v : components[c].automaton.variables()) {
+        if (owners[components[c].global_slot[v.slot]].size() > 1) alone = false;
+      }
+    }
+    if (alone) {
+      const int c = *comps.begin();
+      const Component& comp = components[c];
+      std::vector<int> local(system.symbols().size(), -1);
+      for (std::size_t s = 0; s < comp.global_slot.size(); ++s) {
+        local[comp.global_slot[s]] = static_cast<int>(s);
+      }
+      Property q = p;
+      q.predicate = Remap(
+          p.predicate,
+          [&](const Expression& e) {
+            return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+              return Expression::Symbol(name, local.at(slot));
+            });
+          },
+          [&](const std::string& m) {
+            auto found = system.FindMode(m);
+            return found ? comp.automaton.mode(found->second).name : m;
+          });
+      jobs[c].goals.push_back({q, static_cast<int>(i), p});
+      continue;
+    }
+    if (!product) {
+      try {
+        product = system.Product(options_.max_product_modes);
+      } catch (const std::invalid_argument& e) {
+        results[i].verdict = Verdict::kUnknown;
+        results[i].reason = std::string("the property reads several components and their "
+                                        "product is too large: ") + e.what();
+        continue;
+      }
+    }
+    if (!modes.empty()) {
+      results[i].verdict = Verdict::kUnknown;
+      results[i].reason = "`in MODE` atoms over several components are not supported";
+      continue;
+    }
+    product_job.goals.push_back({p, static_cast<int>(i), p});
+  }
+  Engine engine(system, options_, start, results);
+  for (std::size_t c = 0; c < components.size(); ++c) {
+    Job& job = jobs[c];
+    if (job.goals.empty()) continue;
+    job.automaton = &components[c].automaton;
+    job.to_system = components[c].global_slot;
+    // The component's own declared invariants serve as lemmas.
+    for (const Property& lemma : components[c].automaton.properties()) {
+      if (lemma.kind == Property::Kind::kReach) continue;
+      bool dup = false;
+      for (const Goal& g : job.goals) dup = dup || g.property == lemma;
+      if (dup) continue;
+      Property original = lemma;
+      original.predicate = Remap(
+          lemma.predicate,
+          [&](const Expression& e) {
+            return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+              return Expression::Symbol(name, components[c].global_slot[slot]);
+            });
+          },
+          [&](const std::string& m) {
+            auto id = components[c].automaton.FindMode(m);
+            return id ? system.QualifiedModeName(static_cast<int>(c), *id) : m;
+          });
+      job.goals.push_back({lemma, -1, original});
+    }
+    engine.Run(job);
+  }
+  if (product && !product_job.goals.empty()) {
+    product_job.automaton = &*product;
+    for (int s = 0; s < system.symbols().size(); ++s) product_job.to_system.push_back(s);
+    engine.Run(product_job);
+  }
+  return results;
+}
+
+std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(
+    const System& system, int component) const {
+  const Component& comp = system.components()[component];
+  std::vector<Property> queries;
+  for (int m = 0; m < comp.automaton.num_modes(); ++m) {
+    const std::string name = system.QualifiedModeName(component, ModeId(m));
+    queries.push_back({"reach " + name, Property::Kind::kReach, Predicate::InMode(name), {}});
+  }
+  const std::vector<CheckResult> results = Check(system, queries);
+  std::vector<ModeReachability> out;
+  for (int m = 0; m < comp.automaton.num_modes(); ++m) {
+    const Mode& mode = comp.automaton.mode(ModeId(m));
+    ModeReachability r;
+    r.mode = system.QualifiedModeName(component, ModeId(m));
+    for (const auto& [slot, value] : mode.discrete_values) {
+      // The declared (unqualified) name: `source` has the same slots.
+      r.discrete.emplace_back(comp.source.symbols()[slot].name, value);
+    }
+    r.verdict = results[m].verdict;
+    r.reason = results[m].reason;
+    r.trace = results[m].trace;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace hybrid

@@ -1,0 +1,76 @@
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "automaton/system.h"
+#include "solvers/check_result.h"
+
+namespace hybrid {
+
+/// The `prove` method of `hybrid check`: bounded model checking and k-induction with the Z3 SMT
+/// solver over an encoding of the automaton (see SmtEncoding in smt_encoding.h for exactly what
+/// it covers), for every piecewise-constant input within the inputs' bounds and every value of
+/// the parameters declared with a range.
+///
+/// Per model:
+/// 1. Candidates: the properties asked for plus every invariant the automaton declares (`always`
+///    and `never`), which may serve as lemmas.
+/// 2. Bounded model checking to `max_depth` steps (a step is a flow segment or a jump): a path
+///    that breaks a candidate (or, for `reach`, ends in its target) is turned into a Trace
+///    (parameter values, initial values, a step input) and replayed by the simulator. A replayed
+///    violation is `violated` (`reachable` for `reach`); a path the simulator does not follow
+///    (the encoding over-approximates) leaves the property `unknown`. Violations by at least
+///    `robust_margin` are looked for first: they replay clear of rounding.
+/// 3. k-induction, k = 1 .. max_induction, on the surviving candidates together (Houdini: a
+///    candidate that fails the step is dropped and the rest re-checked): those left are
+///    invariants of every run, hence `proved`; a `reach` target whose negation joins them is
+///    `unreachable`.
+///
+/// Systems: a property that reads one component whose continuous variables no other component
+/// shares is checked on that component alone (composition only removes runs of a component:
+/// other components cannot write its variables, and synchronisation only restricts its jumps);
+/// otherwise on System::Product (up to `max_product_modes`), else `unknown`.
+class PropertyProver {
+ public:
+  struct Options {
+    /// Longest path searched for a counterexample or witness, in steps.
+    int max_depth = 12;
+    /// Largest k tried for k-induction.
+    int max_induction = 2;
+    double robust_margin = 1e-3;
+    /// Per SMT query; a query that times out makes its property `unknown`.
+    unsigned timeout_ms = 60000;
+    int max_product_modes = 2000;
+  };
+
+  PropertyProver() = default;
+  explicit PropertyProver(Options options) : options_(options) {}
+
+  /// One result per property of `properties` (System slots, as System::properties() or a
+  /// component's declared properties qualified like the System), in order. Throws
+  /// std::invalid_argument (naming "PropertyProver") for a property that reads inputs.
+  std::vector<CheckResult> Check(const System& system,
+                                 std::span<const Property> properties) const;
+
+  /// One discrete state of a component and whether some run reaches it.
+  struct ModeReachability {
+    std::string mode;  ///< qualified mode name
+    std::vector<std::pair<std::string, int>> discrete;  ///< discrete values, by variable name
+    /// kReachable (with a replayed witness), kUnreachable (proved) or kUnknown.
+    Verdict verdict = Verdict::kUnknown;
+    std::string reason;
+    std::optional<Trace> trace;
+  };
+  /// Reachability of every mode of component `component` (`reach in MODE` for each), checked as
+  /// Check does.
+  std::vector<ModeReachability> ReachableModes(const System& system, int component) const;
+
+ private:
+  Options options_;
+};
+
+}  // namespace hybrid

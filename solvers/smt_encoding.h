@@ -1,0 +1,156 @@
+#pragma once
+
+// Internal to hybrid::verification: includes Z3's C++ API, which no public header exposes.
+
+#include <z3++.h>
+
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "automaton/automaton.h"
+#include "automaton/predicate.h"
+
+namespace hybrid {
+
+/// How the encoding follows a mode's flow between two consecutive states of a path.
+enum class FlowClass {
+  /// Every variable is constant.
+  kStill,
+  /// Every flow is affine in the inputs with constant coefficients, x' = r0 + sum_j r_j u_j: the
+  /// endpoint relation x1 = x0 + r0 d + sum_j r_j V_j with lo_j d <= V_j <= hi_j d is exact (any
+  /// V is reached by a constant input), and the invariant, if convex, holds on the straight path
+  /// between two points that satisfy it.
+  kConstantRate,
+  /// One input u, no drift: a driver variable w with w' = c u (c constant) and other flows
+  /// v' = K(y) phi(w) u with K reading only variables constant in the mode. Each v is monotone
+  /// along a segment (when phi has one sign on w's domain), and where phi has a closed-form
+  /// antiderivative Phi (sums of constant multiples of (a + b w)^n, n != -1, also under
+  /// max(., eps)), v1 - v0 = K (Phi(w1) - Phi(w0)) / c exactly.
+  kSeparable,
+  /// Anything else: the moving variables may take any values allowed by the invariant (a sound
+  /// over-approximation).
+  kGeneral,
+};
+
+/// "still", "constant_rate", "separable", "general".
+std::string FlowClassName(FlowClass c);
+
+/// The bounded-path encoding of one Automaton into Z3 formulas: the states s_0 .. s_n of a path
+/// (mode as one Boolean per mode, continuous variables, the input applied from s_k), and the
+/// transition relation T(s_k, s_k+1), which is either a flow of the current mode or a jump.
+///
+/// Semantics (an over-approximation of the simulator's runs with piecewise-constant inputs, so
+/// that a formula unsatisfiable for every path proves a property for every such run):
+/// - every state satisfies its mode's invariant; parameters declared with a range take any value
+///   in it (the same on the whole path), others their nominal value;
+/// - a jump: source mode, guard at s_k with input u_k, resets, target mode at s_k+1;
+/// - a flow: as FlowClass says, for the input u_k held constant during the segment;
+/// - urgency: an urgent transition whose guard holds somewhere on the segment (before its end)
+///   forbids the segment. Encoded exactly where every state comparison of the guard is affine
+///   with constant coefficients along the segment (kConstantRate with one input and no drift,
+///   or drift and no input; kSeparable when the comparisons read one moving variable); other
+///   urgent transitions are not encoded (sound: more paths);
+/// - lazy transitions, declaration-order priority and Zeno limits are not encoded (more paths).
+class SmtEncoding {
+ public:
+  /// Throws std::invalid_argument if `automaton` has no initial state.
+  SmtEncoding(z3::context& ctx, const Automaton& automaton);
+
+  const Automaton& automaton() const { return automaton_; }
+  FlowClass flow_class(ModeId m) const { return modes_[m.value()].flow_class; }
+
+  /// s_0 is an initial state.
+  z3::expr Initial();
+  /// Well-formedness of s_k: exactly one mode, its invariant, inputs within bounds.
+  z3::expr State(int k);
+  /// T(s_k, s_k+1).
+  z3::expr Transition(int k);
+  /// `p` at s_k, evaluated leniently within `tolerance` (comparisons in positive position hold
+  /// within it, under `not` they must hold with that margin; tolerance 0 is exact).
+  z3::expr Holds(const Predicate& p, int k, double tolerance = 0.0);
+  /// s_k is in mode `m`.
+  z3::expr InMode(int k, ModeId m);
+  /// Uncertain parameters: name -> Z3 constant (nominal ones are numbers).
+  const std::vector<std::pair<std::string, z3::expr>>& uncertain() const { return uncertain_; }
+
+  /// One step of a satisfying path, read back from a model.
+  struct PathStep {
+    int mode = 0;
+    std::vector<double> x;      // continuous variables by automaton slot order of variables()
+    std::vector<double> input;  // inputs (order of automaton().inputs())
+    bool flow = false;          // the step from this state to the next is a flow
+    double duration = 0.0;      // of that flow
+    int transition = -1;        // or the jump taken
+  };
+  /// States s_0 .. s_n of a model of a path of length n.
+  std::vector<PathStep> ReadPath(const z3::model& model, int n);
+  /// Values of the uncertain parameters in `model`.
+  std::vector<std::pair<std::string, double>> ReadParameters(const z3::model& model);
+
+ private:
+  struct StepVars {
+    std::vector<z3::expr> mode;   // one Bool per mode
+    std::vector<z3::expr> x;      // per continuous variable (index in variables())
+    std::vector<z3::expr> u;      // per input (index in inputs())
+    std::vector<z3::expr> v;      // input integral over the flow from this state
+    z3::expr d;                   // duration of the flow from this state
+    z3::expr flow;                // Bool: the step from here is a flow
+    std::vector<z3::expr> jump;   // Bool per transition: the step from here is that jump
+  };
+  struct SeparableFlow {
+    int var = -1;                 // variable index
+    Expression k;                 // mode-constant factor K
+    double sign_phi = 0.0;        // sign of phi on the driver's domain (0: unknown)
+    std::optional<Expression> antiderivative;  // Phi(w), over the driver's slot
+    std::vector<Comparison> domain;            // where Phi' = phi (evaluated at both ends)
+    // max(B^n, eps) with B = alpha + beta w: (alpha, beta, eps^(1/n)).
+    std::optional<std::tuple<double, double, double>> saturation;
+  };
+  struct ModeInfo {
+    FlowClass flow_class = FlowClass::kGeneral;
+    std::vector<int> moving;                      // variable indices with a nonzero flow
+    // kConstantRate: per moving variable, r0 and r_j (per input index).
+    std::vector<double> drift;                    // by variable index
+    std::vector<std::vector<double>> rate;        // [variable index][input index]
+    // kSeparable
+    int input = -1;
+    int driver = -1;
+    double driver_rate = 0.0;
+    std::vector<SeparableFlow> separable;
+  };
+
+  StepVars& Vars(int k);
+  std::vector<std::optional<z3::expr>> Env(int k);
+  z3::expr Translate(const Expression& e, const std::vector<std::optional<z3::expr>>& env);
+  z3::expr Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
+                   double margin);
+  z3::expr Conjunction(const Constraint& c, const std::vector<std::optional<z3::expr>>& env);
+  z3::expr Flow(int k, int mode);
+  z3::expr NoUrgentGuardOnSegment(int k, int mode);
+  z3::expr Jump(int k, int t);
+  z3::expr Discrete(int k, int slot);
+  Expression Fold(const Expression& e) const;
+  void Classify();
+  z3::expr Fresh(const std::string& prefix);
+
+  z3::context& ctx_;
+  const Automaton& automaton_;
+  std::vector<int> var_slots_;    // slot of each continuous variable
+  std::vector<int> var_index_;    // slot -> variable index, -1 otherwise
+  std::vector<int> input_slots_;
+  std::vector<int> input_index_;  // slot -> input index, -1 otherwise
+  std::vector<double> input_lo_, input_hi_;
+  std::vector<std::optional<z3::expr>> params_;  // per slot (parameters only)
+  std::vector<bool> uncertain_slot_;              // parameter depends on an uncertain one
+  std::vector<double> nominal_;                   // ParameterEnvironment()
+  std::vector<std::pair<std::string, z3::expr>> uncertain_;
+  std::vector<ModeInfo> modes_;
+  std::deque<StepVars> steps_;  // deque: references stay valid as steps are added
+  int fresh_ = 0;
+};
+
+}  // namespace hybrid

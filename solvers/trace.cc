@@ -1,0 +1,144 @@
+#include "solvers/trace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace hybrid {
+
+std::vector<UncertainParameter> UncertainParameters(const System& system) {
+  std::vector<UncertainParameter> out;
+  for (const Component& c : system.components()) {
+    const Automaton& a = c.automaton;
+    const std::vector<double> env = a.ParameterEnvironment();
+    for (const auto& [slot, value] : a.parameters()) {
+      const std::optional<Range> range = a.ParameterRange(slot);
+      if (!range) continue;
+      const std::string& name = system.symbols()[c.global_slot[slot]].name;
+      if (std::any_of(out.begin(), out.end(), [&](const auto& p) { return p.name == name; })) {
+        continue;  // a shared parameter: one entry
+      }
+      out.push_back({name, env[slot], range->lo.Evaluate(env), range->hi.Evaluate(env)});
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// Whether `c` holds with margin `margin` (> 0 lenient, < 0 strict) at `env`.
+bool AtomHolds(const Comparison& c, std::span<const double> env, double margin) {
+  const double r = c.lhs.Evaluate(env) - c.rhs.Evaluate(env);
+  switch (c.relation) {
+    case Relation::kLess:
+      return r < margin;
+    case Relation::kLessEqual:
+      return r <= margin;
+    case Relation::kGreater:
+      return r > -margin;
+    case Relation::kGreaterEqual:
+      return r >= -margin;
+    case Relation::kEqual:
+      return std::abs(r) <= std::max(margin, 0.0);
+  }
+  return false;
+}
+
+// `p` evaluated as leniently as `tol` allows: every comparison in positive position holds within
+// tol, every comparison under an odd number of `not`s must hold with margin tol. So
+// !Lenient(p) means p fails clearly.
+bool Lenient(const Predicate& p, std::span<const double> env,
+             std::span<const std::string> modes, double tol, bool positive) {
+  switch (p.kind()) {
+    case Predicate::Kind::kTrue:
+      return true;
+    case Predicate::Kind::kFalse:
+      return false;
+    case Predicate::Kind::kComparison:
+      return AtomHolds(p.comparison(), env, positive ? tol : -tol);
+    case Predicate::Kind::kInMode:
+      return std::find(modes.begin(), modes.end(), p.mode()) != modes.end();
+    case Predicate::Kind::kNot:
+      return !Lenient(p.operands()[0], env, modes, tol, !positive);
+    case Predicate::Kind::kAnd:
+      return Lenient(p.operands()[0], env, modes, tol, positive) &&
+             Lenient(p.operands()[1], env, modes, tol, positive);
+    case Predicate::Kind::kOr:
+      return Lenient(p.operands()[0], env, modes, tol, positive) ||
+             Lenient(p.operands()[1], env, modes, tol, positive);
+  }
+  return false;
+}
+
+// The System environment of a recorded state: parameters, continuous and discrete variables.
+std::vector<double> StateEnvironment(const Simulator& simulator, const StateSample& sample) {
+  const System& system = simulator.system();
+  std::vector<double> env(system.symbols().size(), 0.0);
+  for (const Component& c : system.components()) {
+    const std::vector<double> local = c.automaton.ParameterEnvironment();
+    for (const auto& [slot, value] : c.automaton.parameters()) env[c.global_slot[slot]] = local[slot];
+  }
+  const auto& names = simulator.variable_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (auto slot = system.symbols().Find(names[i])) env[*slot] = sample.x[static_cast<int>(i)];
+  }
+  for (std::size_t ci = 0; ci < system.components().size(); ++ci) {
+    const Component& c = system.components()[ci];
+    const Mode& mode = c.automaton.mode(ModeId(sample.modes[ci]));
+    for (const auto& [slot, value] : mode.discrete_values) env[c.global_slot[slot]] = value;
+  }
+  return env;
+}
+
+std::vector<std::string> ModeNames(const Simulator& simulator, const StateSample& sample) {
+  std::vector<std::string> out;
+  for (std::size_t c = 0; c < sample.modes.size(); ++c) {
+    out.push_back(simulator.ModeName(static_cast<int>(c), sample.modes[c]));
+  }
+  return out;
+}
+
+}  // namespace
+
+bool IsTarget(const Simulator& simulator, const Property& property, const StateSample& sample,
+              double tolerance) {
+  const std::vector<double> env = StateEnvironment(simulator, sample);
+  const std::vector<std::string> modes = ModeNames(simulator, sample);
+  switch (property.kind) {
+    case Property::Kind::kAlways:
+      return !Lenient(property.predicate, env, modes, tolerance, true);
+    case Property::Kind::kNever:
+      return !Lenient(Predicate::Not(property.predicate), env, modes, tolerance, true);
+    case Property::Kind::kReach:
+      return Lenient(property.predicate, env, modes, tolerance, true);
+  }
+  return false;
+}
+
+bool ReplayTrace(const System& system, const Property& property, Trace& trace,
+                 const ReplayOptions& options) {
+  System copy = system;
+  for (const auto& [name, value] : trace.parameters) copy.SetParameter(name, value);
+  for (const auto& [name, value] : trace.initial_values) copy.SetInitialValue(name, value);
+  if (!(trace.inputs.until > 0.0) || !std::isfinite(trace.inputs.until)) {
+    throw std::invalid_argument("ReplayTrace: the trace's horizon must be positive and finite");
+  }
+  const Simulator simulator(copy);
+  SimulationOptions sim;
+  sim.until = trace.inputs.until;
+  sim.sample_step = options.sample_fraction > 0 ? trace.inputs.until * options.sample_fraction : 0;
+  trace.run = simulator.Run(sim, trace.inputs.inputs);
+  trace.state_index = -1;
+  const double horizon = property.horizon.value_or(INFINITY);
+  for (std::size_t i = 0; i < trace.run.samples.size(); ++i) {
+    const StateSample& s = trace.run.samples[i];
+    if (s.time > horizon) break;
+    if (IsTarget(simulator, property, s, options.tolerance)) {
+      trace.state_index = static_cast<int>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace hybrid

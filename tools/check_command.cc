@@ -1,0 +1,268 @@
+#include "tools/check_command.h"
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "automaton/parser.h"
+#include "solvers/property_prover.h"
+#include "solvers/property_sampler.h"
+#include "solvers/simulator.h"
+#include "tools/output.h"
+
+namespace hybrid::cli {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+constexpr int kExitViolated = 6;
+constexpr int kExitUnknown = 7;
+
+// Every property the model declares, over System slots: the system's own, then (for composed
+// systems) each component's, named INSTANCE.NAME.
+std::vector<Property> DeclaredProperties(const System& system) {
+  std::vector<Property> out(system.properties().begin(), system.properties().end());
+  for (std::size_t c = 0; c < system.components().size(); ++c) {
+    const Component& comp = system.components()[c];
+    if (comp.instance.empty()) continue;
+    for (const Property& p : comp.automaton.properties()) {
+      Property q = p;
+      q.name = comp.instance + "." + p.name;
+      std::function<Predicate(const Predicate&)> remap = [&](const Predicate& x) -> Predicate {
+        switch (x.kind()) {
+          case Predicate::Kind::kComparison: {
+            auto sub = [&](const Expression& e) {
+              return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+                return Expression::Symbol(name, comp.global_slot[slot]);
+              });
+            };
+            const Comparison& k = x.comparison();
+            return Predicate::Compare({sub(k.lhs), k.relation, sub(k.rhs)});
+          }
+          case Predicate::Kind::kInMode: {
+            auto id = comp.automaton.FindMode(x.mode());
+            return Predicate::InMode(id ? system.QualifiedModeName(static_cast<int>(c), *id)
+                                        : x.mode());
+          }
+          case Predicate::Kind::kNot:
+            return Predicate::Not(remap(x.operands()[0]));
+          case Predicate::Kind::kAnd:
+            return Predicate::And(remap(x.operands()[0]), remap(x.operands()[1]));
+          case Predicate::Kind::kOr:
+            return Predicate::Or(remap(x.operands()[0]), remap(x.operands()[1]));
+          default:
+            return x;
+        }
+      };
+      q.predicate = remap(p.predicate);
+      out.push_back(std::move(q));
+    }
+  }
+  return out;
+}
+
+json StateJson(const Simulator& sim, const Eigen::VectorXd& x) {
+  json j = json::object();
+  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
+    j[sim.variable_names()[i]] = x[static_cast<int>(i)];
+  }
+  return j;
+}
+
+json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
+  json params = json::object(), inits = json::object(), inputs = json::object();
+  for (const auto& [n, v] : t.parameters) params[n] = v;
+  for (const auto& [n, v] : t.initial_values) inits[n] = v;
+  for (const InputSignal& s : t.inputs.inputs) {
+    json pts = json::array();
+    for (const auto& [time, value] : s.points) pts.push_back({time, value});
+    inputs[system.symbols()[s.slot].name] = pts;
+  }
+  json events = json::array();
+  const double until_state =
+      t.state_index >= 0 ? t.run.samples[t.state_index].time : t.inputs.until;
+  for (const EventRecord& e : t.run.events) {
+    if (e.time > until_state) break;
+    std::string names;
+    for (const auto& n : e.transitions) names += (names.empty() ? "" : "+") + n;
+    events.push_back({{"time", e.time},
+                      {"transitions", names},
+                      {"mode_before", sim.ModeLabel(e.modes_before)},
+                      {"mode_after", sim.ModeLabel(e.modes_after)}});
+  }
+  json out = {{"parameters", params},
+              {"initial_values", inits},
+              {"until", t.inputs.until},
+              {"inputs", inputs},
+              {"replay_status", std::string(StatusName(t.run.status))},
+              {"events", events}};
+  if (t.state_index >= 0) {
+    const StateSample& s = t.run.samples[t.state_index];
+    out["state"] = {{"time", s.time}, {"mode", sim.ModeLabel(s.modes)}, {"values", StateJson(sim, s.x)}};
+  }
+  return out;
+}
+
+std::string TraceText(const System& system, const Simulator& sim, const Trace& t) {
+  std::ostringstream out;
+  out.precision(10);
+  if (!t.parameters.empty()) {
+    out << "    parameters:";
+    for (const auto& [n, v] : t.parameters) out << " " << n << " = " << v << ";";
+    out << "\n";
+  }
+  for (const InputSignal& s : t.inputs.inputs) {
+    out << "    input " << system.symbols()[s.slot].name << " = step(";
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      out << (i ? ", " : "") << s.points[i].first << ": " << s.points[i].second;
+    }
+    out << ") until " << t.inputs.until << "\n";
+  }
+  const double until_state =
+      t.state_index >= 0 ? t.run.samples[t.state_index].time : t.inputs.until;
+  for (const EventRecord& e : t.run.events) {
+    if (e.time > until_state) break;
+    out << "    t = " << e.time << "  ";
+    for (std::size_t i = 0; i < e.transitions.size(); ++i) out << (i ? "+" : "") << e.transitions[i];
+    out << "  " << sim.ModeLabel(e.modes_before) << " -> " << sim.ModeLabel(e.modes_after) << "\n";
+  }
+  if (t.state_index >= 0) {
+    const StateSample& s = t.run.samples[t.state_index];
+    out << "    at t = " << s.time << " in " << sim.ModeLabel(s.modes) << ":";
+    for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
+      out << " " << sim.variable_names()[i] << " = " << s.x[static_cast<int>(i)] << ";";
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+int RunCheck(const CheckArgs& args) {
+  if (args.method != "prove" && args.method != "sample") {
+    throw std::invalid_argument("--method must be 'prove' or 'sample', not '" + args.method + "'");
+  }
+  if (args.depth < 0 || args.depth > 1000) throw std::invalid_argument("--depth must be in [0, 1000]");
+  if (args.induction < 1 || args.induction > 100) {
+    throw std::invalid_argument("--induction must be in [1, 100]");
+  }
+  if (args.runs < 1) throw std::invalid_argument("--runs must be positive");
+  const auto start = std::chrono::steady_clock::now();
+  const System system = ParseModelFile(args.model);
+  const std::vector<Property> declared = DeclaredProperties(system);
+  std::vector<Property> chosen;
+  if (args.properties.empty()) {
+    chosen = declared;
+  } else {
+    for (const std::string& name : args.properties) {
+      auto it = std::find_if(declared.begin(), declared.end(),
+                             [&](const Property& p) { return p.name == name; });
+      if (it == declared.end()) {
+        std::string known;
+        for (const Property& p : declared) known += " " + p.name;
+        throw std::invalid_argument("--property: '" + name + "' is not a property of " +
+                                    args.model + " (properties:" +
+                                    (known.empty() ? " none" : known) + ")");
+      }
+      chosen.push_back(*it);
+    }
+  }
+  std::vector<CheckResult> results;
+  if (args.method == "prove") {
+    PropertyProver::Options options;
+    options.max_depth = args.depth;
+    options.max_induction = args.induction;
+    results = PropertyProver(options).Check(system, chosen);
+  } else {
+    PropertySampler::Options options;
+    options.runs = args.runs;
+    options.seed = args.seed;
+    const PropertySampler sampler(options);
+    for (const Property& p : chosen) results.push_back(sampler.Check(system, p));
+  }
+  std::vector<std::vector<PropertyProver::ModeReachability>> modes;
+  if (args.modes) {
+    PropertyProver::Options options;
+    options.max_depth = args.depth;
+    options.max_induction = args.induction;
+    for (std::size_t c = 0; c < system.components().size(); ++c) {
+      modes.push_back(PropertyProver(options).ReachableModes(system, static_cast<int>(c)));
+    }
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const Simulator sim(system);
+  int code = 0;
+  for (const CheckResult& r : results) {
+    if (r.verdict == Verdict::kViolated || r.verdict == Verdict::kUnreachable) code = kExitViolated;
+  }
+  if (code == 0) {
+    for (const CheckResult& r : results) {
+      if (r.verdict == Verdict::kUnknown) code = kExitUnknown;
+    }
+  }
+  if (args.json) {
+    json props = json::array();
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const CheckResult& r = results[i];
+      json j = {{"name", r.property},
+                {"kind", std::string(KindKeyword(r.kind))},
+                {"predicate", chosen[i].predicate.ToString()},
+                {"verdict", std::string(VerdictName(r.verdict))},
+                {"method", r.method},
+                {"seconds", r.seconds},
+                {"reason", r.reason}};
+      if (r.trace) j["trace"] = TraceJson(system, sim, *r.trace);
+      props.push_back(j);
+    }
+    json out = {{"model", args.model},
+                {"method", args.method},
+                {"seconds", seconds},
+                {"properties", props}};
+    if (args.modes) {
+      json ms = json::array();
+      for (const auto& comp : modes) {
+        for (const auto& m : comp) {
+          json d = json::object();
+          for (const auto& [n, v] : m.discrete) d[n] = v;
+          json e = {{"mode", m.mode},
+                    {"discrete", d},
+                    {"verdict", std::string(VerdictName(m.verdict))},
+                    {"reason", m.reason}};
+          if (m.trace) e["trace"] = TraceJson(system, sim, *m.trace);
+          ms.push_back(e);
+        }
+      }
+      out["modes"] = ms;
+    }
+    WriteOutput("-", out.dump(2) + "\n");
+    return code;
+  }
+  std::ostringstream out;
+  out.precision(4);
+  out << args.model << ": " << results.size() << " properties, method " << args.method << ", "
+      << seconds << " s\n";
+  for (const CheckResult& r : results) {
+    out << "  " << VerdictName(r.verdict) << "  " << r.property << " (" << KindKeyword(r.kind)
+        << ", " << r.seconds << " s): " << r.reason << "\n";
+    if (r.trace) out << TraceText(system, sim, *r.trace);
+  }
+  if (args.modes) {
+    out << "modes (discrete states):\n";
+    for (const auto& comp : modes) {
+      for (const auto& m : comp) {
+        out << "  " << VerdictName(m.verdict) << "  " << m.mode << " (";
+        for (std::size_t i = 0; i < m.discrete.size(); ++i) {
+          out << (i ? ", " : "") << m.discrete[i].first << " = " << m.discrete[i].second;
+        }
+        out << ")\n";
+      }
+    }
+  }
+  WriteOutput("-", out.str());
+  return code;
+}
+
+}  // namespace hybrid::cli
