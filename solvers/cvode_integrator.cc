@@ -29,6 +29,9 @@ struct CvodeIntegrator::Handles {
   double stop = std::numeric_limits<double>::quiet_NaN();
   long steps_towards_stop = 0;
   double last_t = 0.0;  // the time of the state in `y`
+  // The last message CVODE reported through its error handler (errors and warnings), which would
+  // otherwise be printed to stderr; empty when none since the last Advance or Restart.
+  std::string last_error;
 
   ~Handles() {
     if (cvode) CVodeFree(&cvode);
@@ -53,10 +56,26 @@ int RootFunctions(sunrealtype t, N_Vector y, sunrealtype* gout, void* user_data)
   return 0;
 }
 
-void Check(int flag, const char* call) {
+// CVODE's error handler: keeps the message (in the std::string at `data`) instead of printing
+// it. Warnings (error_code > 0, such as "t + h = t on the next step") are kept the same way.
+void RecordError(int error_code, const char* module, const char* function, char* msg, void* data) {
+  (void)error_code;
+  (void)module;
+  (void)function;
+  *static_cast<std::string*>(data) = msg ? msg : "";
+}
+
+// "FLAG_NAME (what CVODE said)" for a failed call.
+std::string Describe(int flag, const std::string& detail) {
+  std::string out = CVodeGetReturnFlagName(flag);
+  if (!detail.empty()) out += " (" + detail + ")";
+  return out;
+}
+
+void Check(int flag, const char* call, const std::string& detail) {
   if (flag < 0) {
     throw std::runtime_error(std::string("CvodeIntegrator: ") + call +
-                             " failed: " + CVodeGetReturnFlagName(flag));
+                             " failed: " + Describe(flag, detail));
   }
 }
 
@@ -81,6 +100,9 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options
   if (!h_->y || !h_->dky || !h_->matrix || !h_->solver || !h_->cvode) {
     throw std::runtime_error("CvodeIntegrator: cannot allocate SUNDIALS objects");
   }
+  // The library never prints: CVODE's messages are kept and reported through message(). Handles
+  // lives on the heap, so the address of last_error survives moves of the integrator.
+  Check(CVodeSetErrHandlerFn(h_->cvode, RecordError, &h_->last_error), "CVodeSetErrHandlerFn", "");
 }
 
 CvodeIntegrator::~CvodeIntegrator() = default;
@@ -91,28 +113,30 @@ void CvodeIntegrator::Restart(double t0, const Eigen::VectorXd& x0,
                               std::span<const int> directions) {
   double* y = N_VGetArrayPointer(h_->y);
   for (int i = 0; i < h_->dimension; ++i) y[i] = i < x0.size() ? x0[i] : 0.0;
+  h_->last_error.clear();
+  auto check = [&](int flag, const char* call) { Check(flag, call, h_->last_error); };
   if (!h_->initialised) {
-    Check(CVodeInit(h_->cvode, Rhs, t0, h_->y), "CVodeInit");
-    Check(CVodeSetUserData(h_->cvode, h_->system), "CVodeSetUserData");
-    Check(CVodeSStolerances(h_->cvode, h_->options.relative_tolerance,
+    check(CVodeInit(h_->cvode, Rhs, t0, h_->y), "CVodeInit");
+    check(CVodeSetUserData(h_->cvode, h_->system), "CVodeSetUserData");
+    check(CVodeSStolerances(h_->cvode, h_->options.relative_tolerance,
                             h_->options.absolute_tolerance),
           "CVodeSStolerances");
-    Check(CVodeSetLinearSolver(h_->cvode, h_->solver, h_->matrix), "CVodeSetLinearSolver");
-    Check(CVodeSetMaxNumSteps(h_->cvode, h_->options.max_steps), "CVodeSetMaxNumSteps");
+    check(CVodeSetLinearSolver(h_->cvode, h_->solver, h_->matrix), "CVodeSetLinearSolver");
+    check(CVodeSetMaxNumSteps(h_->cvode, h_->options.max_steps), "CVodeSetMaxNumSteps");
     if (h_->options.max_step > 0.0 && std::isfinite(h_->options.max_step)) {
-      Check(CVodeSetMaxStep(h_->cvode, h_->options.max_step), "CVodeSetMaxStep");
+      check(CVodeSetMaxStep(h_->cvode, h_->options.max_step), "CVodeSetMaxStep");
     }
-    Check(CVodeSetNoInactiveRootWarn(h_->cvode), "CVodeSetNoInactiveRootWarn");
+    check(CVodeSetNoInactiveRootWarn(h_->cvode), "CVodeSetNoInactiveRootWarn");
     h_->initialised = true;
   } else {
-    Check(CVodeReInit(h_->cvode, t0, h_->y), "CVodeReInit");
+    check(CVodeReInit(h_->cvode, t0, h_->y), "CVodeReInit");
   }
   h_->num_roots = static_cast<int>(directions.size());
-  Check(CVodeRootInit(h_->cvode, h_->num_roots, h_->num_roots > 0 ? RootFunctions : nullptr),
+  check(CVodeRootInit(h_->cvode, h_->num_roots, h_->num_roots > 0 ? RootFunctions : nullptr),
         "CVodeRootInit");
   if (h_->num_roots > 0) {
     std::vector<int> dirs(directions.begin(), directions.end());
-    Check(CVodeSetRootDirection(h_->cvode, dirs.data()), "CVodeSetRootDirection");
+    check(CVodeSetRootDirection(h_->cvode, dirs.data()), "CVodeSetRootDirection");
   }
   root_info_.assign(h_->num_roots, 0);
   h_->steps_towards_stop = 0;
@@ -120,9 +144,14 @@ void CvodeIntegrator::Restart(double t0, const Eigen::VectorXd& x0,
 }
 
 CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen::VectorXd* x) {
+  h_->last_error.clear();
   const int stop_flag = CVodeSetStopTime(h_->cvode, t_stop);
   if (stop_flag < 0) {
-    message_ = std::string("CVodeSetStopTime: ") + CVodeGetReturnFlagName(stop_flag);
+    message_ = "CVodeSetStopTime: " + Describe(stop_flag, h_->last_error);
+    *t = h_->last_t;
+    x->resize(h_->dimension);
+    const double* y = N_VGetArrayPointer(h_->y);
+    for (int i = 0; i < h_->dimension; ++i) (*x)[i] = y[i];
     return Status::kFailure;
   }
   if (!(t_stop == h_->stop)) {
@@ -150,7 +179,7 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
     return Status::kRoot;
   }
   if (flag < 0) {
-    message_ = std::string("CVode: ") + CVodeGetReturnFlagName(flag);
+    message_ = "CVode: " + Describe(flag, h_->last_error);
     return Status::kFailure;
   }
   return flag == CV_TSTOP_RETURN || reached >= t_stop ? Status::kReachedTime : Status::kStep;

@@ -23,6 +23,12 @@ class OdeSystem {
 /// Method: Adams-Moulton with Newton iteration and a dense linear solver (finite-difference
 /// Jacobian), suited to the small, mostly non-stiff flows of hybrid models. Root functions are
 /// located by CVODE's Illinois method to about 100 * unit roundoff * (|t| + |h|).
+///
+/// The integrator never prints: CVODE's error handler is replaced by one that keeps the last
+/// message (errors and warnings), which failures report in message() (and setup errors in the
+/// exception text). CVODE cannot start a step towards a stop time within about 2 * unit roundoff
+/// * |t| of the restart time (CV_TOO_CLOSE, "tout too close to t0 to start integration"): callers
+/// must not ask for one right after a Restart.
 class CvodeIntegrator {
  public:
   struct Options {
@@ -65,7 +71,8 @@ class CvodeIntegrator {
   /// After kRoot: which root functions crossed (+1 rising, -1 falling, 0 not), per
   /// CVodeGetRootInfo.
   const std::vector<int>& root_info() const { return root_info_; }
-  /// The CVODE error message of the last failure.
+  /// The last failure: the return flag and, in parentheses, what CVODE said, e.g.
+  /// "CVode: CV_TOO_CLOSE (tout too close to t0 to start integration.)".
   const std::string& message() const { return message_; }
   /// Number of internal steps taken since construction.
   long steps() const;

@@ -1,10 +1,10 @@
 #include "solvers/property_prover.h"
 
 #include <chrono>
-#include <cstdlib>
-#include <iostream>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
+#include <iostream>
 #include <set>
 #include <stdexcept>
 
@@ -35,8 +35,7 @@ Predicate Remap(const Predicate& p, const std::function<Expression(const Express
     case Predicate::Kind::kNot:
       return Predicate::Not(Remap(p.operands()[0], expr, mode));
     case Predicate::Kind::kAnd:
-      return Predicate::And(Remap(p.operands()[0], expr, mode),
-                            Remap(p.operands()[1], expr, mode));
+      return Predicate::And(Remap(p.operands()[0], expr, mode), Remap(p.operands()[1], expr, mode));
     case Predicate::Kind::kOr:
       return Predicate::Or(Remap(p.operands()[0], expr, mode), Remap(p.operands()[1], expr, mode));
   }
@@ -45,9 +44,9 @@ Predicate Remap(const Predicate& p, const std::function<Expression(const Express
 
 // A property to decide on one automaton (its own slots and mode names).
 struct Goal {
-  Property property;   // local
-  int result = -1;     // index into the results, -1 for a lemma only
-  Property original;   // as asked (System names), for the replay
+  Property property;  // local
+  int result = -1;    // index into the results, -1 for a lemma only
+  Property original;  // as asked (System names), for the replay
 };
 
 struct Job {
@@ -66,16 +65,34 @@ void DebugPath(SmtEncoding& enc, const z3::model& model, int n) {
     const auto& s = path[k];
     std::cerr << "  s" << k << " " << enc.automaton().modes()[s.mode].name;
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      std::cerr << " " << enc.automaton().symbols()[enc.automaton().variables()[i].slot].name
-                << "=" << s.x[i];
+      std::cerr << " " << enc.automaton().symbols()[enc.automaton().variables()[i].slot].name << "="
+                << s.x[i];
     }
     for (double u : s.input) std::cerr << " u=" << u;
     if (k < n) {
-      if (s.flow) std::cerr << "  --flow d=" << s.duration;
-      else std::cerr << "  --jump " << enc.automaton().transitions()[s.transition].name;
+      if (s.flow)
+        std::cerr << "  --flow d=" << s.duration;
+      else
+        std::cerr << "  --jump " << enc.automaton().transitions()[s.transition].name;
     }
     std::cerr << "\n";
   }
+}
+
+// The solver for every query: Z3's nlsat (complete for polynomial real arithmetic, with Boolean
+// structure), which handles the separable (nonlinear) flows far better than the default core.
+z3::solver MakeSolver(z3::context& ctx, unsigned timeout_ms) {
+  z3::solver s = z3::tactic(ctx, "qfnra-nlsat").mk_solver();
+  z3::params p(ctx);
+  p.set("timeout", timeout_ms);
+  s.set(p);
+  return s;
+}
+
+// Asserts `e` and the definitions of the auxiliary variables it introduced.
+void Add(z3::solver& s, SmtEncoding& enc, const z3::expr& e) {
+  s.add(e);
+  s.add(enc.TakeDefinitions());
 }
 
 class Engine {
@@ -93,11 +110,11 @@ class Engine {
     bool invariant;        // always/never (else reach)
     bool decided = false;  // a verdict is in results_ (or a lemma was refuted)
     bool refuted = false;  // the encoding reaches `bad`: not a lemma
+    bool proved = false;   // an invariant of every run (usable as a lemma)
     int replays = 0;
   };
 
-  bool TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth,
-                Candidate& c);
+  bool TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth, Candidate& c);
   void Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace = {});
 
   const System& system_;
@@ -106,8 +123,7 @@ class Engine {
   std::vector<CheckResult>& results_;
 };
 
-void Engine::Decide(const Candidate& c, Verdict v, std::string reason,
-                    std::optional<Trace> trace) {
+void Engine::Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace) {
   if (c.goal->result < 0) return;
   CheckResult& r = results_[c.goal->result];
   r.verdict = v;
@@ -148,8 +164,10 @@ bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, 
     for (int i = 0; i < ni; ++i) {
       auto& pts = signals[i].points;
       if (pts.empty() || pts.back().second != u[i]) {
-        if (!pts.empty() && pts.back().first == t) pts.back().second = u[i];
-        else pts.emplace_back(t, u[i]);
+        if (!pts.empty() && pts.back().first == t)
+          pts.back().second = u[i];
+        else
+          pts.emplace_back(t, u[i]);
       }
     }
     t += duration;
@@ -157,14 +175,17 @@ bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, 
   for (int k = 0; k < depth; ++k) {
     if (path[k].flow && path[k].duration > 0) add_piece(path[k].input, path[k].duration);
   }
-  // A short tail with the inputs at rest (where 0 is allowed) so that jumps at the end happen.
-  std::vector<double> rest(ni, 0.0);
-  for (int i = 0; i < ni; ++i) {
-    const auto [lo, hi] = system_.InputBounds(signals[i].slot);
-    if (lo > 0 || hi < 0) rest[i] = path.back().input[i];
+  // A short tail with the last input held, so that events due exactly at the end of the path
+  // happen (an input that changed there would decide them instead).
+  std::vector<double> last(ni, 0.0);
+  for (int k = depth - 1; k >= 0; --k) {
+    if (path[k].flow && path[k].duration > 0) {
+      last = path[k].input;
+      break;
+    }
   }
   const double tail = std::max(1e-6, 1e-6 * t);
-  add_piece(rest, tail);
+  add_piece(last, tail);
   trace.inputs.until = t;
   for (auto& s : signals) {
     if (s.points.empty()) s.points.emplace_back(0.0, 0.0);
@@ -185,9 +206,8 @@ bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, 
     return false;
   }
   Decide(c, c.invariant ? Verdict::kViolated : Verdict::kReachable,
-         std::string(c.invariant ? "counterexample" : "witness") + " of " +
-             std::to_string(depth) + " steps found by bounded model checking, replayed by " +
-             "the simulator",
+         std::string(c.invariant ? "counterexample" : "witness") + " of " + std::to_string(depth) +
+             " steps found by bounded model checking, replayed by " + "the simulator",
          std::move(trace));
   c.decided = true;
   return true;
@@ -196,8 +216,6 @@ bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, 
 void Engine::Run(const Job& job) {
   const Automaton& a = *job.automaton;
   z3::context ctx;
-  z3::params params(ctx);
-  params.set("timeout", options_.timeout_ms);
   SmtEncoding enc(ctx, a);
   std::vector<Candidate> cands;
   for (const Goal& g : job.goals) {
@@ -216,21 +234,27 @@ void Engine::Run(const Job& job) {
   }
   // Bounded properties are checked like unbounded ones (sound for `proved`); their traces are
   // replayed with the horizon.
-  auto pending = [&](const Candidate& c) { return !c.decided && c.replays < 3; };
+  auto pending = [&](const Candidate& c) { return !c.decided && c.replays < 8; };
 
   // 1. Base case: no violation within max_induction - 1 steps (what k-induction needs).
+  // Bounded model checking: Z3's default (incremental) solver, which handles long unrollings
+  // better than nlsat.
   z3::solver bmc(ctx);
-  bmc.set(params);
-  bmc.add(enc.Initial());
-  bmc.add(enc.State(0));
+  {
+    z3::params p(ctx);
+    p.set("timeout", options_.timeout_ms);
+    bmc.set(p);
+  }
+  Add(bmc, enc, enc.Initial());
+  Add(bmc, enc, enc.State(0));
   bool bmc_complete = true;
   int bmc_depth = -1;  // paths up to this length are in `bmc`
   auto search = [&](int n, bool invariants_only) {
     while (bmc_depth < n) {
       ++bmc_depth;
       if (bmc_depth > 0) {
-        bmc.add(enc.Transition(bmc_depth - 1));
-        bmc.add(enc.State(bmc_depth));
+        Add(bmc, enc, enc.Transition(bmc_depth - 1));
+        Add(bmc, enc, enc.State(bmc_depth));
       }
     }
     z3::expr_vector any(ctx);
@@ -241,29 +265,35 @@ void Engine::Run(const Job& job) {
     }
     if (any.empty()) return;
     bmc.push();
-    bmc.add(z3::mk_or(any));
+    Add(bmc, enc, z3::mk_or(any));
     const z3::check_result r = bmc.check();
     bmc.pop();
     if (r == z3::unknown) bmc_complete = false;
     if (r != z3::sat) return;
     for (Candidate& c : cands) {
       if (!pending(c) || (invariants_only && !c.invariant)) continue;
-      // Robust violations first (they replay clear of rounding), then exact ones.
-      for (double margin : {options_.robust_margin, 0.0}) {
-        if (!pending(c)) break;
-        bmc.push();
-        bmc.add(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
-                            : enc.Holds(c.bad, n, 0.0));
-        const z3::check_result rc = bmc.check();
-        if (rc == z3::sat) {
-          c.refuted = c.refuted || c.invariant;
-          const z3::model model = bmc.get_model();
-          TryTrace(job, enc, model, n, c);
-        } else if (rc == z3::unknown) {
-          bmc_complete = false;
+      // Parameters at their nominal values first (fewer ties between events, which the
+      // simulator breaks by declaration order), then over their ranges; robust violations first
+      // (they replay clear of rounding), then exact ones.
+      for (bool pinned : {true, false}) {
+        for (double margin : {options_.robust_margin, 0.0}) {
+          if (!pending(c) || (!c.invariant && margin > 0)) continue;
+          if (pinned && enc.uncertain().empty()) continue;
+          bmc.push();
+          Add(bmc, enc,
+              c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
+                          : enc.Holds(c.bad, n, 0.0));
+          if (pinned) bmc.add(enc.NominalParameters());
+          const z3::check_result rc = bmc.check();
+          if (rc == z3::sat) {
+            c.refuted = c.refuted || c.invariant;
+            const z3::model model = bmc.get_model();
+            TryTrace(job, enc, model, n, c);
+          } else if (rc == z3::unknown) {
+            bmc_complete = false;
+          }
+          bmc.pop();
         }
-        bmc.pop();
-        if (rc == z3::sat || !c.invariant) break;
       }
     }
   };
@@ -280,43 +310,89 @@ void Engine::Run(const Job& job) {
   for (int k = 1; k <= options_.max_induction && open() && base_complete; ++k) {
     std::vector<Candidate*> set;
     for (Candidate& c : cands) {
-      if (!c.refuted && !c.decided) set.push_back(&c);
+      if (c.invariant && !c.refuted && !c.decided) set.push_back(&c);
     }
-    z3::solver s(ctx);
-    s.set(params);
-    for (int i = 0; i <= k; ++i) s.add(enc.State(i));
-    for (int i = 0; i < k; ++i) s.add(enc.Transition(i));
-    std::vector<z3::expr> guard;
-    for (std::size_t j = 0; j < set.size(); ++j) {
-      z3::expr lit =
-          ctx.bool_const(("lemma#" + std::to_string(k) + "#" + std::to_string(j)).c_str());
-      z3::expr hyp = ctx.bool_val(true);
-      for (int i = 0; i < k; ++i) hyp = hyp && !enc.Holds(set[j]->bad, i, 0.0);
-      s.add(z3::implies(lit, hyp));
-      guard.push_back(lit);
-    }
+    // The step query is split on the mode of s_(k-1): one small nonlinear problem per mode is
+    // far easier for nlsat than their disjunction. Per mode, all candidates are checked at once;
+    // a model names the ones that fail (dropped, Houdini), a timeout splits per candidate.
     std::vector<bool> alive(set.size(), true);
+    std::vector<std::optional<z3::expr>> path_from(a.num_modes());
+    std::optional<z3::expr> hypotheses;  // of the alive candidates
     bool changed = true;
     while (changed) {
       changed = false;
-      for (std::size_t j = 0; j < set.size(); ++j) {
-        if (!alive[j]) continue;
-        z3::expr_vector assumptions(ctx);
-        for (std::size_t i = 0; i < set.size(); ++i) {
-          if (alive[i]) assumptions.push_back(guard[i]);
+      hypotheses.reset();
+      for (int m = 0; m < a.num_modes(); ++m) {
+        auto check = [&](const std::vector<std::size_t>& goals, unsigned timeout_ms,
+                         std::vector<std::size_t>& failed) {
+          z3::solver s = MakeSolver(ctx, timeout_ms);
+          if (!path_from[m]) {
+            z3::expr e = ctx.bool_val(true);
+            for (int i = 0; i <= k; ++i) e = e && enc.State(i);
+            for (int i = 0; i + 1 < k; ++i) e = e && enc.Transition(i);
+            e = e && enc.TransitionFrom(k - 1, ModeId(m));
+            path_from[m] = e && enc.TakeDefinitions();
+          }
+          s.add(*path_from[m]);
+          if (!hypotheses) {
+            z3::expr e = ctx.bool_val(true);
+            for (std::size_t j = 0; j < set.size(); ++j) {
+              if (!alive[j]) continue;
+              for (int i = 0; i < k; ++i) e = e && !enc.Holds(set[j]->bad, i, 0.0);
+            }
+            hypotheses = e && enc.TakeDefinitions();
+          }
+          s.add(*hypotheses);
+          z3::expr_vector bad(ctx);
+          std::vector<z3::expr> at_k;
+          for (std::size_t j : goals) {
+            at_k.push_back(enc.Holds(set[j]->bad, k, 0.0));
+            bad.push_back(at_k.back());
+          }
+          Add(s, enc, z3::mk_or(bad));
+          const z3::check_result r = s.check();
+          if (r == z3::sat) {
+            const z3::model model = s.get_model();
+            for (std::size_t g = 0; g < goals.size(); ++g) {
+              if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
+            }
+            if (std::getenv("HYBRID_CHECK_DEBUG")) {
+              std::cerr << "induction k=" << k << " from mode " << a.modes()[m].name
+                        << " fails for";
+              for (std::size_t j : failed) std::cerr << " " << set[j]->goal->property.name;
+              std::cerr << ":\n";
+              DebugPath(enc, model, k);
+            }
+            if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
+          }
+          return r;
+        };
+        std::vector<std::size_t> goals, failed;
+        for (std::size_t j = 0; j < set.size(); ++j) {
+          if (alive[j]) goals.push_back(j);
         }
-        s.push();
-        s.add(enc.Holds(set[j]->bad, k, 0.0));
-        const z3::check_result r = s.check(assumptions);
-        if (r == z3::sat && std::getenv("HYBRID_CHECK_DEBUG")) {
-          std::cerr << "induction k=" << k << " fails for " << set[j]->goal->property.name
-                    << ":\n";
-          DebugPath(enc, s.get_model(), k);
+        if (goals.empty()) break;
+        const auto t_mode = Clock::now();
+        z3::check_result r = check(goals, std::min(options_.timeout_ms, 500u), failed);
+        if (std::getenv("HYBRID_CHECK_TIMING")) {
+          std::cerr << "k=" << k << " mode " << a.modes()[m].name << ": " << r << " "
+                    << Since(t_mode) << " s\n";
         }
-        s.pop();
-        if (r != z3::unsat) {
-          alive[j] = false;
-          changed = true;
+        if (r == z3::unknown) {
+          // Split per candidate with the full time budget.
+          for (std::size_t j : goals) {
+            std::vector<std::size_t> f;
+            const z3::check_result rj = check({j}, options_.timeout_ms, f);
+            if (rj == z3::unknown) f.push_back(j);
+            for (std::size_t x : f) failed.push_back(x);
+          }
+        }
+        for (std::size_t j : failed) {
+          if (alive[j]) {
+            alive[j] = false;
+            changed = true;
+            hypotheses.reset();  // weaker now: modes already passed are checked again
+          }
         }
       }
     }
@@ -327,8 +403,9 @@ void Engine::Run(const Job& job) {
       Candidate& c = *set[j];
       const std::string how = std::to_string(k) + "-induction, together with " +
                               std::to_string(lemmas - 1) + " other invariant(s) as lemmas";
-      Decide(c, c.invariant ? Verdict::kProved : Verdict::kUnreachable, "proved by " + how);
+      Decide(c, Verdict::kProved, "proved by " + how);
       c.decided = true;
+      c.proved = true;
     }
   }
 
@@ -339,6 +416,29 @@ void Engine::Run(const Job& job) {
       Decide(c, Verdict::kUnknown,
              "the encoding (an over-approximation) reaches a violation, but no path of at most " +
                  std::to_string(options_.max_depth) + " steps found replays in the simulator");
+      c.decided = true;
+    }
+  }
+  // 4. Reach targets without a witness: unreachable if `not P` is inductive relative to the
+  //    proved invariants (checked per mode, as above).
+  for (Candidate& c : cands) {
+    if (c.decided || c.invariant || !bmc_complete) continue;
+    bool inductive = true;
+    for (int m = 0; m < a.num_modes() && inductive; ++m) {
+      z3::solver s = MakeSolver(ctx, options_.timeout_ms);
+      z3::expr e = enc.State(0) && enc.State(1) && enc.TransitionFrom(0, ModeId(m)) &&
+                   !enc.Holds(c.bad, 0, 0.0) && enc.Holds(c.bad, 1, 0.0);
+      for (const Candidate& lemma : cands) {
+        if (lemma.invariant && lemma.decided && !lemma.refuted && lemma.proved) {
+          e = e && !enc.Holds(lemma.bad, 0, 0.0);
+        }
+      }
+      Add(s, enc, e);
+      inductive = s.check() == z3::unsat;
+    }
+    if (inductive) {
+      Decide(c, Verdict::kUnreachable,
+             "proved by 1-induction of its negation, with the proved invariants as lemmas");
       c.decided = true;
     }
   }
@@ -425,9 +525,10 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       q.predicate = Remap(
           p.predicate,
           [&](const Expression& e) {
-            return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
-              return Expression::Symbol(name, local.at(slot));
-            });
+            return e.Substitute(
+                [&](const std::string& name, int slot) -> std::optional<Expression> {
+                  return Expression::Symbol(name, local.at(slot));
+                });
           },
           [&](const std::string& m) {
             auto found = system.FindMode(m);
@@ -441,8 +542,10 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
         product = system.Product(options_.max_product_modes);
       } catch (const std::invalid_argument& e) {
         results[i].verdict = Verdict::kUnknown;
-        results[i].reason = std::string("the property reads several components and their "
-                                        "product is too large: ") + e.what();
+        results[i].reason = std::string(
+                                "the property reads several components and their "
+                                "product is too large: ") +
+                            e.what();
         continue;
       }
     }
@@ -469,9 +572,10 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       original.predicate = Remap(
           lemma.predicate,
           [&](const Expression& e) {
-            return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
-              return Expression::Symbol(name, components[c].global_slot[slot]);
-            });
+            return e.Substitute(
+                [&](const std::string& name, int slot) -> std::optional<Expression> {
+                  return Expression::Symbol(name, components[c].global_slot[slot]);
+                });
           },
           [&](const std::string& m) {
             auto id = components[c].automaton.FindMode(m);
@@ -489,8 +593,8 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
   return results;
 }
 
-std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(
-    const System& system, int component) const {
+std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(const System& system,
+                                                                             int component) const {
   const Component& comp = system.components()[component];
   std::vector<Property> queries;
   for (int m = 0; m < comp.automaton.num_modes(); ++m) {

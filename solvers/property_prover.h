@@ -53,12 +53,11 @@ class PropertyProver {
   /// One result per property of `properties` (System slots, as System::properties() or a
   /// component's declared properties qualified like the System), in order. Throws
   /// std::invalid_argument (naming "PropertyProver") for a property that reads inputs.
-  std::vector<CheckResult> Check(const System& system,
-                                 std::span<const Property> properties) const;
+  std::vector<CheckResult> Check(const System& system, std::span<const Property> properties) const;
 
   /// One discrete state of a component and whether some run reaches it.
   struct ModeReachability {
-    std::string mode;  ///< qualified mode name
+    std::string mode;                                   ///< qualified mode name
     std::vector<std::pair<std::string, int>> discrete;  ///< discrete values, by variable name
     /// kReachable (with a replayed witness), kUnreachable (proved) or kUnknown.
     Verdict verdict = Verdict::kUnknown;

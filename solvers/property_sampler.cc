@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -199,7 +197,6 @@ struct InitialBox {
   std::string name;  // System name of the variable
   int component = 0;
   Range range;
-  double above = 0.5;  // at nominal parameter values, for LevelGen
 };
 
 struct Space {
@@ -223,7 +220,13 @@ Space SpaceOf(const System& system) {
     if (lo < hi) space.random = true;
   }
   space.parameters = UncertainParameters(system);
-  if (!space.parameters.empty()) space.random = true;
+  for (const UncertainParameter& p : space.parameters) {
+    if (!std::isfinite(p.lo) || !std::isfinite(p.hi) || !(p.lo <= p.nominal && p.nominal <= p.hi)) {
+      Fail("parameter '" + p.name + "' = " + std::to_string(p.nominal) +
+           " is not within its range [" + std::to_string(p.lo) + ", " + std::to_string(p.hi) + "]");
+    }
+    space.random = true;
+  }
   for (std::size_t c = 0; c < system.components().size(); ++c) {
     const Component& component = system.components()[c];
     const Automaton& a = component.automaton;
@@ -238,7 +241,7 @@ Space SpaceOf(const System& system) {
       }
       const double lo = v.range.lo.Evaluate(env);
       const double hi = v.range.hi.Evaluate(env);
-      space.boxes.push_back({name, static_cast<int>(c), v.range, 0.5});
+      space.boxes.push_back({name, static_cast<int>(c), v.range});
       if (lo < hi) space.random = true;
     }
   }
@@ -247,14 +250,18 @@ Space SpaceOf(const System& system) {
 
 rc::Gen<Draw> DrawGen(const Space& space, int max_segments) {
   std::vector<rc::Gen<std::vector<Piece>>> schedules;
-  for (const InputSpace& in : space.inputs)
+  for (const InputSpace& in : space.inputs) {
     schedules.push_back(ScheduleGen(max_segments, in.above));
+  }
   std::vector<rc::Gen<Level>> parameters;
   for (const UncertainParameter& p : space.parameters) {
     parameters.push_back(LevelGen(kParameterWeights, Above(p.nominal, p.lo, p.hi)));
   }
   std::vector<rc::Gen<Level>> initials;
-  for (const InitialBox& b : space.boxes) initials.push_back(LevelGen(kInitialWeights, b.above));
+  // The center of an initial interval is its midpoint: interior values are as likely on each side.
+  for (std::size_t i = 0; i < space.boxes.size(); ++i) {
+    initials.push_back(LevelGen(kInitialWeights, 0.5));
+  }
   return rc::gen::tuple(Each(std::move(schedules)), Each(std::move(parameters)),
                         Each(std::move(initials)));
 }
@@ -403,19 +410,7 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
                                     static_cast<int>(2LL * rc::kNominalSize * (run + 1) / runs));
     rc::Shrinkable<Draw> current = gen(random.split(), size);
     Trace best;
-    if (std::getenv("SAMPLER_DEBUG")) {
-      Trace t = ToTrace(system, space, current.value(), horizon);
-      std::fprintf(stderr, "run %d:", run);
-      for (auto& sig : t.inputs.inputs) for (auto& [a, b] : sig.points) std::fprintf(stderr, " %.17g: %.17g,", a, b);
-      std::fprintf(stderr, "\n");
-    }
-    const auto dbg0 = std::chrono::steady_clock::now();
     const std::optional<bool> hit = attempt(current.value(), best);
-    if (std::getenv("SAMPLER_DEBUG")) {
-      std::fprintf(stderr, "run %d size %d %.3fs status %s events %zu samples %zu pieces %d\n", run, size,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - dbg0).count(),
-                   std::string(StatusName(best.run.status)).c_str(), best.run.events.size(), best.run.samples.size(), InputPieces(best));
-    }
     if (!hit) {
       ++rejected;
       continue;
@@ -463,14 +458,16 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
     result.verdict = reach ? Verdict::kReachable : Verdict::kViolated;
     result.reason =
         found_what + " in run " + std::to_string(run + 1) + " of " + std::to_string(runs);
+    const int pieces = InputPieces(best);
     if (steps > 0) {
       result.reason += ", shrunk in " + Plural(steps, "step");
       if (!space.inputs.empty()) {
-        result.reason += " from " + std::to_string(pieces_found) + " to " +
-                         Plural(InputPieces(best), "input piece");
+        result.reason += pieces != pieces_found ? " from " + std::to_string(pieces_found) + " to " +
+                                                      Plural(pieces, "input piece")
+                                                : " (" + Plural(pieces, "input piece") + ")";
       }
     } else if (!space.inputs.empty()) {
-      result.reason += ", " + Plural(InputPieces(best), "input piece");
+      result.reason += ", " + Plural(pieces, "input piece");
     }
     result.trace = std::move(best);
     return finish(std::move(result));

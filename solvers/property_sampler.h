@@ -15,7 +15,8 @@ namespace hybrid {
 /// to a minimal one. Sampling finds bugs; it never proves anything.
 ///
 /// A run is a Trace (solvers/trace.h), drawn from:
-/// - for every input of the system (bounds from System::InputBounds), a step signal of 1 to
+/// - for every input of the system (bounds from System::InputBounds, under the drawn parameter
+///   values), a step signal of 1 to
 ///   Options::max_segments pieces over the horizon. Each piece has a value, drawn from the
 ///   input's upper end (30%), its lower end (30%), "zero" (0 clamped into the bounds, 15%) and
 ///   uniform values in the bounds (25%), and a duration weight in 1..20: the pieces' durations are
@@ -41,6 +42,8 @@ namespace hybrid {
 ///    zero; duration weights towards 1, i.e. towards pieces of equal length;
 /// 2. parameters: towards the nominal value, then hi, then lo, then values towards nominal;
 /// 3. initial values: towards the midpoint, then hi, then lo, then values towards the midpoint.
+/// A candidate that denotes the same run as the current trace (e.g. "zero" and the lower end of an
+/// input in [0, 1]) is taken without a replay and not counted as a step.
 /// So a minimal counterexample has as few input pieces as possible, with values at "zero" or at
 /// the ends of the bounds where it can, equal durations where timing does not matter, and
 /// parameters and initial values at their nominal values where they do not matter.
@@ -59,7 +62,8 @@ class PropertySampler {
     std::optional<double> horizon;
     /// Accepted shrink steps at most (>= 0; 0 reports the trace as found).
     int max_shrink_steps = 500;
-    /// Candidate replays during shrinking at most (>= 0): bounds the time spent shrinking.
+    /// Shrink candidates examined at most (>= 0; each costs at most one replay): bounds the time
+    /// spent shrinking.
     int max_shrink_replays = 5000;
   };
 
@@ -80,8 +84,9 @@ class PropertySampler {
   /// those left at their nominal value or midpoint.
   ///
   /// Throws std::invalid_argument ("PropertySampler: ...") for misuse: a non-positive or
-  /// non-finite horizon, an input with non-finite or empty bounds, a system the
-  /// simulator rejects (no initial state), or a model that rejects every drawn run.
+  /// non-finite horizon, an input with non-finite or empty bounds, an uncertain parameter whose
+  /// nominal value lies outside its range, a system the simulator rejects (no initial state), or a
+  /// model that rejects every drawn run.
   CheckResult Check(const System& system, const Property& property) const;
 
  private:

@@ -729,12 +729,33 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   // Per-step buffers, reused so that a step allocates nothing.
   std::vector<double> ga, gm;
   std::vector<int> crossed;
+  // Exact segments: the root functions reported at `settled_time` that fired nothing there. The
+  // state reached at a crossing is rounded, so such a root function can be left a hair before its
+  // boundary (theta2 = -8.9e-16 for `theta2 == 0`); its crossing time t - g / s then rounds to t
+  // itself and would be reported again and again at the same instant without anything changing.
+  // A settled root function is not reported again at that instant; a jump (new root functions)
+  // or an input jump there (the other conjuncts may hold now) unsettles them all.
+  std::vector<char> settled;
+  double settled_time = std::numeric_limits<double>::quiet_NaN();
+  size_t settled_events = 0;
+  auto is_settled = [&](size_t i, double time) {
+    return time == settled_time && result.events.size() == settled_events && i < settled.size() &&
+           settled[i] != 0;
+  };
+  // Consecutive passes of the loop that neither advanced time nor jumped. A few are normal (a
+  // root at the segment start, then a stop time there); more mean that the loop is stuck.
+  constexpr int kMaxStalledPasses = 100;
+  // Relative length (in units of roundoff of the time) below which a segment after a restart is
+  // not given to CVODE (see its use).
+  constexpr double kShortGap = 100 * std::numeric_limits<double>::epsilon();
+  int stalled = 0;
 
   while (running && t < until) {
     while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
     const double t_stop = std::min(
         {until, next_sample, next_break < breakpoints.size() ? breakpoints[next_break] : until});
     const double t_prev = t;
+    const size_t events_before = result.events.size();
     double t_new = t;
     crossed.clear();
     auto on_boundary = [&](size_t i) {
@@ -757,6 +778,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       }
     }
     CvodeIntegrator::Status status;
+    bool short_gap = false;  // stepped over a gap too short for CVODE
+    bool restarted = false;  // CVODE was restarted for this pass
     if (exact) {
       t_new = t_stop;
       for (size_t i = 0; i < g_prev.size(); ++i) {
@@ -770,6 +793,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         const double tie =
             4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
         if (crossing > t_new + tie || crossing > t_stop) continue;
+        // Already reported at this instant, and nothing fired: no progress to make here.
+        if (crossing <= t_prev + tie && is_settled(i, t_prev)) continue;
         // An invariant boundary reached exactly at an input breakpoint is not left yet: the
         // input changes there. The next segment starts on the boundary and decides.
         if (run.roots()[i].invariant && at_breakpoint && crossing >= t_stop - tie) continue;
@@ -781,11 +806,32 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
           crossed.empty() ? CvodeIntegrator::Status::kReachedTime : CvodeIntegrator::Status::kRoot;
       x_new = x + rate.head(x.size()) * (t_new - t_prev);
       stale = true;
+    } else if (stale && t_stop - t <= kShortGap * std::max(std::abs(t), std::abs(t_stop))) {
+      // A stop time a few ulps after a restart (a jump one ulp before a sample time or an input
+      // breakpoint): CVODE cannot start a step that short (CV_TOO_CLOSE), and CVODE itself
+      // locates roots only to about this precision. Move there on the tangent instead; a root
+      // function that changes sign, or leaves its boundary, crosses at the stop time.
+      short_gap = true;
+      run.Derivatives(t, x.data(), rate.data());
+      t_new = t_stop;
+      x_new = x + rate.head(x.size()) * (t_new - t_prev);
+      evaluate_roots(t_new, x_new, &g_mid);
+      for (size_t i = 0; i < g_mid.size(); ++i) {
+        const int dir = run.roots()[i].direction;
+        const double g0 = g_prev[i], g1 = g_mid[i];
+        const bool moved = on_boundary(i) ? dir * g1 > dir * g0
+                                          : (dir <= 0 && g0 > 0.0 && g1 <= 0.0) ||
+                                                (dir >= 0 && g0 < 0.0 && g1 >= 0.0);
+        if (moved) crossed.push_back(static_cast<int>(i));
+      }
+      status =
+          crossed.empty() ? CvodeIntegrator::Status::kReachedTime : CvodeIntegrator::Status::kRoot;
     } else {
       if (!integrator) integrator.emplace(&run, std::max(n, 1), io);
       if (stale) {
         integrator->Restart(t, x, run.directions());
         stale = false;
+        restarted = true;
       }
       status = integrator->Advance(t_stop, &t_new, &x_new);
       ++result.steps;
@@ -797,7 +843,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       break;
     }
     // Roots CVODE reports, or a double crossing inside the step found on the interpolant.
-    if (!exact && status == CvodeIntegrator::Status::kRoot) {
+    if (!exact && !short_gap && status == CvodeIntegrator::Status::kRoot) {
       for (size_t i = 0; i < integrator->root_info().size(); ++i) {
         if (integrator->root_info()[i] != 0) crossed.push_back(static_cast<int>(i));
       }
@@ -817,8 +863,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     for (size_t i = 0; i < g_prev.size() && !any_on_boundary; ++i) {
       any_on_boundary = on_boundary(i);
     }
-    if (!exact && (options.dense_checks > 0 || any_on_boundary) && !run.roots().empty() &&
-        t_new > t_prev) {
+    if (!exact && !short_gap && (options.dense_checks > 0 || any_on_boundary) &&
+        !run.roots().empty() && t_new > t_prev) {
       ga = g_prev;
       double a = t_prev;
       const int points = options.dense_checks + 1;  // the last one is the step end
@@ -897,6 +943,14 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         running = false;
       }
       if (running && jumped && zeno_check()) running = false;
+      if (running && exact && !jumped) {
+        if (!(t == settled_time && result.events.size() == settled_events)) {
+          settled.assign(run.roots().size(), 0);
+          settled_time = t;
+          settled_events = result.events.size();
+        }
+        for (int r : crossed) settled[r] = 1;
+      }
     }
     if (!running) break;
     // Stop times reached by this step (also when a root lies exactly on one: otherwise the sample
@@ -911,6 +965,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
       run.SetStepInputs(t);
       run.Load(t, x.data());
+      settled_time = std::numeric_limits<double>::quiet_NaN();  // the inputs changed
       running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
       if (running && zeno_check()) running = false;
       restart = true;
@@ -924,6 +979,20 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       restart = std::find(g_prev.begin(), g_prev.end(), 0.0) != g_prev.end();
     }
     if (restart) stale = true;
+    // Never spin: every pass must advance time or jump, but for a bounded number of passes.
+    // CVODE steps that continue without a restart are not counted: steps shorter than the
+    // resolution of t (t + h = t, as a solution blows up) are bounded by its max_steps, which
+    // reports CV_TOO_MUCH_WORK.
+    const bool continued = !exact && !short_gap && !restarted;
+    if (t > t_prev || result.events.size() != events_before) {
+      stalled = 0;
+    } else if (!continued && ++stalled > kMaxStalledPasses) {
+      result.status = SimulationStatus::kSolverFailure;
+      result.message = "no progress at t = " + FormatNumber(t) + " in mode " +
+                       ModeLabel(run.modes()) + ": " + std::to_string(kMaxStalledPasses) +
+                       " passes neither advanced time nor took a jump";
+      break;
+    }
   }
   if (result.status == SimulationStatus::kCompleted && t < until) {
     result.status = SimulationStatus::kSolverFailure;

@@ -74,8 +74,8 @@ std::optional<Expression> Integrate(const Expression& phi, int w, const std::str
     if (!ab || n == -1) return std::nullopt;
     if (n < 0) side.same_sign.push_back(base);
     const double beta = ab->second;
-    Expression up = n + 1 == 1 ? base
-                               : Expression::Binary(Op::kPow, base, Expression::Constant(n + 1));
+    Expression up =
+        n + 1 == 1 ? base : Expression::Binary(Op::kPow, base, Expression::Constant(n + 1));
     return up / Expression::Constant((n + 1) * beta);
   };
   auto integer_exponent = [](const Expression& e) -> std::optional<int> {
@@ -204,7 +204,24 @@ SmtEncoding::SmtEncoding(z3::context& ctx, const Automaton& automaton)
       params_[slot] = Num(ctx_, nominal_[slot]);
     }
   }
+  for (const z3::expr& d : definitions_) parameter_definitions_.push_back(d);
+  definitions_.clear();
   Classify();
+}
+
+z3::expr SmtEncoding::NominalParameters() {
+  z3::expr out = ctx_.bool_val(true);
+  for (const auto& [slot, value] : automaton_.parameters()) {
+    if (automaton_.ParameterRange(slot)) out = out && *params_[slot] == Num(ctx_, nominal_[slot]);
+  }
+  return out;
+}
+
+z3::expr SmtEncoding::TakeDefinitions() {
+  z3::expr out = ctx_.bool_val(true);
+  for (const z3::expr& d : definitions_) out = out && d;
+  definitions_.clear();
+  return out;
 }
 
 z3::expr SmtEncoding::Fresh(const std::string& prefix) {
@@ -250,8 +267,10 @@ void SmtEncoding::Classify() {
       }
       info.drift[v] = a->constant;
       for (const auto& [slot, coef] : a->terms) {
-        if (input_index_[slot] < 0) constant_rate = false;
-        else info.rate[v][input_index_[slot]] = coef;
+        if (input_index_[slot] < 0)
+          constant_rate = false;
+        else
+          info.rate[v][input_index_[slot]] = coef;
       }
       if (!constant_rate) break;
     }
@@ -290,8 +309,10 @@ void SmtEncoding::Classify() {
         // f = h * u or u * h.
         std::optional<Expression> h;
         if (f.op() == Op::kMul) {
-          if (f.args()[1].is_symbol() && f.args()[1].slot() == u) h = f.args()[0];
-          else if (f.args()[0].is_symbol() && f.args()[0].slot() == u) h = f.args()[1];
+          if (f.args()[1].is_symbol() && f.args()[1].slot() == u)
+            h = f.args()[0];
+          else if (f.args()[0].is_symbol() && f.args()[0].slot() == u)
+            h = f.args()[1];
         }
         if (!h || Reads(*h, u)) {
           ok = false;
@@ -303,10 +324,12 @@ void SmtEncoding::Classify() {
         for (const auto& [e, num] : factors) {
           bool reads_w = false, reads_other = false;
           for (int s : e.Slots()) {
-            if (s == w) reads_w = true;
+            if (s == w)
+              reads_w = true;
             else if (automaton_.symbols()[s].kind == SymbolKind::kVariable && !still[s])
               reads_other = true;
-            else if (automaton_.symbols()[s].kind == SymbolKind::kInput) reads_other = true;
+            else if (automaton_.symbols()[s].kind == SymbolKind::kInput)
+              reads_other = true;
           }
           if (reads_other) ok = false;
           if (reads_w) {
@@ -332,8 +355,7 @@ void SmtEncoding::Classify() {
           sf.sign_phi = r.lo() > 0 ? 1.0 : (r.hi() < 0 ? -1.0 : 0.0);
         }
         Integral side;
-        sf.antiderivative =
-            Integrate(phi, w, automaton_.symbols()[w].name, side);
+        sf.antiderivative = Integrate(phi, w, automaton_.symbols()[w].name, side);
         sf.domain = side.domain;
         if (side.saturations.size() == 1) {
           const auto& sat = side.saturations[0];
@@ -359,8 +381,9 @@ void SmtEncoding::Classify() {
 SmtEncoding::StepVars& SmtEncoding::Vars(int k) {
   while (static_cast<int>(steps_.size()) <= k) {
     const std::string s = std::to_string(steps_.size());
-    StepVars v{{}, {}, {}, {}, ctx_.real_const(("d@" + s).c_str()),
-               ctx_.bool_const(("flow@" + s).c_str()), {}};
+    StepVars v{
+        {}, {}, {}, {}, ctx_.real_const(("d@" + s).c_str()), ctx_.bool_const(("flow@" + s).c_str()),
+        {}};
     for (const Mode& m : automaton_.modes()) {
       v.mode.push_back(ctx_.bool_const(("mode:" + m.name + "@" + s).c_str()));
     }
@@ -428,9 +451,18 @@ z3::expr SmtEncoding::Translate(const Expression& e,
       case Op::kMul:
         out = go(args[0]) * go(args[1]);
         break;
-      case Op::kDiv:
-        out = go(args[0]) / go(args[1]);
+      case Op::kDiv: {
+        z3::expr num = go(args[0]), den = go(args[1]);
+        if (den.is_numeral()) {
+          out = num / den;
+        } else {
+          // q = num / den as the polynomial definition den q = num (den != 0), so that the
+          // formulas stay polynomial (nlsat); q is unconstrained where den = 0 (undefined).
+          out = Fresh("div");
+          definitions_.push_back(z3::implies(den != 0, out * den == num));
+        }
         break;
+      }
       case Op::kPow: {
         const Expression& ex = args[1];
         if (ex.is_constant() && ex.constant() == std::round(ex.constant()) &&
@@ -533,7 +565,12 @@ z3::expr SmtEncoding::State(int k) {
   const auto env = Env(k);
   z3::expr_vector modes(ctx_);
   for (const auto& b : v.mode) modes.push_back(b);
-  z3::expr out = z3::mk_or(modes) && z3::atmost(modes, 1);
+  // Exactly one mode (pairwise at-most-one: plain clauses, which every Z3 tactic accepts).
+  z3::expr out = z3::mk_or(modes);
+  for (std::size_t i = 0; i < v.mode.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.mode.size(); ++j) out = out && (!v.mode[i] || !v.mode[j]);
+  }
+  for (const z3::expr& d : parameter_definitions_) out = out && d;
   for (int m = 0; m < automaton_.num_modes(); ++m) {
     const Constraint& inv = automaton_.modes()[m].invariant;
     if (!inv.empty()) out = out && z3::implies(v.mode[m], Conjunction(inv, env));
@@ -657,14 +694,14 @@ z3::expr SmtEncoding::Flow(int k, int mode) {
               const z3::expr side1 = side_sign > 0 ? b1 > 0 : b1 < 0;
               // Leaving the domain: v0 -> v* = v0 + D -> beyond.
               const z3::expr d_out = K * (phi_edge - phi0) / c;
-              out = out && z3::implies(in0 && !in1 && side0,
-                                       z3::implies(d_out >= 0, dv >= d_out) &&
-                                           z3::implies(d_out <= 0, dv <= d_out));
+              out = out &&
+                    z3::implies(in0 && !in1 && side0, z3::implies(d_out >= 0, dv >= d_out) &&
+                                                          z3::implies(d_out <= 0, dv <= d_out));
               // Entering it: v0 -> v* -> v1 = v* + D.
               const z3::expr d_in = K * (phi1 - phi_edge) / c;
-              out = out && z3::implies(!in0 && in1 && side1,
-                                       z3::implies(d_in >= 0, dv >= d_in) &&
-                                           z3::implies(d_in <= 0, dv <= d_in));
+              out =
+                  out && z3::implies(!in0 && in1 && side1, z3::implies(d_in >= 0, dv >= d_in) &&
+                                                               z3::implies(d_in <= 0, dv <= d_in));
             }
           }
         }
@@ -725,8 +762,8 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
     if (tr.source.value() != mode || tr.urgency != Urgency::kUrgent) continue;
     struct Atom {
       z3::expr alpha;
-      double beta;        // sign and magnitude (for the case split)
-      z3::expr beta_q;    // the exact rational value
+      double beta;      // sign and magnitude (for the case split)
+      z3::expr beta_q;  // the exact rational value
       Relation rel;
     };
     std::vector<Atom> atoms;
@@ -758,9 +795,8 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
       atoms.push_back({Translate(r, env), beta, beta_q.simplify(), c.relation});
     }
     if (!ok) continue;
-    z3::expr sigma_end = const_sigma ? *const_sigma
-                                     : (sep_var >= 0 ? b.x[sep_var] - a.x[sep_var]
-                                                     : Num(ctx_, 0.0));
+    z3::expr sigma_end =
+        const_sigma ? *const_sigma : (sep_var >= 0 ? b.x[sep_var] - a.x[sep_var] : Num(ctx_, 0.0));
     // Guard holds at some sigma of the segment; sign: +1 [0, end), -1 (end, 0], 0 {0}.
     auto meet = [&](int sign) {
       z3::expr fixed = ctx_.bool_val(true);
@@ -835,8 +871,8 @@ z3::expr SmtEncoding::Jump(int k, int t) {
   StepVars& a = Vars(k);
   StepVars& b = Vars(k + 1);
   const auto env = Env(k);
-  z3::expr out = a.mode[tr.source.value()] && b.mode[tr.target.value()] &&
-                 Conjunction(tr.guard, env);
+  z3::expr out =
+      a.mode[tr.source.value()] && b.mode[tr.target.value()] && Conjunction(tr.guard, env);
   std::vector<bool> reset(var_slots_.size(), false);
   for (const Reset& r : tr.resets) {
     const int v = var_index_[r.slot];
@@ -847,6 +883,18 @@ z3::expr SmtEncoding::Jump(int k, int t) {
     if (!reset[v]) out = out && b.x[v] == a.x[v];
   }
   return out;
+}
+
+z3::expr SmtEncoding::TransitionFrom(int k, ModeId m) {
+  StepVars& a = Vars(k);
+  StepVars& b = Vars(k + 1);
+  const int mode = m.value();
+  z3::expr_vector options(ctx_);
+  options.push_back(a.flow && b.mode[mode] && Flow(k, mode));
+  for (int t = 0; t < automaton_.num_transitions(); ++t) {
+    if (automaton_.transitions()[t].source == m) options.push_back(a.jump[t] && Jump(k, t));
+  }
+  return a.mode[mode] && z3::mk_or(options);
 }
 
 z3::expr SmtEncoding::Transition(int k) {

@@ -69,11 +69,19 @@ class SmtEncoding {
   z3::expr State(int k);
   /// T(s_k, s_k+1).
   z3::expr Transition(int k);
+  /// T(s_k, s_k+1) with s_k in mode `m` (smaller than Transition(k) and InMode(k, m)).
+  z3::expr TransitionFrom(int k, ModeId m);
   /// `p` at s_k, evaluated leniently within `tolerance` (comparisons in positive position hold
   /// within it, under `not` they must hold with that margin; tolerance 0 is exact).
   z3::expr Holds(const Predicate& p, int k, double tolerance = 0.0);
   /// s_k is in mode `m`.
   z3::expr InMode(int k, ModeId m);
+  /// Every uncertain parameter at its nominal value.
+  z3::expr NominalParameters();
+  /// Definitions of the auxiliary variables introduced by the formulas built since the last call
+  /// (a quotient q = a / b becomes b q = a): assert them at the top level, outside any negation,
+  /// next to the formulas that use them.
+  z3::expr TakeDefinitions();
   /// Uncertain parameters: name -> Z3 constant (nominal ones are numbers).
   const std::vector<std::pair<std::string, z3::expr>>& uncertain() const { return uncertain_; }
 
@@ -93,18 +101,18 @@ class SmtEncoding {
 
  private:
   struct StepVars {
-    std::vector<z3::expr> mode;   // one Bool per mode
-    std::vector<z3::expr> x;      // per continuous variable (index in variables())
-    std::vector<z3::expr> u;      // per input (index in inputs())
-    std::vector<z3::expr> v;      // input integral over the flow from this state
-    z3::expr d;                   // duration of the flow from this state
-    z3::expr flow;                // Bool: the step from here is a flow
-    std::vector<z3::expr> jump;   // Bool per transition: the step from here is that jump
+    std::vector<z3::expr> mode;  // one Bool per mode
+    std::vector<z3::expr> x;     // per continuous variable (index in variables())
+    std::vector<z3::expr> u;     // per input (index in inputs())
+    std::vector<z3::expr> v;     // input integral over the flow from this state
+    z3::expr d;                  // duration of the flow from this state
+    z3::expr flow;               // Bool: the step from here is a flow
+    std::vector<z3::expr> jump;  // Bool per transition: the step from here is that jump
   };
   struct SeparableFlow {
-    int var = -1;                 // variable index
-    Expression k;                 // mode-constant factor K
-    double sign_phi = 0.0;        // sign of phi on the driver's domain (0: unknown)
+    int var = -1;                              // variable index
+    Expression k;                              // mode-constant factor K
+    double sign_phi = 0.0;                     // sign of phi on the driver's domain (0: unknown)
     std::optional<Expression> antiderivative;  // Phi(w), over the driver's slot
     std::vector<Comparison> domain;            // where Phi' = phi (evaluated at both ends)
     // max(B^n, eps) with B = alpha + beta w: (alpha, beta, eps^(1/n)).
@@ -112,10 +120,10 @@ class SmtEncoding {
   };
   struct ModeInfo {
     FlowClass flow_class = FlowClass::kGeneral;
-    std::vector<int> moving;                      // variable indices with a nonzero flow
+    std::vector<int> moving;  // variable indices with a nonzero flow
     // kConstantRate: per moving variable, r0 and r_j (per input index).
-    std::vector<double> drift;                    // by variable index
-    std::vector<std::vector<double>> rate;        // [variable index][input index]
+    std::vector<double> drift;              // by variable index
+    std::vector<std::vector<double>> rate;  // [variable index][input index]
     // kSeparable
     int input = -1;
     int driver = -1;
@@ -139,17 +147,19 @@ class SmtEncoding {
 
   z3::context& ctx_;
   const Automaton& automaton_;
-  std::vector<int> var_slots_;    // slot of each continuous variable
-  std::vector<int> var_index_;    // slot -> variable index, -1 otherwise
+  std::vector<int> var_slots_;  // slot of each continuous variable
+  std::vector<int> var_index_;  // slot -> variable index, -1 otherwise
   std::vector<int> input_slots_;
   std::vector<int> input_index_;  // slot -> input index, -1 otherwise
   std::vector<double> input_lo_, input_hi_;
   std::vector<std::optional<z3::expr>> params_;  // per slot (parameters only)
-  std::vector<bool> uncertain_slot_;              // parameter depends on an uncertain one
-  std::vector<double> nominal_;                   // ParameterEnvironment()
+  std::vector<bool> uncertain_slot_;             // parameter depends on an uncertain one
+  std::vector<double> nominal_;                  // ParameterEnvironment()
   std::vector<std::pair<std::string, z3::expr>> uncertain_;
   std::vector<ModeInfo> modes_;
-  std::deque<StepVars> steps_;  // deque: references stay valid as steps are added
+  std::vector<z3::expr> definitions_;
+  std::vector<z3::expr> parameter_definitions_;  // asserted with every State
+  std::deque<StepVars> steps_;                   // deque: references stay valid as steps are added
   int fresh_ = 0;
 };
 

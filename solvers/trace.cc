@@ -47,8 +47,8 @@ bool AtomHolds(const Comparison& c, std::span<const double> env, double margin) 
 // `p` evaluated as leniently as `tol` allows: every comparison in positive position holds within
 // tol, every comparison under an odd number of `not`s must hold with margin tol. So
 // !Lenient(p) means p fails clearly.
-bool Lenient(const Predicate& p, std::span<const double> env,
-             std::span<const std::string> modes, double tol, bool positive) {
+bool Lenient(const Predicate& p, std::span<const double> env, std::span<const std::string> modes,
+             double tol, bool positive) {
   switch (p.kind()) {
     case Predicate::Kind::kTrue:
       return true;
@@ -76,7 +76,8 @@ std::vector<double> StateEnvironment(const Simulator& simulator, const StateSamp
   std::vector<double> env(system.symbols().size(), 0.0);
   for (const Component& c : system.components()) {
     const std::vector<double> local = c.automaton.ParameterEnvironment();
-    for (const auto& [slot, value] : c.automaton.parameters()) env[c.global_slot[slot]] = local[slot];
+    for (const auto& [slot, value] : c.automaton.parameters())
+      env[c.global_slot[slot]] = local[slot];
   }
   const auto& names = simulator.variable_names();
   for (std::size_t i = 0; i < names.size(); ++i) {

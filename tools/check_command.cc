@@ -33,9 +33,10 @@ std::vector<Property> DeclaredProperties(const System& system) {
         switch (x.kind()) {
           case Predicate::Kind::kComparison: {
             auto sub = [&](const Expression& e) {
-              return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
-                return Expression::Symbol(name, comp.global_slot[slot]);
-              });
+              return e.Substitute(
+                  [&](const std::string& name, int slot) -> std::optional<Expression> {
+                    return Expression::Symbol(name, comp.global_slot[slot]);
+                  });
             };
             const Comparison& k = x.comparison();
             return Predicate::Compare({sub(k.lhs), k.relation, sub(k.rhs)});
@@ -99,7 +100,8 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
               {"events", events}};
   if (t.state_index >= 0) {
     const StateSample& s = t.run.samples[t.state_index];
-    out["state"] = {{"time", s.time}, {"mode", sim.ModeLabel(s.modes)}, {"values", StateJson(sim, s.x)}};
+    out["state"] = {
+        {"time", s.time}, {"mode", sim.ModeLabel(s.modes)}, {"values", StateJson(sim, s.x)}};
   }
   return out;
 }
@@ -124,7 +126,8 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
   for (const EventRecord& e : t.run.events) {
     if (e.time > until_state) break;
     out << "    t = " << e.time << "  ";
-    for (std::size_t i = 0; i < e.transitions.size(); ++i) out << (i ? "+" : "") << e.transitions[i];
+    for (std::size_t i = 0; i < e.transitions.size(); ++i)
+      out << (i ? "+" : "") << e.transitions[i];
     out << "  " << sim.ModeLabel(e.modes_before) << " -> " << sim.ModeLabel(e.modes_after) << "\n";
   }
   if (t.state_index >= 0) {
@@ -144,7 +147,8 @@ int RunCheck(const CheckArgs& args) {
   if (args.method != "prove" && args.method != "sample") {
     throw std::invalid_argument("--method must be 'prove' or 'sample', not '" + args.method + "'");
   }
-  if (args.depth < 0 || args.depth > 1000) throw std::invalid_argument("--depth must be in [0, 1000]");
+  if (args.depth < 0 || args.depth > 1000)
+    throw std::invalid_argument("--depth must be in [0, 1000]");
   if (args.induction < 1 || args.induction > 100) {
     throw std::invalid_argument("--induction must be in [1, 100]");
   }
@@ -163,8 +167,8 @@ int RunCheck(const CheckArgs& args) {
         std::string known;
         for (const Property& p : declared) known += " " + p.name;
         throw std::invalid_argument("--property: '" + name + "' is not a property of " +
-                                    args.model + " (properties:" +
-                                    (known.empty() ? " none" : known) + ")");
+                                    args.model +
+                                    " (properties:" + (known.empty() ? " none" : known) + ")");
       }
       chosen.push_back(*it);
     }

@@ -12,11 +12,11 @@ struct CheckArgs {
   std::vector<std::string> properties;  ///< names to check; empty: every declared property
   std::string method = "prove";         ///< prove or sample
   bool json = false;
-  bool modes = false;                   ///< also report which modes (discrete states) are reachable
-  int depth = 12;                       ///< prove: longest counterexample searched, in steps
-  int induction = 2;                    ///< prove: largest k of k-induction
-  int runs = 200;                       ///< sample: random runs per property
-  std::uint64_t seed = 1;               ///< sample: seed
+  bool modes = false;      ///< also report which modes (discrete states) are reachable
+  int depth = 12;          ///< prove: longest counterexample searched, in steps
+  int induction = 2;       ///< prove: largest k of k-induction
+  int runs = 200;          ///< sample: random runs per property
+  std::uint64_t seed = 1;  ///< sample: seed
 };
 
 /// Runs `hybrid check`; returns the exit code: 0 when no property is violated or unknown, 6 when

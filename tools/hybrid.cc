@@ -21,9 +21,9 @@
 #include "automaton/mode_graph.h"
 #include "automaton/parser.h"
 #include "automaton/system.h"
+#include "tools/check_command.h"
 #include "tools/gripper_command.h"
 #include "tools/output.h"
-#include "tools/check_command.h"
 #include "tools/simulate_command.h"
 
 namespace {
@@ -356,9 +356,10 @@ int main(int argc, char** argv) {
   check->add_flag("--json", check_args.json, "Machine-readable output");
   check->add_flag("--modes", check_args.modes,
                   "Also report which modes (discrete states) some run reaches");
-  check->add_option("--depth", check_args.depth,
-                    "prove: longest counterexample or witness searched, in steps (flow segments "
-                    "and jumps)")
+  check
+      ->add_option("--depth", check_args.depth,
+                   "prove: longest counterexample or witness searched, in steps (flow segments "
+                   "and jumps)")
       ->capture_default_str();
   check->add_option("--induction", check_args.induction, "prove: largest k of k-induction")
       ->capture_default_str();

@@ -457,8 +457,8 @@ TEST(Parser, FingerModel) {
   EXPECT_EQ(a.parameters().size(), 11u);
   EXPECT_EQ(a.initial_states().size(), 1u);
   EXPECT_EQ(a.mode(a.initial_states()[0].mode).name, "c000_l000");
-  EXPECT_EQ(a.properties().size(), 8u);
-  EXPECT_EQ(s.properties().size(), 8u);
+  EXPECT_EQ(a.properties().size(), 13u);
+  EXPECT_EQ(s.properties().size(), 13u);
   ASSERT_TRUE(s.scenario().has_value());
   EXPECT_EQ(s.scenario()->until, 530.0);
   const auto m1 = a.symbols().Find("m1");

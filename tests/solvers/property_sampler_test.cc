@@ -180,6 +180,8 @@ TEST(PropertySamplerTest, ReversalNeedsExactlyTwoPieces) {
   EXPECT_LT(values[1], 0.0);
   // Shrinking pushes the values to the ends of the bounds (a reversal at full speed).
   EXPECT_EQ(values, (std::vector<double>{1.0, -1.0}));
+  // ... and the durations to equal pieces: up for 5, down for 5.
+  EXPECT_DOUBLE_EQ(result.trace->inputs.inputs[0].points[1].first, 5.0);
   EXPECT_LE(AtTarget(system, *result.trace, "x"), 1.0);
   ExpectReplays(system, property, result);
 }
@@ -329,16 +331,19 @@ std::pair<std::size_t, std::size_t> Block(const std::string& text, const std::st
 }
 
 // spec/finger.ha with theta1's upper limit removed in phase 1' (link 3 at its lower limit): the
-// limit transition t3_c000_l00n_to_c000_l10n is dropped and the mode's invariant widened by 10
-// degrees, so closing carries theta1 past theta1_max.
+// limit transition t3_c000_l00n_to_c000_l10n is dropped (and, should the mode's invariant bound
+// theta1 by theta1_max, that bound is widened by 10 degrees), so closing carries theta1 past
+// theta1_max. The text is read at test time: the file is generated (tools/generate_finger.py).
 std::string FingerWithoutPhase1PrimeTheta1Limit() {
   std::string text = SpecText("finger");
   const auto [t_begin, t_end] = Block(text, "  transition t3_c000_l00n_to_c000_l10n:");
   text.erase(t_begin, t_end - t_begin);
   const auto [m_begin, m_end] = Block(text, "  mode c000_l00n (");
   const std::string mode = text.substr(m_begin, m_end - m_begin);
-  text.replace(m_begin, m_end - m_begin,
-               ReplaceOnce(mode, "theta1 <= theta1_max", "theta1 <= theta1_max + 10"));
+  if (mode.find("theta1 <= theta1_max") != std::string::npos) {
+    text.replace(m_begin, m_end - m_begin,
+                 ReplaceOnce(mode, "theta1 <= theta1_max", "theta1 <= theta1_max + 10"));
+  }
   return text;
 }
 
@@ -350,6 +355,14 @@ TEST(PropertySamplerTest, FingerWithoutTheta1LimitViolatesTheta1Range) {
   EXPECT_GT(AtTarget(system, *result.trace, "theta1"), 70.0);
   // Closing at full speed is the minimal counterexample.
   EXPECT_EQ(InputValues(*result.trace), std::vector<double>{1.0}) << result.reason;
+  // Uncertain parameters (the contact positions gob1..3, if declared with ranges) do not matter:
+  // shrinking leaves them at their nominal values (no contact).
+  const std::vector<UncertainParameter> uncertain = UncertainParameters(system);
+  ASSERT_EQ(result.trace->parameters.size(), uncertain.size());
+  for (std::size_t i = 0; i < uncertain.size(); ++i) {
+    EXPECT_EQ(result.trace->parameters[i].first, uncertain[i].name);
+    EXPECT_EQ(result.trace->parameters[i].second, uncertain[i].nominal) << uncertain[i].name;
+  }
   ExpectReplays(system, property, result);
 
   // The unmodified model is not caught by this property (its limits hold).

@@ -53,7 +53,7 @@ TEST(FingerSpecTest, CommittedFileIsTheGeneratorOutput) {
 TEST(FingerSpecTest, SizeAndReachability) {
   const Automaton a = Finger();
   EXPECT_EQ(a.num_modes(), 31);
-  EXPECT_EQ(a.num_transitions(), 100);
+  EXPECT_EQ(a.num_transitions(), 106);
   const ModeGraph graph(a);
   EXPECT_EQ(graph.ReachableModes().size(), 31u);
   EXPECT_TRUE(graph.Warnings().empty());

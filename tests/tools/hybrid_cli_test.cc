@@ -98,7 +98,7 @@ TEST(HybridCli, InfoJsonOfTheFinger) {
   EXPECT_EQ(c["discrete_variables"].size(), 6u);
   EXPECT_EQ(c["inputs"][0]["bounds"], nlohmann::json::array({-1.0, 1.0}));
   EXPECT_EQ(c["initial_states"][0]["mode"], "c000_l000");
-  EXPECT_EQ(c["properties"].size(), 8u);
+  EXPECT_EQ(c["properties"].size(), 13u);
   EXPECT_TRUE(info["warnings"].empty());
   EXPECT_EQ(info["scenario"]["until"], 530.0);
   EXPECT_EQ(info["scenario"]["inputs"][0]["shape"], "step");
