@@ -27,8 +27,8 @@ class OdeSystem {
 /// The integrator never prints: CVODE's error handler is replaced by one that keeps the last
 /// message (errors and warnings), which failures report in message() (and setup errors in the
 /// exception text). CVODE cannot start a step towards a stop time within about 2 * unit roundoff
-/// * |t| of the restart time (CV_TOO_CLOSE, "tout too close to t0 to start integration"): callers
-/// must not ask for one right after a Restart.
+/// * |t| of the restart time: Advance then reports kFailure (CV_TOO_CLOSE, "tout too close to t0
+/// to start integration"); the Simulator steps over such short gaps without CVODE.
 class CvodeIntegrator {
  public:
   struct Options {

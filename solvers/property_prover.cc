@@ -248,8 +248,9 @@ void Engine::Run(const Job& job) {
   Add(bmc, enc, enc.Initial());
   Add(bmc, enc, enc.State(0));
   bool bmc_complete = true;
+  std::string budget_note;
   int bmc_depth = -1;  // paths up to this length are in `bmc`
-  auto search = [&](int n, bool invariants_only) {
+  auto search = [&](int n, bool invariants_only, std::initializer_list<bool> passes) {
     while (bmc_depth < n) {
       ++bmc_depth;
       if (bmc_depth > 0) {
@@ -257,28 +258,35 @@ void Engine::Run(const Job& job) {
         Add(bmc, enc, enc.State(bmc_depth));
       }
     }
-    z3::expr_vector any(ctx);
-    for (Candidate& c : cands) {
-      if (!pending(c) || (invariants_only && !c.invariant)) continue;
-      any.push_back(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, 0.0)
-                                : enc.Holds(c.bad, n, 0.0));
-    }
-    if (any.empty()) return;
-    bmc.push();
-    Add(bmc, enc, z3::mk_or(any));
-    const z3::check_result r = bmc.check();
-    bmc.pop();
-    if (r == z3::unknown) bmc_complete = false;
-    if (r != z3::sat) return;
-    for (Candidate& c : cands) {
-      if (!pending(c) || (invariants_only && !c.invariant)) continue;
-      // Parameters at their nominal values first (fewer ties between events, which the
-      // simulator breaks by declaration order), then over their ranges; robust violations first
-      // (they replay clear of rounding), then exact ones.
-      for (bool pinned : {true, false}) {
+    // Parameters at their nominal values first (fewer ties between events, which the simulator
+    // breaks by declaration order), then over their ranges; per pass, one query for all
+    // candidates, then one per candidate (robust violations first: they replay clear of
+    // rounding; then exact ones).
+    for (bool pinned : passes) {
+      if (pinned && enc.uncertain().empty()) continue;
+      z3::expr_vector any(ctx);
+      for (Candidate& c : cands) {
+        if (!pending(c) || (invariants_only && !c.invariant)) continue;
+        any.push_back(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, 0.0)
+                                  : enc.Holds(c.bad, n, 0.0));
+      }
+      if (any.empty()) return;
+      bmc.push();
+      Add(bmc, enc, z3::mk_or(any));
+      if (pinned) bmc.add(enc.NominalParameters());
+      const auto t_query = Clock::now();
+      const z3::check_result r = bmc.check();
+      bmc.pop();
+      if (std::getenv("HYBRID_CHECK_TIMING")) {
+        std::cerr << "bmc depth " << n << (pinned ? " pinned: " : " free: ") << r << " "
+                  << Since(t_query) << " s\n";
+      }
+      if (r == z3::unknown && !pinned) bmc_complete = false;
+      if (r == z3::unsat) continue;
+      for (Candidate& c : cands) {
+        if (!pending(c) || (invariants_only && !c.invariant)) continue;
         for (double margin : {options_.robust_margin, 0.0}) {
           if (!pending(c) || (!c.invariant && margin > 0)) continue;
-          if (pinned && enc.uncertain().empty()) continue;
           bmc.push();
           Add(bmc, enc,
               c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
@@ -289,15 +297,18 @@ void Engine::Run(const Job& job) {
             c.refuted = c.refuted || c.invariant;
             const z3::model model = bmc.get_model();
             TryTrace(job, enc, model, n, c);
-          } else if (rc == z3::unknown) {
+          } else if (rc == z3::unknown && !pinned) {
             bmc_complete = false;
           }
           bmc.pop();
+          if (rc == z3::sat) break;
         }
       }
     }
   };
-  for (int n = 0; n < options_.max_induction && n <= options_.max_depth; ++n) search(n, true);
+  for (int n = 0; n < options_.max_induction && n <= options_.max_depth; ++n) {
+    search(n, true, {true, false});
+  }
   const bool base_complete = bmc_complete;
 
   // 2. k-induction with Houdini over the surviving invariants (and negated reach targets).
@@ -378,11 +389,12 @@ void Engine::Run(const Job& job) {
           std::cerr << "k=" << k << " mode " << a.modes()[m].name << ": " << r << " "
                     << Since(t_mode) << " s\n";
         }
+        (void)t_mode;
         if (r == z3::unknown) {
           // Split per candidate with the full time budget.
           for (std::size_t j : goals) {
             std::vector<std::size_t> f;
-            const z3::check_result rj = check({j}, options_.timeout_ms, f);
+            const z3::check_result rj = check({j}, std::min(options_.timeout_ms, 3000u), f);
             if (rj == z3::unknown) f.push_back(j);
             for (std::size_t x : f) failed.push_back(x);
           }
@@ -410,7 +422,26 @@ void Engine::Run(const Job& job) {
   }
 
   // 3. Counterexamples and witnesses for what is still open, up to max_depth steps.
-  for (int n = 0; n <= options_.max_depth && open(); ++n) search(n, false);
+  // Nominal parameters to full depth first (cheap), then all parameter values within the
+  // budget (the search space grows fast with the depth).
+  const Clock::time_point bmc_start = Clock::now();
+  for (int pass = 0; pass < 2 && open(); ++pass) {
+    const bool pinned = pass == 0;
+    if (pinned && enc.uncertain().empty()) continue;
+    int searched = -1;
+    for (int n = 0; n <= options_.max_depth && open(); ++n) {
+      if (Since(bmc_start) > options_.search_seconds) {
+        bmc_complete = false;
+        budget_note = "the search budget of " + FormatNumber(options_.search_seconds) +
+                      " s ran out after paths of " + std::to_string(searched) + " steps" +
+                      (pinned ? " with nominal parameters" : "") + "; ";
+        break;
+      }
+      if (pinned) search(n, false, {true});
+      else search(n, false, {false});
+      searched = n;
+    }
+  }
   for (Candidate& c : cands) {
     if (!c.decided && c.refuted) {
       Decide(c, Verdict::kUnknown,
@@ -444,13 +475,16 @@ void Engine::Run(const Job& job) {
   }
   for (Candidate& c : cands) {
     if (c.decided) continue;
-    std::string why = bmc_complete ? "" : "an SMT query timed out; ";
+    std::string why = !budget_note.empty() ? budget_note
+                      : bmc_complete     ? ""
+                                         : "an SMT query timed out; ";
+    const std::string within =
+        budget_note.empty() ? " within " + std::to_string(options_.max_depth) + " steps" : "";
     if (c.invariant) {
       why += "not proved by k-induction for k <= " + std::to_string(options_.max_induction) +
-             " and no counterexample within " + std::to_string(options_.max_depth) + " steps";
+             " and no counterexample" + within;
     } else {
-      why += "no witness within " + std::to_string(options_.max_depth) +
-             " steps that replays, and unreachability not proved by k-induction";
+      why += "no witness" + within + " that replays, and unreachability not proved by induction";
     }
     Decide(c, Verdict::kUnknown, why);
   }
@@ -566,7 +600,10 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
     for (const Property& lemma : components[c].automaton.properties()) {
       if (lemma.kind == Property::Kind::kReach) continue;
       bool dup = false;
-      for (const Goal& g : job.goals) dup = dup || g.property == lemma;
+      for (const Goal& g : job.goals) {
+        dup = dup || (g.property.kind == lemma.kind && g.property.predicate == lemma.predicate &&
+                      g.property.horizon == lemma.horizon);
+      }
       if (dup) continue;
       Property original = lemma;
       original.predicate = Remap(
@@ -583,7 +620,79 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
           });
       job.goals.push_back({lemma, -1, original});
     }
-    engine.Run(job);
+    // Instances of one automaton asked the same questions share the proof: only traces are
+    // carried over (renamed) and replayed for this instance.
+    int same = -1;
+    for (std::size_t c0 = 0; c0 < c && same < 0; ++c0) {
+      const Job& j0 = jobs[c0];
+      if (j0.goals.size() != job.goals.size() || !(components[c0].source == components[c].source)) {
+        continue;
+      }
+      // Compare with the declared (unqualified) names: slots are the same in both instances.
+      auto plain = [&](const Predicate& p, const Component& comp) {
+        return Remap(
+            p,
+            [&](const Expression& e) {
+              return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
+                return Expression::Symbol(comp.source.symbols()[slot].name, slot);
+              });
+            },
+            [&](const std::string& m) {
+              auto id = comp.automaton.FindMode(m);
+              return id ? comp.source.mode(*id).name : m;
+            });
+      };
+      bool equal = true;
+      for (std::size_t g = 0; g < job.goals.size() && equal; ++g) {
+        const Property& a = j0.goals[g].property;
+        const Property& b = job.goals[g].property;
+        equal = a.kind == b.kind && a.horizon == b.horizon &&
+                plain(a.predicate, components[c0]) == plain(b.predicate, components[c]);
+      }
+      if (equal) same = static_cast<int>(c0);
+    }
+    if (same < 0) {
+      engine.Run(job);
+      continue;
+    }
+    const std::string from = components[same].instance + ".", to = components[c].instance + ".";
+    auto rename = [&](const std::string& name) {
+      return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
+    };
+    for (std::size_t g = 0; g < job.goals.size(); ++g) {
+      const int src = jobs[same].goals[g].result, dst = job.goals[g].result;
+      if (dst < 0) continue;
+      if (src < 0) continue;  // (cannot happen: goals pair up in order)
+      CheckResult r = results[src];
+      r.property = results[dst].property;
+      r.kind = results[dst].kind;
+      if (r.trace) {
+        Trace t = *r.trace;
+        for (auto& [name, v] : t.parameters) name = rename(name);
+        for (auto& [name, v] : t.initial_values) name = rename(name);
+        for (InputSignal& in : t.inputs.inputs) {
+          const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
+          if (slot) in.slot = *slot;
+        }
+        bool ok = false;
+        try {
+          ok = ReplayTrace(system, job.goals[g].original, t);
+        } catch (const std::exception&) {
+        }
+        if (ok) {
+          r.trace = std::move(t);
+        } else {
+          r.trace.reset();
+          r.verdict = Verdict::kUnknown;
+          r.reason = "the trace found for instance " + components[same].instance +
+                     " does not replay for " + components[c].instance;
+        }
+      }
+      r.reason += " (the proof for instance " + components[same].instance +
+                  ", an instance of the same automaton)";
+      r.seconds = Since(start);
+      results[dst] = std::move(r);
+    }
   }
   if (product && !product_job.goals.empty()) {
     product_job.automaton = &*product;

@@ -38,12 +38,15 @@ class PropertyProver {
  public:
   struct Options {
     /// Longest path searched for a counterexample or witness, in steps.
-    int max_depth = 12;
+    int max_depth = 10;
     /// Largest k tried for k-induction.
     int max_induction = 2;
     double robust_margin = 1e-3;
     /// Per SMT query; a query that times out makes its property `unknown`.
-    unsigned timeout_ms = 60000;
+    unsigned timeout_ms = 10000;
+    /// Wall-clock budget of the search for counterexamples and witnesses (step 2) per
+    /// automaton; when it runs out, undecided properties are `unknown`.
+    double search_seconds = 30.0;
     int max_product_modes = 2000;
   };
 

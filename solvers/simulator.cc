@@ -745,8 +745,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   // Consecutive passes of the loop that neither advanced time nor jumped. A few are normal (a
   // root at the segment start, then a stop time there); more mean that the loop is stuck.
   constexpr int kMaxStalledPasses = 100;
-  // Relative length (in units of roundoff of the time) below which a segment after a restart is
-  // not given to CVODE (see its use).
+  // A segment after a restart shorter than this times |t| is not given to CVODE (see its use).
   constexpr double kShortGap = 100 * std::numeric_limits<double>::epsilon();
   int stalled = 0;
 

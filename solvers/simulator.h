@@ -54,8 +54,9 @@ enum class SimulationStatus {
   kZeno,
   /// The state reached a mode invariant's boundary, moving out, with no transition to take.
   kInvariantViolated,
-  /// CVODE failed, or its steps collapsed (more than CvodeIntegrator::Options::max_steps steps
-  /// towards one stop time); see message.
+  /// CVODE failed (message quotes what it said), or its steps collapsed (more than
+  /// CvodeIntegrator::Options::max_steps steps towards one stop time), or the run stopped making
+  /// progress (many passes at one instant without a jump: "no progress at t = ..."); see message.
   kSolverFailure,
   /// More than SimulationOptions::max_events events.
   kEventLimit,
@@ -153,6 +154,17 @@ struct SimulationResult {
 /// integration error). The event rules above apply unchanged; a root function that starts on its
 /// boundary and moves on sends that segment to the solver path, and an invariant boundary reached
 /// exactly at an input breakpoint is decided by the next segment (the input changes there).
+/// The state at a crossing is rounded, so a root function may be left a hair before its boundary
+/// and its next crossing time round to the current time: a root function reported at an instant
+/// at which nothing fired is not reported again at that instant (until a jump or an input jump
+/// there).
+///
+/// Rounding guards. A stop time within about 100 ulps of the time at which CVODE would be
+/// restarted (a jump one ulp before a sample time) is reached on the tangent instead: CVODE cannot
+/// start a step that short, and locates roots only to about that precision itself; root functions
+/// that cross on it cross at the stop time. The main loop never spins: more than a hundred passes
+/// at one instant without a jump (CVODE steps that continue without a restart aside, which its
+/// max_steps bounds) end the run with kSolverFailure. CVODE never prints (see CvodeIntegrator).
 class Simulator {
  public:
   /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument

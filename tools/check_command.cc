@@ -1,6 +1,7 @@
 #include "tools/check_command.h"
 
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -153,6 +154,9 @@ int RunCheck(const CheckArgs& args) {
     throw std::invalid_argument("--induction must be in [1, 100]");
   }
   if (args.runs < 1) throw std::invalid_argument("--runs must be positive");
+  if (!(args.budget > 0) || !std::isfinite(args.budget)) {
+    throw std::invalid_argument("--budget must be a positive number of seconds");
+  }
   const auto start = std::chrono::steady_clock::now();
   const System system = ParseModelFile(args.model);
   const std::vector<Property> declared = DeclaredProperties(system);
@@ -178,6 +182,7 @@ int RunCheck(const CheckArgs& args) {
     PropertyProver::Options options;
     options.max_depth = args.depth;
     options.max_induction = args.induction;
+    options.search_seconds = args.budget;
     results = PropertyProver(options).Check(system, chosen);
   } else {
     PropertySampler::Options options;
@@ -191,6 +196,7 @@ int RunCheck(const CheckArgs& args) {
     PropertyProver::Options options;
     options.max_depth = args.depth;
     options.max_induction = args.induction;
+    options.search_seconds = args.budget;
     for (std::size_t c = 0; c < system.components().size(); ++c) {
       modes.push_back(PropertyProver(options).ReachableModes(system, static_cast<int>(c)));
     }

@@ -363,6 +363,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   check->add_option("--induction", check_args.induction, "prove: largest k of k-induction")
       ->capture_default_str();
+  check->add_option("--budget", check_args.budget,
+                    "prove: seconds for the counterexample and witness search per automaton")
+      ->capture_default_str();
   check->add_option("--runs", check_args.runs, "sample: random runs per property")
       ->capture_default_str();
   check->add_option("--seed", check_args.seed, "sample: random seed")->capture_default_str();

@@ -1,6 +1,7 @@
 // Tests of the CVODE RAII wrapper on its own (solvers/cvode_integrator.h): accuracy on x' = -x,
 // root location with crossing directions, restarts with another number of root functions,
-// interpolation inside the last step, and run-time failures reported as a status.
+// interpolation inside the last step, run-time failures reported as a status, and CVODE messages
+// kept for message() instead of printed.
 
 #include "solvers/cvode_integrator.h"
 
@@ -308,6 +309,37 @@ TEST(CvodeIntegratorTest, MaxStepBoundsTheInternalSteps) {
   EXPECT_LE(t - t_prev, 0.25 * (1 + 1e-12));
   EXPECT_GE(integrator.steps(), 40);
   EXPECT_NEAR(x[0], 10.0, 1e-10);
+}
+
+TEST(CvodeIntegratorTest, CvodeMessagesAreKeptNotPrinted) {
+  FunctionSystem clock([](double, const double*, double* dx) { dx[0] = 1.0; });
+  CvodeIntegrator integrator(&clock, 1, {});
+  double t = 0.0;
+  Eigen::VectorXd x;
+  ::testing::internal::CaptureStderr();
+  // A stop time one ulp after the restart time: CVODE cannot start (CV_TOO_CLOSE).
+  integrator.Restart(1.0, Vec({0.0}), {});
+  const CvodeIntegrator::Status status = integrator.Advance(std::nextafter(1.0, 2.0), &t, &x);
+  // Steps below the resolution of t (t + h = t warnings) as x' = x^2 blows up at t = 1.
+  FunctionSystem blow([](double, const double* y, double* dy) { dy[0] = y[0] * y[0]; });
+  CvodeIntegrator blow_up(&blow, 1, {});
+  blow_up.Restart(0.0, Vec({1.0}), {});
+  double tb = 0.0;
+  Eigen::VectorXd xb;
+  const CvodeIntegrator::Status blow_status = AdvanceUntil(blow_up, 2.0, &tb, &xb);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(status, CvodeIntegrator::Status::kFailure);
+  EXPECT_NE(integrator.message().find("CV_TOO_CLOSE"), std::string::npos) << integrator.message();
+  EXPECT_NE(integrator.message().find("tout too close to t0"), std::string::npos)
+      << integrator.message();
+  EXPECT_EQ(t, 1.0);  // where it stayed
+  EXPECT_EQ(blow_status, CvodeIntegrator::Status::kFailure);
+  EXPECT_FALSE(blow_up.message().empty());
+  // Still usable: a restart and a reachable stop time.
+  integrator.Restart(1.0, Vec({0.0}), {});
+  ASSERT_EQ(AdvanceUntil(integrator, 2.0, &t, &x), CvodeIntegrator::Status::kReachedTime)
+      << integrator.message();
+  EXPECT_NEAR(x[0], 1.0, 1e-12);
 }
 
 TEST(CvodeIntegratorTest, MovedIntegratorKeepsWorking) {

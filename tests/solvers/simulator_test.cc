@@ -10,9 +10,11 @@
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -1006,6 +1008,182 @@ automaton sliding {
   EXPECT_NEAR(r.samples.back().time, 0.5, 1e-6);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Rounding at stop times: the run must neither stall nor let CVODE fail (or print).
+
+// x enters mode b at t = 272 a hair (-2^-50) below the boundary of `leave`'s guard and rises at
+// 0.9: the crossing time 272 + 2^-50 / 0.9 rounds to 272 itself. Reported there, `leave` does
+// not fire (u = 1), and the same crossing must not be reported again and again at t = 272.
+std::string HairModel(const std::string& relation) {
+  return R"(
+automaton hair {
+  var x, c;
+  input u in [-1, 1];
+  mode a { c' = 1; }
+  mode b { x' = 0.9; c' = 1; }
+  mode d { c' = 1; }
+  transition enter: a -> b { guard c >= 272; }
+  transition leave: b -> d { guard x )" +
+         relation + R"( 0 and u < 0; }
+  init a { x = )" +
+         Number(-std::ldexp(1.0, -50)) +
+         R"(; c = 0; }
+  scenario { until 273; }
+}
+)";
+}
+
+TEST(SimulatorTest, CrossingThatRoundsToTheCurrentTimeIsReportedOnce) {
+  for (const std::string relation : {"==", ">=", ">"}) {
+    const Model m(HairModel(relation));
+    const SimulationResult r = m.Run({}, {m.Signal("u", InputSignal::Shape::kStep, {{0, 1}})});
+    ASSERT_EQ(r.status, SimulationStatus::kCompleted) << relation << "\n" << Describe(m, r);
+    ASSERT_EQ(Transitions(r), std::vector<std::string>{"enter"}) << relation;
+    EXPECT_EQ(r.events[0].time, 272.0);
+    EXPECT_EQ(r.steps, 0);  // exact segments throughout
+    EXPECT_EQ(r.samples.back().time, 273.0);
+    EXPECT_NEAR(r.samples.back().x[m.Var("x")], 0.9, 1e-12);
+    // An input jump at that instant re-examines the guard: it fires at t = 272.
+    const SimulationResult now =
+        m.Run({}, {m.Signal("u", InputSignal::Shape::kStep, {{0, 1}, {272, -1}})});
+    ASSERT_EQ(Transitions(now), (std::vector<std::string>{"enter", "leave"})) << relation << "\n"
+                                                                              << Describe(m, now);
+    EXPECT_EQ(now.events[1].time, 272.0) << relation;
+    // Later, the rising x satisfies the inequalities (not x == 0 any more).
+    const SimulationResult later =
+        m.Run({}, {m.Signal("u", InputSignal::Shape::kStep, {{0, 1}, {272.5, -1}})});
+    ASSERT_EQ(later.status, SimulationStatus::kCompleted) << Describe(m, later);
+    if (relation == "==") {
+      EXPECT_EQ(Transitions(later), std::vector<std::string>{"enter"});
+    } else {
+      ASSERT_EQ(Transitions(later), (std::vector<std::string>{"enter", "leave"})) << relation;
+      EXPECT_EQ(later.events[1].time, 272.5);
+    }
+  }
+}
+
+TEST(SimulatorTest, FingerWithSampleStopsInsideAnExactSegmentTerminates) {
+  // Regression: the sample at t = 200 splits the segment in which theta2 falls to 0 (t4 at
+  // t = 206); rounding leaves theta2 = -8.9e-16, and after t3 at t = 272 the crossing of t4's
+  // `theta2 == theta2_min` rounded to 272 itself: the run repeated that instant for ever.
+  const Model m(SpecText("finger"), SpecPath("finger"));
+  const std::vector<InputSignal> u = {
+      m.Signal("u", InputSignal::Shape::kStep, {{0, 1}, {162, -0.5}, {250, 1}})};
+  SimulationOptions o = Until(273.0);
+  const SimulationResult plain = m.Run(o, u);
+  o.sample_step = 50.0;
+  const SimulationResult r = m.Run(o, u);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << Describe(m, r);
+  ASSERT_EQ(plain.status, SimulationStatus::kCompleted) << Describe(m, plain);
+  // The same events and end state as without samples.
+  EXPECT_EQ(Transitions(r), Transitions(plain)) << Describe(m, r);
+  ASSERT_EQ(r.events.size(), plain.events.size());
+  for (size_t k = 0; k < r.events.size(); ++k) {
+    EXPECT_NEAR(r.events[k].time, plain.events[k].time, 1e-9) << "event " << k;
+  }
+  // Closing: theta3 to its lower limit (t = 110), theta1 to its upper limit (t = 140); opening
+  // at u = -1/2 from t = 162: theta2 back to 0 at t = 206; closing again from t = 250.
+  ASSERT_EQ(r.events.size(), 4u) << Describe(m, r);
+  const double times[] = {110.0, 140.0, 206.0, 272.0};
+  for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(r.events[k].time, times[k], 1e-9) << "event " << k;
+  const StateSample& end = r.samples.back();
+  EXPECT_EQ(end.time, 273.0);
+  EXPECT_EQ(m.sim.ModeLabel(end.modes), m.sim.ModeLabel(plain.samples.back().modes));
+  EXPECT_EQ(m.sim.ModeLabel(end.modes), "c000_l10n");
+  EXPECT_NEAR(end.x[m.Var("g")], 141.0, 1e-9);  // 162 - 88 / 2 + 23
+  EXPECT_NEAR(end.x[m.Var("theta1")], 70.0, 1e-9);
+  EXPECT_NEAR(end.x[m.Var("theta2")], 0.9, 1e-9);
+  EXPECT_NEAR(end.x[m.Var("theta3")], -55.0, 1e-9);
+  for (int i = 0; i < end.x.size(); ++i) {
+    EXPECT_NEAR(end.x[i], plain.samples.back().x[i], 1e-9) << m.sim.variable_names()[i];
+  }
+  size_t samples = 0;
+  for (const StateSample& s : r.samples) samples += s.kind == StateSample::Kind::kSample;
+  EXPECT_EQ(samples, 5u);  // 50, ..., 250
+  ExpectConsistent(m, r, u);
+}
+
+// A jump one ulp before a stop time (a sample, or an input breakpoint) into a mode that needs
+// CVODE, which cannot start a step that short (CV_TOO_CLOSE).
+std::string NearStopModel() {
+  const std::string before = Number(std::nextafter(1.0, 0.0));
+  return R"(
+automaton near_stop {
+  var x, y;
+  input u in [0, 1];
+  mode a { x' = 1; }
+  mode b { x' = 1; y' = u - y; }
+  mode c { x' = 1; y' = u - y; }
+  transition go: a -> b { guard x >= )" +
+         before + R"(; }
+  transition on: b -> c { guard x > )" +
+         before + R"(; }
+  init a { x = 0; y = 1; }
+  scenario { until 2; }
+}
+)";
+}
+
+TEST(SimulatorTest, JumpJustBeforeAStopTimeNeedsNoTooShortSolverStep) {
+  const Model m(NearStopModel());
+  struct Case {
+    const char* name;
+    double sample_step;
+    std::vector<std::pair<double, double>> u;
+  };
+  for (const Case& c :
+       {Case{"sample at 1", 1.0, {{0, 0}}}, Case{"breakpoint at 1", 0.0, {{0, 0}, {1, 1}}},
+        Case{"both", 0.5, {{0, 0}, {1, 1}}}}) {
+    SimulationOptions o;
+    o.sample_step = c.sample_step;
+    const std::vector<InputSignal> u = {m.Signal("u", InputSignal::Shape::kStep, c.u)};
+    ::testing::internal::CaptureStderr();
+    const SimulationResult r = m.Run(o, u);
+    const std::string printed = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(printed, "") << c.name;
+    ASSERT_EQ(r.status, SimulationStatus::kCompleted) << c.name << "\n" << Describe(m, r);
+    // go at 1 - 2^-53; the strict guard of `on`, on its boundary there, holds once x moves on:
+    // at the stop time 1.
+    ASSERT_EQ(Transitions(r), (std::vector<std::string>{"go", "on"})) << c.name;
+    EXPECT_EQ(r.events[0].time, std::nextafter(1.0, 0.0)) << c.name;
+    EXPECT_EQ(r.events[1].time, 1.0) << c.name;
+    // y' = u - y from y = 1 at t = 1: y(2) = u + (1 - u) / e.
+    const double u1 = c.u.back().second;
+    EXPECT_NEAR(r.samples.back().x[m.Var("y")], u1 + (1.0 - u1) * std::exp(-1.0), 1e-8) << c.name;
+    EXPECT_EQ(r.samples.back().time, 2.0);
+    ExpectConsistent(m, r, u);
+  }
+}
+
+TEST(SimulatorTest, FingerJumpJustBeforeASampleTimeIsNotASolverFailure) {
+  // Regression: link 2 reaches its limit at t = 211.49999999999997, one ulp before the sample
+  // at 211.5; phase 3 (CVODE) then failed with CV_TOO_CLOSE and printed "[CVODE ERROR] CVode
+  // tout too close to t0 to start integration." on stderr.
+  const Model m(WithParameter(SpecText("finger"), "gob1", "30"), SpecPath("finger"));
+  const std::vector<InputSignal> u = {
+      m.Signal("u", InputSignal::Shape::kStep, {{0, 1}, {105, 0.5}, {122, 0}, {195, 1}})};
+  SimulationOptions o = Until(274.0);
+  const SimulationResult plain = m.Run(o, u);
+  o.sample_step = 0.3;
+  ::testing::internal::CaptureStderr();
+  const SimulationResult r = m.Run(o, u);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << Describe(m, r);
+  ASSERT_EQ(plain.status, SimulationStatus::kCompleted) << Describe(m, plain);
+  EXPECT_EQ(Transitions(r), Transitions(plain)) << Describe(m, r);
+  ASSERT_EQ(r.events.size(), plain.events.size());
+  for (size_t k = 0; k < r.events.size(); ++k) {
+    EXPECT_NEAR(r.events[k].time, plain.events[k].time, 1e-6) << "event " << k;
+  }
+  EXPECT_EQ(r.samples.back().time, 274.0);
+  EXPECT_EQ(r.samples.back().modes, plain.samples.back().modes);
+  for (int i = 0; i < r.samples.back().x.size(); ++i) {
+    EXPECT_NEAR(r.samples.back().x[i], plain.samples.back().x[i], 1e-6)
+        << m.sim.variable_names()[i];
+  }
+  ExpectConsistent(m, r, u);
+}
+
 // Two components with a shared clock x and (when `share_label`) a shared label go.
 std::string SyncModel(bool share_label, const std::string& right_guard) {
   return R"(
@@ -1433,6 +1611,81 @@ RC_GTEST_PROP(SimulatorProperty, FingerRandomObjectsAndProfiles, ()) {
   o.until = close + hold + open + 10.0;
   o.sample_step = *rc::gen::element(0.0, 10.0);
   CheckProperties(m, o, {m.Signal("u", InputSignal::Shape::kStep, u)});
+}
+
+// Random piecewise-constant motor commands (a few pieces, each u in {-1, -1/2, 0, 1/2, 1}, with
+// integer or real durations, mostly kept inside the motor range so that the finger closes and
+// reopens) under several sample steps, in free space or against objects (phase 3 needs CVODE):
+// every run ends with a status (the loop never spins at one instant) after time advanced, prints
+// nothing, and is completed or stops at the motor's range (the finger's only invariants).
+RC_GTEST_PROP(SimulatorProperty, FingerRandomPiecewiseConstantInputsTerminate, ()) {
+  // Parsed once: object positions (gob1, gob2, gob3), 256 for none.
+  static const std::vector<std::array<double, 3>> kObjects = {
+      {256, 256, 256}, {30, 256, 256}, {256, 56, 182.5}, {171.97, 56, 182.58}, {256, 256, 120}};
+  static std::vector<std::unique_ptr<Model>> models;
+  if (models.empty()) {
+    for (const auto& objects : kObjects) {
+      std::string text = SpecText("finger");
+      for (int i = 0; i < 3; ++i) {
+        text = WithParameter(text, "gob" + std::to_string(i + 1), Number(objects[i]));
+      }
+      models.push_back(std::make_unique<Model>(text, SpecPath("finger")));
+    }
+  }
+  // Several profiles per case: the rounding coincidences this looks for are rare.
+  for (int profile = 0; profile < 4; ++profile) {
+    const size_t which = *rc::gen::inRange<size_t>(0, kObjects.size());
+    const Model& m = *models[which];
+    auto whole = [](int lo, int hi) {
+      return rc::gen::map(testing::GenInt(lo, hi), [](int v) { return static_cast<double>(v); });
+    };
+    const int pieces = *testing::GenInt(1, 5);
+    std::vector<std::pair<double, double>> u;
+    double t = 0.0, g = 0.0;  // g = integral of u, clamped to the motor range [0, 255]
+    for (int i = 0; i < pieces; ++i) {
+      const double v = *rc::gen::element(-1.0, -0.5, 0.0, 0.5, 1.0);
+      u.emplace_back(t, v);
+      double d = *rc::gen::oneOf(GenReal(0.5, 150.0), whole(1, 150), whole(1, 30));
+      if (*rc::gen::inRange(0, 5) > 0) {  // mostly stop at the end of the motor range
+        if (v > 0.0) d = std::max(0.5, std::min(d, (255.0 - g) / v));
+        if (v < 0.0) d = std::max(0.5, std::min(d, g / -v));
+      }
+      g = std::clamp(g + v * d, 0.0, 255.0);
+      t += d;
+    }
+    const double until = t + *rc::gen::oneOf(GenReal(0.0, 50.0), whole(1, 50));
+    const double random_step = *rc::gen::oneOf(
+        rc::gen::element(0.1, 0.3, 1.0 / 3.0, 7.0, 10.0, 25.0, 50.0), GenReal(0.5, 60.0));
+    RC_LOG() << "profile " << profile << ": objects " << which << ", until " << Number(until)
+             << ", u = step(";
+    for (const auto& [time, value] : u) RC_LOG() << Number(time) << ": " << Number(value) << ", ";
+    RC_LOG() << ")\n";
+    const std::vector<InputSignal> signals = {m.Signal("u", InputSignal::Shape::kStep, u)};
+    for (const double sample_step : {0.0, random_step, 0.1, 0.3, 1.0 / 3.0, 50.0}) {
+      SimulationOptions o;
+      o.until = until;
+      o.sample_step = sample_step;
+      ::testing::internal::CaptureStderr();
+      const SimulationResult r = m.Run(o, signals);
+      const std::string printed = ::testing::internal::GetCapturedStderr();
+      RC_LOG() << "sample step " << Number(sample_step) << ": " << Describe(m, r) << "\n";
+      RC_ASSERT(printed.empty());
+      RC_ASSERT(r.status == SimulationStatus::kCompleted ||
+                r.status == SimulationStatus::kInvariantViolated);
+      const StateSample& end = r.samples.back();
+      RC_ASSERT(end.kind == StateSample::Kind::kEnd);
+      RC_ASSERT(end.time > 0.0);
+      if (r.status == SimulationStatus::kCompleted) {
+        RC_ASSERT(end.time == until);
+      } else {
+        RC_ASSERT(r.message.find("'g >= 0'") != std::string::npos ||
+                  r.message.find("'g <= 255'") != std::string::npos);
+      }
+      for (size_t i = 1; i < r.samples.size(); ++i) {
+        RC_ASSERT(r.samples[i].time >= r.samples[i - 1].time);
+      }
+    }
+  }
 }
 
 }  // namespace
