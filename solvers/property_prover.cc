@@ -44,9 +44,10 @@ Predicate Remap(const Predicate& p, const std::function<Expression(const Express
 
 // A property to decide on one automaton (its own slots and mode names).
 struct Goal {
-  Property property;  // local
-  int result = -1;    // index into the results, -1 for a lemma only
-  Property original;  // as asked (System names), for the replay
+  Property property;      // local
+  int result = -1;        // index into the results, -1 for a lemma only
+  Property original;      // as asked (System names), for the replay
+  std::vector<int> also;  // further results asking the same question
 };
 
 struct Job {
@@ -81,10 +82,12 @@ void DebugPath(SmtEncoding& enc, const z3::model& model, int n) {
 
 // The solver for every query: Z3's nlsat (complete for polynomial real arithmetic, with Boolean
 // structure), which handles the separable (nonlinear) flows far better than the default core.
-z3::solver MakeSolver(z3::context& ctx, unsigned timeout_ms) {
+// Limits are Z3 resource units (`rlimit`), not seconds, so that verdicts do not depend on the
+// machine's load; about 2.5 million units per second on the development machine.
+z3::solver MakeSolver(z3::context& ctx, unsigned resource_limit) {
   z3::solver s = z3::tactic(ctx, "qfnra-nlsat").mk_solver();
   z3::params p(ctx);
-  p.set("timeout", timeout_ms);
+  p.set("rlimit", resource_limit);
   s.set(p);
   return s;
 }
@@ -125,11 +128,15 @@ class Engine {
 
 void Engine::Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace) {
   if (c.goal->result < 0) return;
-  CheckResult& r = results_[c.goal->result];
-  r.verdict = v;
-  r.reason = std::move(reason);
-  r.trace = std::move(trace);
-  r.seconds = Since(start_);
+  std::vector<int> targets = c.goal->also;
+  targets.insert(targets.begin(), c.goal->result);
+  for (int index : targets) {
+    CheckResult& r = results_[index];
+    r.verdict = v;
+    r.reason = reason;
+    r.trace = trace;
+    r.seconds = Since(start_);
+  }
 }
 
 bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth,
@@ -242,7 +249,7 @@ void Engine::Run(const Job& job) {
   z3::solver bmc(ctx);
   {
     z3::params p(ctx);
-    p.set("timeout", options_.timeout_ms);
+    p.set("rlimit", options_.resource_limit);
     bmc.set(p);
   }
   Add(bmc, enc, enc.Initial());
@@ -334,9 +341,9 @@ void Engine::Run(const Job& job) {
       changed = false;
       hypotheses.reset();
       for (int m = 0; m < a.num_modes(); ++m) {
-        auto check = [&](const std::vector<std::size_t>& goals, unsigned timeout_ms,
+        auto check = [&](const std::vector<std::size_t>& goals, unsigned resource_limit,
                          std::vector<std::size_t>& failed) {
-          z3::solver s = MakeSolver(ctx, timeout_ms);
+          z3::solver s = MakeSolver(ctx, resource_limit);
           if (!path_from[m]) {
             z3::expr e = ctx.bool_val(true);
             for (int i = 0; i <= k; ++i) e = e && enc.State(i);
@@ -384,7 +391,7 @@ void Engine::Run(const Job& job) {
         }
         if (goals.empty()) break;
         const auto t_mode = Clock::now();
-        z3::check_result r = check(goals, std::min(options_.timeout_ms, 500u), failed);
+        z3::check_result r = check(goals, options_.resource_limit / 25, failed);
         if (std::getenv("HYBRID_CHECK_TIMING")) {
           std::cerr << "k=" << k << " mode " << a.modes()[m].name << ": " << r << " "
                     << Since(t_mode) << " s\n";
@@ -394,7 +401,7 @@ void Engine::Run(const Job& job) {
           // Split per candidate with the full time budget.
           for (std::size_t j : goals) {
             std::vector<std::size_t> f;
-            const z3::check_result rj = check({j}, std::min(options_.timeout_ms, 3000u), f);
+            const z3::check_result rj = check({j}, options_.resource_limit, f);
             if (rj == z3::unknown) f.push_back(j);
             for (std::size_t x : f) failed.push_back(x);
           }
@@ -422,25 +429,40 @@ void Engine::Run(const Job& job) {
   }
 
   // 3. Counterexamples and witnesses for what is still open, up to max_depth steps.
-  // Nominal parameters to full depth first (cheap), then all parameter values within the
-  // budget (the search space grows fast with the depth).
+  // Search order: short paths with nominal and with free parameters; then longer paths with
+  // nominal parameters (cheap: fewer branches; at most 40% of the budget); then longer paths with
+  // every parameter value (the search space grows fast with the depth).
   const Clock::time_point bmc_start = Clock::now();
-  for (int pass = 0; pass < 2 && open(); ++pass) {
-    const bool pinned = pass == 0;
-    if (pinned && enc.uncertain().empty()) continue;
-    int searched = -1;
-    for (int n = 0; n <= options_.max_depth && open(); ++n) {
-      if (Since(bmc_start) > options_.search_seconds) {
+  const int shallow = std::min(options_.max_depth, 3);
+  struct Pass {
+    int from, to;
+    std::initializer_list<bool> pinned;
+    double budget_fraction;
+  };
+  const Pass passes[] = {{0, shallow, {true, false}, 1.0},
+                         {shallow + 1, options_.max_depth, {true}, 0.4},
+                         {shallow + 1, options_.max_depth, {false}, 1.0}};
+  int searched = -1;
+  for (const Pass& pass : passes) {
+    const bool pinned_only = pass.pinned.size() == 1 && *pass.pinned.begin();
+    if (pinned_only && enc.uncertain().empty()) continue;  // the next pass covers it
+    for (int n = pass.from; n <= pass.to && open(); ++n) {
+      if (Since(bmc_start) > options_.search_seconds * pass.budget_fraction) {
+        if (pass.budget_fraction < 1.0) break;  // on to the next pass
         bmc_complete = false;
-        budget_note = "the search budget of " + FormatNumber(options_.search_seconds) +
-                      " s ran out after paths of " + std::to_string(searched) + " steps" +
-                      (pinned ? " with nominal parameters" : "") + "; ";
+        budget_note =
+            "the search budget of " + FormatNumber(options_.search_seconds) + " s ran out" +
+            (searched >= 0 ? " after paths of " + std::to_string(searched) + " steps" : "") + "; ";
         break;
       }
-      if (pinned) search(n, false, {true});
-      else search(n, false, {false});
-      searched = n;
+      if (enc.uncertain().empty()) {
+        search(n, false, {false});
+      } else {
+        search(n, false, pass.pinned);
+      }
+      if (!pinned_only) searched = n;
     }
+    if (!budget_note.empty()) break;
   }
   for (Candidate& c : cands) {
     if (!c.decided && c.refuted) {
@@ -453,10 +475,10 @@ void Engine::Run(const Job& job) {
   // 4. Reach targets without a witness: unreachable if `not P` is inductive relative to the
   //    proved invariants (checked per mode, as above).
   for (Candidate& c : cands) {
-    if (c.decided || c.invariant || !bmc_complete) continue;
+    if (c.decided || c.invariant || !base_complete) continue;
     bool inductive = true;
     for (int m = 0; m < a.num_modes() && inductive; ++m) {
-      z3::solver s = MakeSolver(ctx, options_.timeout_ms);
+      z3::solver s = MakeSolver(ctx, options_.resource_limit);
       z3::expr e = enc.State(0) && enc.State(1) && enc.TransitionFrom(0, ModeId(m)) &&
                    !enc.Holds(c.bad, 0, 0.0) && enc.Holds(c.bad, 1, 0.0);
       for (const Candidate& lemma : cands) {
@@ -476,8 +498,8 @@ void Engine::Run(const Job& job) {
   for (Candidate& c : cands) {
     if (c.decided) continue;
     std::string why = !budget_note.empty() ? budget_note
-                      : bmc_complete     ? ""
-                                         : "an SMT query timed out; ";
+                      : bmc_complete       ? ""
+                                           : "an SMT query timed out; ";
     const std::string within =
         budget_note.empty() ? " within " + std::to_string(options_.max_depth) + " steps" : "";
     if (c.invariant) {
@@ -568,7 +590,16 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
             auto found = system.FindMode(m);
             return found ? comp.automaton.mode(found->second).name : m;
           });
-      jobs[c].goals.push_back({q, static_cast<int>(i), p});
+      bool same = false;
+      for (Goal& g : jobs[c].goals) {
+        if (g.property.kind == q.kind && g.property.predicate == q.predicate &&
+            g.property.horizon == q.horizon) {
+          g.also.push_back(static_cast<int>(i));
+          same = true;
+          break;
+        }
+      }
+      if (!same) jobs[c].goals.push_back({q, static_cast<int>(i), p, {}});
       continue;
     }
     if (!product) {
@@ -588,7 +619,7 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       results[i].reason = "`in MODE` atoms over several components are not supported";
       continue;
     }
-    product_job.goals.push_back({p, static_cast<int>(i), p});
+    product_job.goals.push_back({p, static_cast<int>(i), p, {}});
   }
   Engine engine(system, options_, start, results);
   for (std::size_t c = 0; c < components.size(); ++c) {
@@ -618,7 +649,7 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
             auto id = components[c].automaton.FindMode(m);
             return id ? system.QualifiedModeName(static_cast<int>(c), *id) : m;
           });
-      job.goals.push_back({lemma, -1, original});
+      job.goals.push_back({lemma, -1, original, {}});
     }
     // Instances of one automaton asked the same questions share the proof: only traces are
     // carried over (renamed) and replayed for this instance.
@@ -660,38 +691,41 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
     };
     for (std::size_t g = 0; g < job.goals.size(); ++g) {
-      const int src = jobs[same].goals[g].result, dst = job.goals[g].result;
-      if (dst < 0) continue;
-      if (src < 0) continue;  // (cannot happen: goals pair up in order)
-      CheckResult r = results[src];
-      r.property = results[dst].property;
-      r.kind = results[dst].kind;
-      if (r.trace) {
-        Trace t = *r.trace;
-        for (auto& [name, v] : t.parameters) name = rename(name);
-        for (auto& [name, v] : t.initial_values) name = rename(name);
-        for (InputSignal& in : t.inputs.inputs) {
-          const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
-          if (slot) in.slot = *slot;
+      const int src = jobs[same].goals[g].result;
+      if (src < 0 || job.goals[g].result < 0) continue;
+      std::vector<int> targets = job.goals[g].also;
+      targets.insert(targets.begin(), job.goals[g].result);
+      for (int dst : targets) {
+        CheckResult r = results[src];
+        r.property = results[dst].property;
+        r.kind = results[dst].kind;
+        if (r.trace) {
+          Trace t = *r.trace;
+          for (auto& [name, v] : t.parameters) name = rename(name);
+          for (auto& [name, v] : t.initial_values) name = rename(name);
+          for (InputSignal& in : t.inputs.inputs) {
+            const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
+            if (slot) in.slot = *slot;
+          }
+          bool ok = false;
+          try {
+            ok = ReplayTrace(system, job.goals[g].original, t);
+          } catch (const std::exception&) {
+          }
+          if (ok) {
+            r.trace = std::move(t);
+          } else {
+            r.trace.reset();
+            r.verdict = Verdict::kUnknown;
+            r.reason = "the trace found for instance " + components[same].instance +
+                       " does not replay for " + components[c].instance;
+          }
         }
-        bool ok = false;
-        try {
-          ok = ReplayTrace(system, job.goals[g].original, t);
-        } catch (const std::exception&) {
-        }
-        if (ok) {
-          r.trace = std::move(t);
-        } else {
-          r.trace.reset();
-          r.verdict = Verdict::kUnknown;
-          r.reason = "the trace found for instance " + components[same].instance +
-                     " does not replay for " + components[c].instance;
-        }
+        r.reason += " (the proof for instance " + components[same].instance +
+                    ", an instance of the same automaton)";
+        r.seconds = Since(start);
+        results[dst] = std::move(r);
       }
-      r.reason += " (the proof for instance " + components[same].instance +
-                  ", an instance of the same automaton)";
-      r.seconds = Since(start);
-      results[dst] = std::move(r);
     }
   }
   if (product && !product_job.goals.empty()) {
@@ -724,6 +758,50 @@ std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(con
     r.reason = results[m].reason;
     r.trace = results[m].trace;
     out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// Every property the model declares, over System slots: the system's own, then (for composed
+// systems) each component's, named INSTANCE.NAME.
+std::vector<Property> DeclaredProperties(const System& system) {
+  std::vector<Property> out(system.properties().begin(), system.properties().end());
+  for (std::size_t c = 0; c < system.components().size(); ++c) {
+    const Component& comp = system.components()[c];
+    if (comp.instance.empty()) continue;
+    for (const Property& p : comp.automaton.properties()) {
+      Property q = p;
+      q.name = comp.instance + "." + p.name;
+      std::function<Predicate(const Predicate&)> remap = [&](const Predicate& x) -> Predicate {
+        switch (x.kind()) {
+          case Predicate::Kind::kComparison: {
+            auto sub = [&](const Expression& e) {
+              return e.Substitute(
+                  [&](const std::string& name, int slot) -> std::optional<Expression> {
+                    return Expression::Symbol(name, comp.global_slot[slot]);
+                  });
+            };
+            const Comparison& k = x.comparison();
+            return Predicate::Compare({sub(k.lhs), k.relation, sub(k.rhs)});
+          }
+          case Predicate::Kind::kInMode: {
+            auto id = comp.automaton.FindMode(x.mode());
+            return Predicate::InMode(id ? system.QualifiedModeName(static_cast<int>(c), *id)
+                                        : x.mode());
+          }
+          case Predicate::Kind::kNot:
+            return Predicate::Not(remap(x.operands()[0]));
+          case Predicate::Kind::kAnd:
+            return Predicate::And(remap(x.operands()[0]), remap(x.operands()[1]));
+          case Predicate::Kind::kOr:
+            return Predicate::Or(remap(x.operands()[0]), remap(x.operands()[1]));
+          default:
+            return x;
+        }
+      };
+      q.predicate = remap(p.predicate);
+      out.push_back(std::move(q));
+    }
   }
   return out;
 }

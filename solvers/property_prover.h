@@ -11,6 +11,11 @@
 
 namespace hybrid {
 
+/// Every property `system` declares, over System slots: the system's own, then, for composed
+/// systems, each instantiated component's, named INSTANCE.NAME with `in` atoms qualified. What
+/// `hybrid check` checks by default.
+std::vector<Property> DeclaredProperties(const System& system);
+
 /// The `prove` method of `hybrid check`: bounded model checking and k-induction with the Z3 SMT
 /// solver over an encoding of the automaton (see SmtEncoding in smt_encoding.h for exactly what
 /// it covers), for every piecewise-constant input within the inputs' bounds and every value of
@@ -42,8 +47,10 @@ class PropertyProver {
     /// Largest k tried for k-induction.
     int max_induction = 2;
     double robust_margin = 1e-3;
-    /// Per SMT query; a query that times out makes its property `unknown`.
-    unsigned timeout_ms = 10000;
+    /// Per SMT query, in Z3 resource units (`rlimit`: deterministic, unlike a time limit; about
+    /// 2.5 million per second here). A query that runs out makes its property `unknown`
+    /// (an induction candidate that runs out is dropped).
+    unsigned resource_limit = 25'000'000;
     /// Wall-clock budget of the search for counterexamples and witnesses (step 2) per
     /// automaton; when it runs out, undecided properties are `unknown`.
     double search_seconds = 30.0;

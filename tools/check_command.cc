@@ -20,48 +20,25 @@ using json = nlohmann::ordered_json;
 constexpr int kExitViolated = 6;
 constexpr int kExitUnknown = 7;
 
-// Every property the model declares, over System slots: the system's own, then (for composed
-// systems) each component's, named INSTANCE.NAME.
-std::vector<Property> DeclaredProperties(const System& system) {
-  std::vector<Property> out(system.properties().begin(), system.properties().end());
-  for (std::size_t c = 0; c < system.components().size(); ++c) {
-    const Component& comp = system.components()[c];
-    if (comp.instance.empty()) continue;
-    for (const Property& p : comp.automaton.properties()) {
-      Property q = p;
-      q.name = comp.instance + "." + p.name;
-      std::function<Predicate(const Predicate&)> remap = [&](const Predicate& x) -> Predicate {
-        switch (x.kind()) {
-          case Predicate::Kind::kComparison: {
-            auto sub = [&](const Expression& e) {
-              return e.Substitute(
-                  [&](const std::string& name, int slot) -> std::optional<Expression> {
-                    return Expression::Symbol(name, comp.global_slot[slot]);
-                  });
-            };
-            const Comparison& k = x.comparison();
-            return Predicate::Compare({sub(k.lhs), k.relation, sub(k.rhs)});
-          }
-          case Predicate::Kind::kInMode: {
-            auto id = comp.automaton.FindMode(x.mode());
-            return Predicate::InMode(id ? system.QualifiedModeName(static_cast<int>(c), *id)
-                                        : x.mode());
-          }
-          case Predicate::Kind::kNot:
-            return Predicate::Not(remap(x.operands()[0]));
-          case Predicate::Kind::kAnd:
-            return Predicate::And(remap(x.operands()[0]), remap(x.operands()[1]));
-          case Predicate::Kind::kOr:
-            return Predicate::Or(remap(x.operands()[0]), remap(x.operands()[1]));
-          default:
-            return x;
-        }
-      };
-      q.predicate = remap(p.predicate);
-      out.push_back(std::move(q));
-    }
+// Whether event `e` of the trace's run happened before its reported state: earlier, or at the
+// same instant up to the jump that produced the state (samples and events are recorded in order).
+bool EventBeforeState(const Trace& t, const EventRecord& e) {
+  if (t.state_index < 0) return true;
+  const StateSample& s = t.run.samples[t.state_index];
+  if (e.time < s.time) return true;
+  if (e.time > s.time) return false;
+  // Same instant: count the after-event samples at this time up to the state.
+  int after_events = 0;
+  for (int i = 0; i <= t.state_index; ++i) {
+    const StateSample& x = t.run.samples[i];
+    if (x.time == s.time && x.kind == StateSample::Kind::kAfterEvent) ++after_events;
   }
-  return out;
+  int earlier = 0;  // events at this instant before e
+  for (const EventRecord& o : t.run.events) {
+    if (&o == &e) break;
+    if (o.time == s.time) ++earlier;
+  }
+  return earlier < after_events;
 }
 
 json StateJson(const Simulator& sim, const Eigen::VectorXd& x) {
@@ -82,10 +59,8 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
     inputs[system.symbols()[s.slot].name] = pts;
   }
   json events = json::array();
-  const double until_state =
-      t.state_index >= 0 ? t.run.samples[t.state_index].time : t.inputs.until;
   for (const EventRecord& e : t.run.events) {
-    if (e.time > until_state) break;
+    if (!EventBeforeState(t, e)) break;
     std::string names;
     for (const auto& n : e.transitions) names += (names.empty() ? "" : "+") + n;
     events.push_back({{"time", e.time},
@@ -122,10 +97,8 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
     }
     out << ") until " << t.inputs.until << "\n";
   }
-  const double until_state =
-      t.state_index >= 0 ? t.run.samples[t.state_index].time : t.inputs.until;
   for (const EventRecord& e : t.run.events) {
-    if (e.time > until_state) break;
+    if (!EventBeforeState(t, e)) break;
     out << "    t = " << e.time << "  ";
     for (std::size_t i = 0; i < e.transitions.size(); ++i)
       out << (i ? "+" : "") << e.transitions[i];
@@ -247,13 +220,14 @@ int RunCheck(const CheckArgs& args) {
       }
       out["modes"] = ms;
     }
-    WriteOutput("-", out.dump(2) + "\n");
+    // The model path may be any bytes: replace invalid UTF-8 rather than throw.
+    WriteOutput("-", out.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
     return code;
   }
   std::ostringstream out;
   out.precision(4);
-  out << args.model << ": " << results.size() << " properties, method " << args.method << ", "
-      << seconds << " s\n";
+  out << args.model << ": " << results.size() << (results.size() == 1 ? " property" : " properties")
+      << ", method " << args.method << ", " << seconds << " s\n";
   for (const CheckResult& r : results) {
     out << "  " << VerdictName(r.verdict) << "  " << r.property << " (" << KindKeyword(r.kind)
         << ", " << r.seconds << " s): " << r.reason << "\n";

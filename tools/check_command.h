@@ -13,8 +13,8 @@ struct CheckArgs {
   std::string method = "prove";         ///< prove or sample
   bool json = false;
   bool modes = false;      ///< also report which modes (discrete states) are reachable
-  int depth = 10;                       ///< prove: longest counterexample searched, in steps
-  double budget = 30.0;                 ///< prove: seconds for the counterexample search
+  int depth = 10;          ///< prove: longest counterexample searched, in steps
+  double budget = 30.0;    ///< prove: seconds for the counterexample search
   int induction = 2;       ///< prove: largest k of k-induction
   int runs = 200;          ///< sample: random runs per property
   std::uint64_t seed = 1;  ///< sample: seed
@@ -23,8 +23,8 @@ struct CheckArgs {
 /// Runs `hybrid check`; returns the exit code: 0 when no property is violated or unknown, 6 when
 /// some property is violated (or a reach target is unreachable), 7 when none is violated but
 /// some verdict is unknown. Throws hybrid::ParseError for a bad model, std::invalid_argument for
-/// bad options (an unknown property name, a method other than prove/sample, a non-positive
-/// depth), and OutputError when standard output cannot be written.
+/// bad options (an unknown property name, a method other than prove/sample, a depth outside
+/// [0, 1000], a non-positive budget), and OutputError when standard output cannot be written.
 int RunCheck(const CheckArgs& args);
 
 }  // namespace hybrid::cli

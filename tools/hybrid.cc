@@ -295,7 +295,8 @@ int main(int argc, char** argv) {
   CLI::App app{"hybrid: declare, inspect and draw hybrid automata (see docs/cli.md)", "hybrid"};
   app.footer(
       "Exit codes: 0 success; 1 invalid model (FILE:LINE:COL: message on stderr); 2 usage error; "
-      "3 cannot write output.");
+      "3 cannot write output; 4 internal error; 5 simulation stopped early; 6 check: a property "
+      "violated; 7 check: a verdict unknown.");
   app.require_subcommand(1);
   app.set_version_flag("--version", "hybrid 0.1.0");
 
@@ -363,8 +364,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   check->add_option("--induction", check_args.induction, "prove: largest k of k-induction")
       ->capture_default_str();
-  check->add_option("--budget", check_args.budget,
-                    "prove: seconds for the counterexample and witness search per automaton")
+  check
+      ->add_option("--budget", check_args.budget,
+                   "prove: seconds for the counterexample and witness search per automaton")
       ->capture_default_str();
   check->add_option("--runs", check_args.runs, "sample: random runs per property")
       ->capture_default_str();

@@ -43,3 +43,15 @@ done
 "$hybrid" hand --object circle:0,0.06,0.02 --simulate --json > "$out/hand_basic.json"
 "$hybrid" hand --object circle:0,0.06,0.02 --mode pinch --draw "$out/hand_pinch.svg"
 echo "wrote out/finger_*.svg, out/finger_object.json, out/hand_basic.svg, out/hand_basic.json, out/hand_pinch.svg"
+echo
+
+# Verification (docs/verification.md): every invariant of the finger and of the hand proved for all
+# inputs and object positions (exit 0 only if every verdict is proved or reachable); the finger's
+# reachable discrete states.
+echo "=== check ==="
+"$hybrid" check spec/finger.ha
+"$hybrid" check spec/finger.ha --json > "$out/check_finger.json"
+"$hybrid" check spec/hand.ha --json > "$out/check_hand.json"
+grep -c '"verdict": "proved"' "$out/check_hand.json" | sed 's/^/hand: proved properties: /'
+"$hybrid" check spec/finger.ha --modes --json > "$out/check_finger_modes.json"
+echo "wrote out/check_finger.json, out/check_hand.json, out/check_finger_modes.json"

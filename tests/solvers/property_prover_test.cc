@@ -1,0 +1,361 @@
+// Tests of the SMT prover (solvers/property_prover.h) on small models: invariants kept by an
+// urgent transition are proved and broken ones violated with a trace the simulator replays;
+// reachable targets get replayed witnesses and impossible ones are proved unreachable; uncertain
+// parameters are covered over their ranges; instances of one automaton share the proof; misuse
+// throws; and the finger model (spec/finger.ha): its invariants are proved and its modes'
+// reachability is decided with witnesses.
+
+#include "solvers/property_prover.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <iostream>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "automaton/parser.h"
+#include "solvers/simulator.h"
+#include "solvers/trace.h"
+#include "tests/test_utilities/models.h"
+
+namespace hybrid {
+namespace {
+
+using testing::ReplaceOnce;
+
+// x' = u with u in [0, 1] from x = 0; an urgent transition stops x at 5.
+constexpr std::string_view kLimitedModel = R"(
+automaton limited {
+  var x;
+  input u in [0, 1];
+  mode run { x' = u; }
+  mode stop { }
+  transition limit: run -> stop { guard x >= 5; }
+  init run { x = 0; }
+  scenario { until 10; }
+  property below_5: always x <= 5;
+  property never_above_5: never x > 5;
+  property gets_to_3: reach x >= 3;
+  property stops: reach in stop;
+  property negative: reach x < -1;
+}
+)";
+
+// The limit at an uncertain c in [0, 10] (nominal 5).
+constexpr std::string_view kUncertainModel = R"(
+automaton bounded {
+  param c = 5 in [0, 10];
+  var x;
+  input u in [0, 1];
+  mode run { x' = u; }
+  mode stop { }
+  transition limit: run -> stop { guard x >= c; }
+  init run { x = 0; }
+  scenario { until 20; }
+  property below_10: always x <= 10;
+  property below_c: always x <= c;
+  property below_7: always x <= 7;
+}
+)";
+
+// Two instances of one automaton.
+constexpr std::string_view kPairModel = R"(
+automaton tank {
+  var x;
+  input u in [0, 1];
+  mode run { x' = u; }
+  mode stop { }
+  transition limit: run -> stop { guard x >= 5; }
+  init run { x = 0; }
+}
+system pair {
+  instance A = tank;
+  instance B = tank;
+  property a_below_5: always A.x <= 5;
+  property a_below_3: always A.x <= 3;
+  property b_below_5: always B.x <= 5;
+  property b_below_3: always B.x <= 3;
+  scenario { until 10; }
+}
+)";
+
+System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
+
+const Property& Named(const System& system, const std::string& name) {
+  for (const Property& p : system.properties()) {
+    if (p.name == name) return p;
+  }
+  throw std::invalid_argument("no property " + name);
+}
+
+PropertyProver::Options Small() {
+  PropertyProver::Options o;
+  o.max_depth = 4;
+  o.max_induction = 2;
+  o.timeout_ms = 2000;
+  o.search_seconds = 5.0;
+  return o;
+}
+
+// Checks one named property of `system`.
+CheckResult CheckOne(const System& system, const std::string& name,
+                     PropertyProver::Options options = Small()) {
+  const std::vector<Property> ps = {Named(system, name)};
+  const std::vector<CheckResult> results = PropertyProver(options).Check(system, ps);
+  EXPECT_EQ(results.size(), 1u);
+  return results.at(0);
+}
+
+// The value of variable `name` at the trace's target state.
+double AtTarget(const System& system, const Trace& trace, const std::string& name) {
+  const Simulator sim(system);
+  const auto& names = sim.variable_names();
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw std::invalid_argument("no variable " + name);
+  return trace.run.samples.at(trace.state_index).x[static_cast<int>(it - names.begin())];
+}
+
+// Replays a copy of the result's trace independently: it must hit, at a valid state. Returns the
+// replayed copy.
+Trace Replayed(const System& system, const Property& property, const CheckResult& result) {
+  EXPECT_TRUE(result.trace.has_value());
+  if (!result.trace) return {};
+  Trace copy = *result.trace;
+  copy.run = {};
+  copy.state_index = -1;
+  EXPECT_TRUE(ReplayTrace(system, property, copy));
+  EXPECT_GE(copy.state_index, 0);
+  EXPECT_LT(copy.state_index, static_cast<int>(copy.run.samples.size()));
+  return copy;
+}
+
+std::string ParameterNames(const Trace& t) {
+  std::string out;
+  for (const auto& [name, v] : t.parameters) out += name + " ";
+  return out;
+}
+
+TEST(PropertyProver, UrgentLimitProvesTheBound) {
+  const System system = Parse(kLimitedModel);
+  for (const char* name : {"below_5", "never_above_5"}) {
+    const CheckResult r = CheckOne(system, name);
+    EXPECT_EQ(r.verdict, Verdict::kProved) << name << ": " << r.reason;
+    EXPECT_EQ(r.property, name);
+    EXPECT_EQ(r.method, "prove");
+    EXPECT_FALSE(r.trace.has_value());
+    EXPECT_NE(r.reason.find("induction"), std::string::npos) << r.reason;
+  }
+}
+
+TEST(PropertyProver, WithoutTheLimitTheBoundIsViolated) {
+  const System system = Parse(ReplaceOnce(std::string(kLimitedModel),
+                                          "  transition limit: run -> stop { guard x >= 5; }\n",
+                                          ""));
+  const Property& below_5 = Named(system, "below_5");
+  const CheckResult r = CheckOne(system, "below_5");
+  ASSERT_EQ(r.verdict, Verdict::kViolated) << r.reason;
+  EXPECT_EQ(r.kind, Property::Kind::kAlways);
+  ASSERT_TRUE(r.trace.has_value());
+  EXPECT_GT(AtTarget(system, *r.trace, "x"), 5.0);
+  const Trace copy = Replayed(system, below_5, r);
+  EXPECT_GT(AtTarget(system, copy, "x"), 5.0);
+  EXPECT_EQ(copy.state_index, r.trace->state_index);
+  // The trace's input stays within its bounds [0, 1].
+  ASSERT_EQ(copy.inputs.inputs.size(), 1u);
+  for (const auto& [t, v] : copy.inputs.inputs[0].points) {
+    EXPECT_GE(v, 0.0);
+    EXPECT_LE(v, 1.0);
+  }
+}
+
+TEST(PropertyProver, ReachableTargetHasAReplayedWitness) {
+  const System system = Parse(kLimitedModel);
+  const CheckResult r = CheckOne(system, "gets_to_3");
+  ASSERT_EQ(r.verdict, Verdict::kReachable) << r.reason;
+  const Trace copy = Replayed(system, Named(system, "gets_to_3"), r);
+  EXPECT_GE(AtTarget(system, copy, "x"), 3.0 - 1e-6);
+
+  const CheckResult stops = CheckOne(system, "stops");
+  ASSERT_EQ(stops.verdict, Verdict::kReachable) << stops.reason;
+  const Trace in_stop = Replayed(system, Named(system, "stops"), stops);
+  EXPECT_EQ(in_stop.run.samples[in_stop.state_index].modes.at(0),
+            system.components()[0].automaton.FindMode("stop")->value());
+}
+
+TEST(PropertyProver, ImpossibleTargetIsUnreachable) {
+  const System system = Parse(kLimitedModel);
+  const CheckResult r = CheckOne(system, "negative");
+  EXPECT_EQ(r.verdict, Verdict::kUnreachable) << r.reason;
+  EXPECT_FALSE(r.trace.has_value());
+}
+
+TEST(PropertyProver, ResultsComeInOrder) {
+  const System system = Parse(kLimitedModel);
+  const std::vector<CheckResult> results =
+      PropertyProver(Small()).Check(system, system.properties());
+  ASSERT_EQ(results.size(), system.properties().size());
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].property, system.properties()[i].name);
+    EXPECT_EQ(results[i].kind, system.properties()[i].kind);
+  }
+  EXPECT_EQ(results[0].verdict, Verdict::kProved);
+  EXPECT_EQ(results[1].verdict, Verdict::kProved);
+  EXPECT_EQ(results[2].verdict, Verdict::kReachable);
+  EXPECT_EQ(results[3].verdict, Verdict::kReachable);
+  EXPECT_EQ(results[4].verdict, Verdict::kUnreachable);
+  EXPECT_TRUE(PropertyProver(Small()).Check(system, std::vector<Property>{}).empty());
+}
+
+TEST(PropertyProver, UncertainParameterProvedOverItsRange) {
+  const System system = Parse(kUncertainModel);
+  for (const char* name : {"below_10", "below_c"}) {
+    const CheckResult r = CheckOne(system, name);
+    EXPECT_EQ(r.verdict, Verdict::kProved) << name << ": " << r.reason;
+  }
+}
+
+TEST(PropertyProver, UncertainParameterViolationReportsItsValue) {
+  const System system = Parse(kUncertainModel);
+  // Nominal c = 5 keeps x <= 7; values of c above 7 do not.
+  const CheckResult r = CheckOne(system, "below_7");
+  ASSERT_EQ(r.verdict, Verdict::kViolated) << r.reason;
+  ASSERT_TRUE(r.trace.has_value());
+  const auto c = std::find_if(r.trace->parameters.begin(), r.trace->parameters.end(),
+                              [](const auto& p) { return p.first == "c"; });
+  ASSERT_NE(c, r.trace->parameters.end()) << ParameterNames(*r.trace);
+  EXPECT_GT(c->second, 7.0);
+  EXPECT_LE(c->second, 10.0);
+  const Trace copy = Replayed(system, Named(system, "below_7"), r);
+  EXPECT_GT(AtTarget(system, copy, "x"), 7.0);
+  // With the nominal c the same inputs do not violate it.
+  Trace nominal = *r.trace;
+  nominal.parameters.clear();
+  EXPECT_FALSE(ReplayTrace(system, Named(system, "below_7"), nominal));
+}
+
+TEST(PropertyProver, SecondInstanceSharesTheProof) {
+  const System system = Parse(kPairModel);
+  const std::vector<CheckResult> results =
+      PropertyProver(Small()).Check(system, system.properties());
+  ASSERT_EQ(results.size(), 4u);
+  EXPECT_EQ(results[0].verdict, Verdict::kProved) << results[0].reason;
+  EXPECT_EQ(results[1].verdict, Verdict::kViolated) << results[1].reason;
+  EXPECT_EQ(results[2].verdict, Verdict::kProved) << results[2].reason;
+  EXPECT_EQ(results[3].verdict, Verdict::kViolated) << results[3].reason;
+  for (int i : {2, 3}) {
+    EXPECT_NE(results[i].reason.find("(the proof for instance A"), std::string::npos)
+        << results[i].reason;
+  }
+  for (int i : {0, 1}) {
+    EXPECT_EQ(results[i].reason.find("(the proof for instance"), std::string::npos)
+        << results[i].reason;
+  }
+  EXPECT_EQ(results[2].property, "b_below_5");
+  EXPECT_EQ(results[3].property, "b_below_3");
+  // B's trace drives B's input and breaks B's bound.
+  ASSERT_TRUE(results[3].trace.has_value());
+  const int b_u = system.symbols().Find("B.u").value();
+  ASSERT_FALSE(results[3].trace->inputs.inputs.empty());
+  for (const InputSignal& s : results[3].trace->inputs.inputs) EXPECT_EQ(s.slot, b_u);
+  for (const auto& [name, v] : results[3].trace->initial_values) EXPECT_EQ(name.rfind("B.", 0), 0u);
+  const Trace copy = Replayed(system, Named(system, "b_below_3"), results[3]);
+  EXPECT_GT(AtTarget(system, copy, "B.x"), 3.0);
+  EXPECT_DOUBLE_EQ(AtTarget(system, copy, "A.x"), 0.0);
+  // A's own trace breaks A's bound.
+  const Trace a_copy = Replayed(system, Named(system, "a_below_3"), results[1]);
+  EXPECT_GT(AtTarget(system, a_copy, "A.x"), 3.0);
+}
+
+TEST(PropertyProver, PropertyReadingAnInputThrows) {
+  const System system = Parse(kLimitedModel);
+  // The parser rejects such properties; a hand-built one is misuse.
+  const int u = system.symbols().Find("u").value();
+  const Property bad{"reads_u", Property::Kind::kAlways,
+                     Predicate::Compare({Expression::Symbol("u", u), Relation::kLessEqual,
+                                         Expression::Constant(1.0)}),
+                     std::nullopt};
+  try {
+    PropertyProver(Small()).Check(system, std::vector<Property>{bad});
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("PropertyProver"), std::string::npos) << e.what();
+  }
+}
+
+System Finger() { return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha"); }
+
+TEST(PropertyProverFinger, EveryInvariantIsProved) {
+  const System finger = Finger();
+  std::vector<Property> invariants;
+  for (const Property& p : finger.properties()) {
+    if (p.kind != Property::Kind::kReach) invariants.push_back(p);
+  }
+  ASSERT_EQ(invariants.size(), 12u);
+  const std::vector<CheckResult> results = PropertyProver().Check(finger, invariants);
+  ASSERT_EQ(results.size(), invariants.size());
+  for (const CheckResult& r : results) {
+    EXPECT_EQ(r.verdict, Verdict::kProved) << r.property << ": " << r.reason;
+  }
+}
+
+TEST(PropertyProverFinger, ReachableModes) {
+  const System finger = Finger();
+  PropertyProver::Options options;
+  options.search_seconds = std::atof(std::getenv("SS"));
+  options.timeout_ms = std::atoi(std::getenv("TM"));
+  options.max_depth = std::atoi(std::getenv("MD"));
+  const std::vector<PropertyProver::ModeReachability> modes =
+      PropertyProver(options).ReachableModes(finger, 0);
+  const Automaton& a = finger.components()[0].automaton;
+  ASSERT_EQ(static_cast<int>(modes.size()), a.num_modes());
+  std::set<std::string> reachable;
+  for (int m = 0; m < a.num_modes(); ++m) {
+    const auto& r = modes[m];
+    std::cerr << "DBG " << r.mode << " " << VerdictName(r.verdict) << " " << r.reason << "\n";
+    EXPECT_EQ(r.mode, a.mode(ModeId(m)).name);
+    EXPECT_EQ(r.discrete.size(), 6u);
+    EXPECT_TRUE(r.verdict == Verdict::kReachable || r.verdict == Verdict::kUnreachable ||
+                r.verdict == Verdict::kUnknown)
+        << r.mode << ": " << VerdictName(r.verdict);
+    if (r.verdict != Verdict::kReachable) {
+      EXPECT_FALSE(r.trace.has_value()) << r.mode;
+      continue;
+    }
+    reachable.insert(r.mode);
+    // The witness ends in that mode, and replays.
+    ASSERT_TRUE(r.trace.has_value()) << r.mode;
+    EXPECT_EQ(r.trace->run.samples.at(r.trace->state_index).modes.at(0), m) << r.mode;
+    Trace copy = *r.trace;
+    const Property in_mode{"reach " + r.mode, Property::Kind::kReach, Predicate::InMode(r.mode),
+                           std::nullopt};
+    EXPECT_TRUE(ReplayTrace(finger, in_mode, copy)) << r.mode;
+    EXPECT_EQ(copy.run.samples.at(copy.state_index).modes.at(0), m) << r.mode;
+  }
+  // Closing with no object drives link 1, then link 2 to their limits.
+  EXPECT_TRUE(reachable.contains("c000_l000"));
+  EXPECT_TRUE(reachable.contains("c000_l100"));
+  EXPECT_TRUE(reachable.contains("c000_l110"));
+  int both_limits = 0;
+  for (const auto& r : modes) {
+    int l1 = -2, l2 = -2;
+    for (const auto& [name, v] : r.discrete) {
+      if (name == "l1") l1 = v;
+      if (name == "l2") l2 = v;
+    }
+    if (l1 == 1 && l2 == 1 && r.verdict == Verdict::kReachable) ++both_limits;
+  }
+  EXPECT_GE(both_limits, 1);
+  // The report: no mode with c_i = l_i = 1 exists, so none is reachable.
+  for (const auto& r : modes) {
+    EXPECT_FALSE(r.mode[1] == '1' && r.mode[5] == '1') << r.mode;
+  }
+}
+
+}  // namespace
+}  // namespace hybrid
