@@ -88,6 +88,7 @@ z3::solver MakeSolver(z3::context& ctx, unsigned resource_limit) {
   z3::solver s = z3::tactic(ctx, "qfnra-nlsat").mk_solver();
   z3::params p(ctx);
   p.set("rlimit", resource_limit);
+  p.set("timeout", 10000u);  // a safety net: the resource limit is the intended bound
   s.set(p);
   return s;
 }
@@ -250,6 +251,7 @@ void Engine::Run(const Job& job) {
   {
     z3::params p(ctx);
     p.set("rlimit", options_.resource_limit);
+    p.set("timeout", 10000u);  // a safety net: not every engine honours the resource limit
     bmc.set(p);
   }
   Add(bmc, enc, enc.Initial());
@@ -257,6 +259,9 @@ void Engine::Run(const Job& job) {
   bool bmc_complete = true;
   std::string budget_note;
   int bmc_depth = -1;  // paths up to this length are in `bmc`
+  // The budget of the deep search (step 3): checked before every query.
+  std::optional<Clock::time_point> deep_start;
+  auto over_budget = [&]() { return deep_start && Since(*deep_start) > options_.search_seconds; };
   auto search = [&](int n, bool invariants_only, std::initializer_list<bool> passes) {
     while (bmc_depth < n) {
       ++bmc_depth;
@@ -274,6 +279,8 @@ void Engine::Run(const Job& job) {
       z3::expr_vector any(ctx);
       for (Candidate& c : cands) {
         if (!pending(c) || (invariants_only && !c.invariant)) continue;
+        // Lemmas need no counterexample of their own beyond the base case.
+        if (deep_start && c.goal->result < 0) continue;
         any.push_back(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, 0.0)
                                   : enc.Holds(c.bad, n, 0.0));
       }
@@ -292,8 +299,9 @@ void Engine::Run(const Job& job) {
       if (r == z3::unsat) continue;
       for (Candidate& c : cands) {
         if (!pending(c) || (invariants_only && !c.invariant)) continue;
+        if (deep_start && c.goal->result < 0) continue;
         for (double margin : {options_.robust_margin, 0.0}) {
-          if (!pending(c) || (!c.invariant && margin > 0)) continue;
+          if (!pending(c) || (!c.invariant && margin > 0) || over_budget()) continue;
           bmc.push();
           Add(bmc, enc,
               c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
@@ -401,7 +409,7 @@ void Engine::Run(const Job& job) {
           // Split per candidate with the full time budget.
           for (std::size_t j : goals) {
             std::vector<std::size_t> f;
-            const z3::check_result rj = check({j}, options_.resource_limit, f);
+            const z3::check_result rj = check({j}, options_.resource_limit / 5, f);
             if (rj == z3::unknown) f.push_back(j);
             for (std::size_t x : f) failed.push_back(x);
           }
@@ -433,6 +441,7 @@ void Engine::Run(const Job& job) {
   // nominal parameters (cheap: fewer branches; at most 40% of the budget); then longer paths with
   // every parameter value (the search space grows fast with the depth).
   const Clock::time_point bmc_start = Clock::now();
+  deep_start = bmc_start;
   const int shallow = std::min(options_.max_depth, 3);
   struct Pass {
     int from, to;

@@ -45,7 +45,7 @@ class PropertyProver {
     /// Longest path searched for a counterexample or witness, in steps.
     int max_depth = 10;
     /// Largest k tried for k-induction.
-    int max_induction = 2;
+    int max_induction = 1;
     double robust_margin = 1e-3;
     /// Per SMT query, in Z3 resource units (`rlimit`: deterministic, unlike a time limit; about
     /// 2.5 million per second here). A query that runs out makes its property `unknown`

@@ -98,7 +98,6 @@ PropertyProver::Options Small() {
   PropertyProver::Options o;
   o.max_depth = 4;
   o.max_induction = 2;
-  o.timeout_ms = 2000;
   o.search_seconds = 5.0;
   return o;
 }
@@ -308,7 +307,7 @@ TEST(PropertyProverFinger, ReachableModes) {
   const System finger = Finger();
   PropertyProver::Options options;
   options.search_seconds = std::atof(std::getenv("SS"));
-  options.timeout_ms = std::atoi(std::getenv("TM"));
+  options.resource_limit = std::atoi(std::getenv("TM"));
   options.max_depth = std::atoi(std::getenv("MD"));
   const std::vector<PropertyProver::ModeReachability> modes =
       PropertyProver(options).ReachableModes(finger, 0);
