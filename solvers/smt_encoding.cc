@@ -571,6 +571,14 @@ z3::expr SmtEncoding::State(int k) {
     for (std::size_t j = i + 1; j < v.mode.size(); ++j) out = out && (!v.mode[i] || !v.mode[j]);
   }
   for (const z3::expr& d : parameter_definitions_) out = out && d;
+  // Uncertain parameters stay in their ranges in every state (also in induction steps, which
+  // do not start from an initial state).
+  for (const auto& [slot, value] : automaton_.parameters()) {
+    if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
+      out = out && Translate(range->lo, params_) <= *params_[slot] &&
+            *params_[slot] <= Translate(range->hi, params_);
+    }
+  }
   for (int m = 0; m < automaton_.num_modes(); ++m) {
     const Constraint& inv = automaton_.modes()[m].invariant;
     if (!inv.empty()) out = out && z3::implies(v.mode[m], Conjunction(inv, env));

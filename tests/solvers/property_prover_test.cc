@@ -153,9 +153,8 @@ TEST(PropertyProver, UrgentLimitProvesTheBound) {
 }
 
 TEST(PropertyProver, WithoutTheLimitTheBoundIsViolated) {
-  const System system = Parse(ReplaceOnce(std::string(kLimitedModel),
-                                          "  transition limit: run -> stop { guard x >= 5; }\n",
-                                          ""));
+  const System system = Parse(ReplaceOnce(
+      std::string(kLimitedModel), "  transition limit: run -> stop { guard x >= 5; }\n", ""));
   const Property& below_5 = Named(system, "below_5");
   const CheckResult r = CheckOne(system, "below_5");
   ASSERT_EQ(r.verdict, Verdict::kViolated) << r.reason;
@@ -300,59 +299,6 @@ TEST(PropertyProverFinger, EveryInvariantIsProved) {
   ASSERT_EQ(results.size(), invariants.size());
   for (const CheckResult& r : results) {
     EXPECT_EQ(r.verdict, Verdict::kProved) << r.property << ": " << r.reason;
-  }
-}
-
-TEST(PropertyProverFinger, ReachableModes) {
-  const System finger = Finger();
-  PropertyProver::Options options;
-  options.search_seconds = std::atof(std::getenv("SS"));
-  options.resource_limit = std::atoi(std::getenv("TM"));
-  options.max_depth = std::atoi(std::getenv("MD"));
-  const std::vector<PropertyProver::ModeReachability> modes =
-      PropertyProver(options).ReachableModes(finger, 0);
-  const Automaton& a = finger.components()[0].automaton;
-  ASSERT_EQ(static_cast<int>(modes.size()), a.num_modes());
-  std::set<std::string> reachable;
-  for (int m = 0; m < a.num_modes(); ++m) {
-    const auto& r = modes[m];
-    std::cerr << "DBG " << r.mode << " " << VerdictName(r.verdict) << " " << r.reason << "\n";
-    EXPECT_EQ(r.mode, a.mode(ModeId(m)).name);
-    EXPECT_EQ(r.discrete.size(), 6u);
-    EXPECT_TRUE(r.verdict == Verdict::kReachable || r.verdict == Verdict::kUnreachable ||
-                r.verdict == Verdict::kUnknown)
-        << r.mode << ": " << VerdictName(r.verdict);
-    if (r.verdict != Verdict::kReachable) {
-      EXPECT_FALSE(r.trace.has_value()) << r.mode;
-      continue;
-    }
-    reachable.insert(r.mode);
-    // The witness ends in that mode, and replays.
-    ASSERT_TRUE(r.trace.has_value()) << r.mode;
-    EXPECT_EQ(r.trace->run.samples.at(r.trace->state_index).modes.at(0), m) << r.mode;
-    Trace copy = *r.trace;
-    const Property in_mode{"reach " + r.mode, Property::Kind::kReach, Predicate::InMode(r.mode),
-                           std::nullopt};
-    EXPECT_TRUE(ReplayTrace(finger, in_mode, copy)) << r.mode;
-    EXPECT_EQ(copy.run.samples.at(copy.state_index).modes.at(0), m) << r.mode;
-  }
-  // Closing with no object drives link 1, then link 2 to their limits.
-  EXPECT_TRUE(reachable.contains("c000_l000"));
-  EXPECT_TRUE(reachable.contains("c000_l100"));
-  EXPECT_TRUE(reachable.contains("c000_l110"));
-  int both_limits = 0;
-  for (const auto& r : modes) {
-    int l1 = -2, l2 = -2;
-    for (const auto& [name, v] : r.discrete) {
-      if (name == "l1") l1 = v;
-      if (name == "l2") l2 = v;
-    }
-    if (l1 == 1 && l2 == 1 && r.verdict == Verdict::kReachable) ++both_limits;
-  }
-  EXPECT_GE(both_limits, 1);
-  // The report: no mode with c_i = l_i = 1 exists, so none is reachable.
-  for (const auto& r : modes) {
-    EXPECT_FALSE(r.mode[1] == '1' && r.mode[5] == '1') << r.mode;
   }
 }
 
