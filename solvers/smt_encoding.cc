@@ -566,10 +566,13 @@ z3::expr SmtEncoding::State(int k) {
   z3::expr_vector modes(ctx_);
   for (const auto& b : v.mode) modes.push_back(b);
   // Exactly one mode (pairwise at-most-one: plain clauses, which every Z3 tactic accepts).
-  z3::expr out = z3::mk_or(modes);
+  // Built as one flat conjunction: a long chain of binary `&&` is slow for Z3 to free.
+  z3::expr_vector clauses(ctx_);
+  clauses.push_back(z3::mk_or(modes));
   for (std::size_t i = 0; i < v.mode.size(); ++i) {
-    for (std::size_t j = i + 1; j < v.mode.size(); ++j) out = out && (!v.mode[i] || !v.mode[j]);
+    for (std::size_t j = i + 1; j < v.mode.size(); ++j) clauses.push_back(!v.mode[i] || !v.mode[j]);
   }
+  z3::expr out = z3::mk_and(clauses);
   for (const z3::expr& d : parameter_definitions_) out = out && d;
   // Uncertain parameters stay in their ranges in every state (also in induction steps, which
   // do not start from an initial state).

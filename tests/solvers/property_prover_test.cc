@@ -10,8 +10,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <iostream>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -300,6 +298,75 @@ TEST(PropertyProverFinger, EveryInvariantIsProved) {
   for (const CheckResult& r : results) {
     EXPECT_EQ(r.verdict, Verdict::kProved) << r.property << ": " << r.reason;
   }
+}
+
+// The closed-finger state (both links at their limits) is 6 steps from the start with no
+// object: close until theta3 reaches its lower limit, link 1 its limit, then link 2 its limit.
+TEST(PropertyProverFinger, ClosesFully) {
+  const System finger = Finger();
+  const Property& close = Named(finger, "can_close_fully");
+  PropertyProver::Options options;
+  options.max_depth = 6;
+  const CheckResult r = PropertyProver(options).Check(finger, std::vector<Property>{close}).at(0);
+  ASSERT_EQ(r.verdict, Verdict::kReachable) << r.reason;
+  const Trace copy = Replayed(finger, close, r);
+  const Automaton& a = finger.components()[0].automaton;
+  const Mode& mode = a.mode(ModeId(copy.run.samples.at(copy.state_index).modes.at(0)));
+  EXPECT_EQ(mode.DiscreteValueOf(a.symbols().Find("l1").value()), 1) << mode.name;
+  EXPECT_EQ(mode.DiscreteValueOf(a.symbols().Find("l2").value()), 1) << mode.name;
+}
+
+// Modes with a replayed witness in some run of the prover (up to 6 steps): never unreachable.
+const std::set<std::string> kReachableFingerModes = {
+    "c000_l000", "c000_l00n", "c100_l000", "c100_l00n", "c000_l10n", "c110_l000",
+    "c001_l000", "c011_l000", "c111_l000", "c010_l001", "c110_l001", "c000_l11n"};
+
+// Paths of at most 2 steps, searched completely (so that the verdicts do not depend on the
+// machine's speed): the start mode and the first limits and contacts are reached, with witnesses
+// ending in their mode; a mode the invariants exclude is unreachable.
+TEST(PropertyProverFinger, ReachableModes) {
+  const System finger = Finger();
+  PropertyProver::Options options;
+  options.max_depth = 2;
+  options.search_seconds = 300;  // never the limit: the search is complete
+  const std::vector<PropertyProver::ModeReachability> modes =
+      PropertyProver(options).ReachableModes(finger, 0);
+  const Automaton& a = finger.components()[0].automaton;
+  ASSERT_EQ(static_cast<int>(modes.size()), a.num_modes());
+  std::set<std::string> reachable, unreachable;
+  for (int m = 0; m < a.num_modes(); ++m) {
+    const PropertyProver::ModeReachability& r = modes[m];
+    EXPECT_EQ(r.mode, a.mode(ModeId(m)).name);
+    // Discrete values by declared name, as the mode declares them.
+    ASSERT_EQ(r.discrete.size(), 6u) << r.mode;
+    for (const auto& [name, value] : r.discrete) {
+      EXPECT_EQ(a.mode(ModeId(m)).DiscreteValueOf(a.symbols().Find(name).value()), value)
+          << r.mode << " " << name;
+    }
+    if (r.verdict == Verdict::kUnreachable) unreachable.insert(r.mode);
+    if (r.verdict != Verdict::kReachable) {
+      EXPECT_FALSE(r.trace.has_value()) << r.mode;
+      continue;
+    }
+    reachable.insert(r.mode);
+    ASSERT_TRUE(r.trace.has_value()) << r.mode;
+    EXPECT_EQ(r.trace->run.samples.at(r.trace->state_index).modes.at(0), m) << r.mode;
+    // The witness replays independently and ends in that mode.
+    const Property in_mode{"reach " + r.mode, Property::Kind::kReach, Predicate::InMode(r.mode),
+                           std::nullopt};
+    Trace copy = *r.trace;
+    copy.run = {};
+    copy.state_index = -1;
+    ASSERT_TRUE(ReplayTrace(finger, in_mode, copy)) << r.mode;
+    EXPECT_EQ(copy.run.samples.at(copy.state_index).modes.at(0), m) << r.mode;
+  }
+  for (const char* m : {"c000_l000", "c000_l00n", "c100_l000"}) {
+    EXPECT_TRUE(reachable.contains(m)) << m << ": " << modes[a.FindMode(m)->value()].reason;
+  }
+  // Link 1 at its limit with link 3 free would need theta3 = -theta1 - theta2 <= -70, below
+  // its lower limit of -55 (distal_coupling, limits_exact): unreachable.
+  EXPECT_TRUE(unreachable.contains("c000_l100")) << modes[a.FindMode("c000_l100")->value()].reason;
+  for (const std::string& m : kReachableFingerModes) EXPECT_FALSE(unreachable.contains(m)) << m;
 }
 
 }  // namespace

@@ -59,8 +59,7 @@ automaton two {
 )";
 
 Automaton FingerAutomaton() {
-  static const System finger =
-      ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
+  static const System finger = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
   return finger.components()[0].automaton;
 }
 
@@ -153,8 +152,8 @@ TEST(SmtEncoding, ClassifiesTheFingerModes) {
   const SmtEncoding enc(ctx, a);
   EXPECT_EQ(enc.flow_class(Mode(a, "c000_l000")), FlowClass::kConstantRate);  // phase 1
   EXPECT_EQ(enc.flow_class(Mode(a, "c100_l000")), FlowClass::kConstantRate);  // phase 2
-  for (const char* m : {"c010_l000", "c000_l010", "c110_l000", "c100_l010", "c010_l100",
-                        "c000_l110"}) {  // phase 3
+  for (const char* m :
+       {"c010_l000", "c000_l010", "c110_l000", "c100_l010", "c010_l100", "c000_l110"}) {  // phase 3
     EXPECT_EQ(enc.flow_class(Mode(a, m)), FlowClass::kSeparable) << m;
   }
   // Phase 4 (link 3 blocked or at its limit): nothing moves.
@@ -308,8 +307,7 @@ TEST(SmtEncoding, SeparableFlowStopsAtAnUrgentGuard) {
             z3::unsat);
   // The same segment is allowed when the release is lazy.
   static StepChecker lazy(FingerWithLazyRelease());
-  EXPECT_EQ(lazy.Check("c010_l000", start, "c010_l000", end(-20 - 630.0 / 165, 90), 1e-9),
-            z3::sat);
+  EXPECT_EQ(lazy.Check("c010_l000", start, "c010_l000", end(-20 - 630.0 / 165, 90), 1e-9), z3::sat);
 }
 
 }  // namespace
