@@ -21,6 +21,7 @@
 #include "solvers/simulator.h"
 #include "solvers/trace.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/properties.h"
 
 namespace hybrid {
 namespace {
@@ -85,12 +86,7 @@ system pair {
 
 System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
 
-const Property& Named(const System& system, const std::string& name) {
-  for (const Property& p : system.properties()) {
-    if (p.name == name) return p;
-  }
-  throw std::invalid_argument("no property " + name);
-}
+using testing::Named;
 
 PropertyProver::Options Small() {
   PropertyProver::Options o;

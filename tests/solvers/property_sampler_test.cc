@@ -18,6 +18,7 @@
 #include "solvers/simulator.h"
 #include "solvers/trace.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/properties.h"
 
 namespace hybrid {
 namespace {
@@ -116,12 +117,7 @@ automaton outside {
 
 System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
 
-const Property& Named(const System& system, const std::string& name) {
-  for (const Property& p : system.properties()) {
-    if (p.name == name) return p;
-  }
-  throw std::invalid_argument("no property " + name);
-}
+using testing::Named;
 
 // The value of variable `name` at the trace's target state.
 double AtTarget(const System& system, const Trace& trace, const std::string& name) {

@@ -16,6 +16,7 @@
 
 #include "automaton/parser.h"
 #include "solvers/simulator.h"
+#include "tests/test_utilities/properties.h"
 
 namespace hybrid {
 namespace {
@@ -75,12 +76,7 @@ system pair {
 
 System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
 
-const Property& Named(const System& system, const std::string& name) {
-  for (const Property& p : system.properties()) {
-    if (p.name == name) return p;
-  }
-  throw std::invalid_argument("no property " + name);
-}
+using testing::Named;
 
 // A trace that holds input `input` at `value` for `until` time units.
 Trace ConstantInput(const System& system, const std::string& input, double value, double until) {

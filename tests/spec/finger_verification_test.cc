@@ -11,6 +11,7 @@
 #include "solvers/simulator.h"
 #include "solvers/trace.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/properties.h"
 
 namespace hybrid {
 namespace {
@@ -26,12 +27,7 @@ std::string Block(const std::string& text, const std::string& name) {
   return text.substr(at, end + 4 - at);
 }
 
-const Property& Named(const System& s, const std::string& name) {
-  for (const Property& p : s.properties()) {
-    if (p.name == name) return p;
-  }
-  throw std::invalid_argument("no property " + name);
-}
+using testing::Named;
 
 TEST(FingerVerificationTest, EveryDeclaredInvariantIsProved) {
   const System finger = ParseModel(SpecText("finger"), "finger.ha");
