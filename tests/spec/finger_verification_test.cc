@@ -71,11 +71,12 @@ const Mutant kMutants[] = {
        const std::string b = Block(text, "t3_c000_l00n_to_c000_l10n");
        return ReplaceOnce(text, b, ReplaceOnce(b, "theta1 >= theta1_max", "theta1 <= theta1_max"));
      }},
-    // A missing reset: blocking link 2 no longer records where phase 3 starts.
+    // A missing reset: reaching theta2's limit (blocking link 2, against the palm) no longer
+    // records where phase 3 starts, so the transmission no longer adds up to g_s.
     {"missing_reset", "transmission",
      [](const std::string& text) {
-       const std::string b = Block(text, "t1_c000_l000_to_c010_l000");
-       return ReplaceOnce(text, b, ReplaceOnce(b, "    reset theta3_s := theta3, g_s := g;\n", ""));
+       const std::string b = Block(text, "t3_c000_l10n_to_c000_l11n");
+       return ReplaceOnce(text, b, ReplaceOnce(b, ", theta3_s := theta3, g_s := g", ""));
      }},
     // A dropped transition: nothing stops theta1 at its limit in phase 1'.
     {"dropped_transition", "theta1_range",
@@ -100,7 +101,9 @@ TEST_P(FingerMutantTest, ComesBackViolatedWithATraceTheSimulatorReplays) {
   const System mutant = ParseModel(text, std::string(m.name) + ".ha");
   const Property& property = Named(mutant, m.property);
   PropertyProver::Options options;
-  options.search_seconds = 20;
+  // Bounded by depth, not by time: every mutant breaks its property within 6 steps.
+  options.max_depth = 6;
+  options.search_seconds = 600;
   const auto results = PropertyProver(options).Check(mutant, {&property, 1});
   ASSERT_EQ(results[0].verdict, Verdict::kViolated) << results[0].reason;
   ASSERT_TRUE(results[0].trace.has_value());
