@@ -82,7 +82,7 @@ def normalise(s):
 # (theta3_max - theta3_s) (g - g_s) / (255 - g), continued from theta3_s and g_s, the values when
 # link 2 was blocked, differentiated in g. (Section 3's m3(g) = theta3_min + c / (255 - g) is not
 # this rate.) The max(.., 1e-12) only matters for g_s = g = 255, where the numerator is 0 too.
-M3 = "(theta3_max - theta3_s) * (255 - g_s) / max((255 - g) ^ 2, 1e-12) * u"
+M3 = "m3_scale * (theta3_max - theta3_s) * (255 - g_s) / max((255 - g) ^ 2, 1e-12) * u"
 
 
 def rate(flow):
@@ -215,6 +215,11 @@ automaton finger {
   # m1 = theta1_max / 140 and m2 = theta2_max / 100 (degrees per motor count), as in the report.
   param m1 [deg/count] = theta1_max / 140;
   param m2 [deg/count] = theta2_max / 100;
+  # Link 3 reaches its upper limit in phase 3 this fraction of the way from g_s (where link 2
+  # stopped) to 255: the report's one half (figure 4.1). m3_scale = (1 - f) / f scales the law so
+  # that it does; `hybrid diagnose` fits the fraction (cause theta3_law).
+  param theta3_fraction = 0.5;
+  param m3_scale = (1 - theta3_fraction) / theta3_fraction;
   # Motor position at which link i first touches an object; 256 (beyond the motor range) = no
   # object. Issue-level scenarios set these; geometry-based contact replaces them later.
   # `in [0, 256]`: `hybrid check` proves properties for every object position (and none).
@@ -287,7 +292,7 @@ automaton finger {
   # its lower limit.
   property distal_coupling: always c2 == 1 or l2 == 1 or (l3 == 0 and theta1 + theta2 + theta3 == 0) or (l3 == -1 and theta1 + theta2 + theta3_min >= 0);
   # Once link 2 is blocked, theta3 follows section 4's law from (theta3_s, g_s) (decision C2).
-  property phase3_law: always (c2 == 0 and l2 == 0) or ((theta3 - theta3_s) * (255 - g) == (theta3_max - theta3_s) * (g - g_s) and g >= g_s and theta3_s >= theta3_min and theta1 + theta2 + theta3_s >= 0 and (theta3_s == theta3_min or theta1 + theta2 + theta3_s == 0));
+  property phase3_law: always (c2 == 0 and l2 == 0) or ((theta3 - theta3_s) * (255 - g) == m3_scale * (theta3_max - theta3_s) * (g - g_s) and g >= g_s and theta3_s >= theta3_min and theta1 + theta2 + theta3_s >= 0 and (theta3_s == theta3_min or theta1 + theta2 + theta3_s == 0));
   # Reachability questions.
   property can_close_fully: reach l1 == 1 and l2 == 1;
 }""")
