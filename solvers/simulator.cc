@@ -419,6 +419,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   if (!std::isfinite(until) || !(until > 0.0)) {
     fail("the horizon must be positive and finite, got " + FormatNumber(until));
   }
+  for (size_t i = 0; i < options.sample_times.size(); ++i) {
+    const double ts = options.sample_times[i];
+    if (!std::isfinite(ts) || ts < 0.0 || ts > until) {
+      fail("sample time " + FormatNumber(ts) + " lies outside [0, " + FormatNumber(until) + "]");
+    }
+    if (i > 0 && ts < options.sample_times[i - 1]) fail("sample times must not decrease");
+  }
   std::vector<InputSignal> inputs;
   if (system.scenario()) inputs = system.scenario()->inputs;
   for (const InputSignal& s : signals) {
@@ -718,7 +725,21 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   bool running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
   if (running && zeno_check()) running = false;
   size_t next_break = 0;
-  double next_sample = options.sample_step > 0.0 ? options.sample_step : until;
+  double next_uniform = options.sample_step > 0.0 ? options.sample_step : until;
+  size_t next_listed = 0;
+  const std::vector<double>& listed = options.sample_times;
+  // Listed times already reached (0, or before the first step): recorded now, after the start.
+  auto record_listed = [&]() {
+    while (next_listed < listed.size() && listed[next_listed] <= t) {
+      record(StateSample::Kind::kSample);
+      ++next_listed;
+    }
+  };
+  auto next_sample_time = [&]() {
+    return std::min(next_uniform, next_listed < listed.size() ? listed[next_listed] : until);
+  };
+  record_listed();
+  double next_sample = next_sample_time();
   std::vector<double> g_prev(run.roots().size()), g_mid;
   auto evaluate_roots = [&](double time, const Eigen::VectorXd& state, std::vector<double>* g) {
     g->resize(run.roots().size());
@@ -955,12 +976,14 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     // Stop times reached by this step (also when a root lies exactly on one: otherwise the sample
     // or the input jump there would be skipped, and the next Advance would be asked to stop at
     // the current time).
-    if (t >= next_sample && options.sample_step > 0.0 && t < until) {
+    if (t >= next_uniform && options.sample_step > 0.0 && t < until) {
       record(StateSample::Kind::kSample);
       // The k-th sample is at k * sample_step exactly (no accumulated drift).
-      next_sample =
+      next_uniform =
           std::min(until, options.sample_step * (std::floor(t / options.sample_step + 0.5) + 1.0));
     }
+    record_listed();
+    next_sample = next_sample_time();
     if (next_break < breakpoints.size() && t >= breakpoints[next_break]) {
       run.SetStepInputs(t);
       run.Load(t, x.data());

@@ -21,6 +21,12 @@ struct SimulationOptions {
   /// > 0: also record the state every `sample_step` (from the start); 0: only the start, the end
   /// and both sides of every event.
   double sample_step = 0.0;
+  /// Further times at which to record the state (StateSample::Kind::kSample), e.g. the instants
+  /// of measured samples. Non-decreasing, finite, within [0, until]; a repeated time is recorded
+  /// once per occurrence, so the result has one sample per entry (a time at which an event
+  /// happens records the state after the jump; a time 0 records the start). Run throws
+  /// std::invalid_argument otherwise.
+  std::vector<double> sample_times;
   double relative_tolerance = 1e-10;
   double absolute_tolerance = 1e-12;
   /// A residual within this of 0 counts as on the boundary (non-strict guards hold, invariants

@@ -608,6 +608,33 @@ TEST(SimulatorTest, FingerClosesAndReopensInFreeSpace) {
 // Special cases, each on a small model.
 
 // Three transitions whose guards become true at x = 1, where the invariant ends too.
+// Listed sample times: one sample per entry, at exactly that time, also on an event (after the
+// jump), repeated times repeated; the finger's free closing is theta1 = m1 g, theta3 = -m1 g.
+TEST(SimulatorTest, ListedSampleTimesRecordOneSamplePerEntry) {
+  const Model m(SpecText("finger"));
+  SimulationOptions o = Until(120.0);
+  o.sample_times = {0.0, 0.5, 37.25, 37.25, 110.0, 120.0};
+  const SimulationResult r = m.Run(o, {m.Signal("u", InputSignal::Shape::kStep, {{0.0, 1.0}})});
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  std::vector<StateSample> listed;
+  for (const StateSample& s : r.samples) {
+    if (s.kind == StateSample::Kind::kSample) listed.push_back(s);
+  }
+  ASSERT_EQ(listed.size(), o.sample_times.size());
+  for (size_t i = 0; i < listed.size(); ++i) {
+    EXPECT_EQ(listed[i].time, o.sample_times[i]);
+    const double g = std::min(o.sample_times[i], 110.0);
+    EXPECT_NEAR(listed[i].x[m.Var("theta1")], 0.5 * o.sample_times[i], 1e-9);
+    EXPECT_NEAR(listed[i].x[m.Var("theta3")], -0.5 * g, 1e-9);
+  }
+  // At t = 110 theta3 reaches its lower limit: the sample is in the mode after the jump.
+  EXPECT_EQ(listed[4].modes[0], m.Mode(0, "c000_l00n"));
+  o.sample_times = {2.0, 1.0};
+  EXPECT_THROW(m.Run(o), std::invalid_argument);
+  o.sample_times = {121.0};
+  EXPECT_THROW(m.Run(o), std::invalid_argument);
+}
+
 std::string PriorityModel(const std::string& transitions) {
   return R"(
 automaton priority {
