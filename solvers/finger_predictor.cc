@@ -13,6 +13,19 @@ constexpr std::string_view kApi = "FingerPredictor";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // gob beyond the motor range: no object (spec/finger.ha's parameter range is [0, 256]).
 constexpr double kNoObject = 256.0;
+constexpr double kMotorMax = 255.0;
+
+// Step-signal points with strictly increasing times: of several points at one time the last
+// holds (pieces shorter than the time's rounding vanish), and repeated values are merged.
+void Normalize(std::vector<std::pair<double, double>>& points) {
+  std::vector<std::pair<double, double>> out;
+  for (const auto& pt : points) {
+    if (!out.empty() && out.back().first >= pt.first) out.pop_back();
+    if (!out.empty() && out.back().second == pt.second) continue;
+    out.push_back(pt);
+  }
+  points = std::move(out);
+}
 
 void AppendNumber(std::string& key, double v) {
   char buffer[32];
@@ -87,16 +100,21 @@ FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEf
   SimulationOptions options;
   options.relative_tolerance = options_.relative_tolerance;
   options.absolute_tolerance = options_.absolute_tolerance;
+  options.dense_checks = options_.dense_checks;
   options.sample_times.resize(n);
   std::vector<std::pair<double, double>> points;
+  // The timeline keeps the drive a hair (1e-9 counts) inside the motor range: the finger's g is
+  // integrated along it, and a rounding-level mismatch between the two must not reach g = 0 or
+  // 255 moving out before the input stops or reverses there.
+  constexpr double kMargin = 1e-9;
   double t = 0.0, q = 0.0;
   for (size_t k = 0; k < n; ++k) {
-    const double step = p.drive[k] - q;
+    const double step = std::clamp(p.drive[k], kMargin, kMotorMax - kMargin) - q;
     if (step != 0.0) {
       const double sign = step > 0 ? 1.0 : -1.0;
       if (points.empty() || points.back().second != sign) points.emplace_back(t, sign);
       t += std::abs(step);
-      q = p.drive[k];
+      q += step;
     }
     options.sample_times[k] = t;
   }
@@ -106,14 +124,44 @@ FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEf
   points.front().first = 0.0;
   if (t > 0.0) points.emplace_back(t, 0.0);
   options.until = t + 1.0;
+  Normalize(points);
   const std::shared_ptr<const Entry> entry = SimulatorFor(run, e);
   const Simulator* sim = &entry->simulator;
   const int u_slot = *sim->system().symbols().Find("u");
-  const std::vector<InputSignal> signals = {
-      InputSignal{u_slot, InputSignal::Shape::kStep, std::move(points)}};
-  const SimulationResult r = sim->Run(options, signals);
+  const int g_index =
+      static_cast<int>(std::find(sim->variable_names().begin(), sim->variable_names().end(), "g") -
+                       sim->variable_names().begin());
+  // Where the finger stopped the motor (phase 4) but the data's g went on, the finger's g lags the
+  // drive and may reach the end of the motor range (0 or 255) before the drive turns: the finger
+  // then stays there (the extended automaton's transmission goes slack) until the drive reverses.
+  // Each pass that ends on the range's boundary, moving out, stops the input there to the end of
+  // that piece.
+  SimulationResult r;
+  for (int pass = 0;; ++pass) {
+    const std::vector<InputSignal> signals = {
+        InputSignal{u_slot, InputSignal::Shape::kStep, points}};
+    r = sim->Run(options, signals);
+    if (r.status != SimulationStatus::kInvariantViolated || pass >= 8) break;
+    const StateSample& last = r.samples.back();
+    const double g_end = last.x[g_index];
+    if (!(std::abs(g_end) < 1e-6 || std::abs(g_end - kMotorMax) < 1e-6)) break;
+    // Stop the piece that moved out (a hair before the violation: it may be reported at the
+    // next breakpoint, within rounding) and keep the pieces after it.
+    const double stop = std::max(0.0, last.time - 1e-7);
+    const double outward = std::abs(g_end) < 1e-6 ? -1.0 : 1.0;
+    size_t i = 0;
+    while (i + 1 < points.size() && points[i + 1].first <= stop) ++i;
+    if (points[i].second != outward) break;
+    if (points[i].first == stop) {
+      points[i].second = 0.0;
+    } else {
+      points.insert(points.begin() + static_cast<long>(i) + 1, {stop, 0.0});
+    }
+    Normalize(points);
+  }
   p.status = r.status;
   p.message = r.message;
+  p.model_g.assign(n, kNaN);
   std::array<int, 3> index{};
   const std::vector<std::string>& names = sim->variable_names();
   for (int j = 0; j < 3; ++j) {
@@ -125,6 +173,7 @@ FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEf
     if (s.kind != StateSample::Kind::kSample || k >= n) continue;
     for (int j = 0; j < 3; ++j) p.theta[j][k] = s.x[index[j]] + e.sensor_bias[j];
     p.mode[k] = s.modes[0];
+    p.model_g[k] = s.x[g_index];
     ++k;
   }
   if (p.status == SimulationStatus::kCompleted && k < n) {

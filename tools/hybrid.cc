@@ -21,7 +21,9 @@
 #include "automaton/mode_graph.h"
 #include "automaton/parser.h"
 #include "automaton/system.h"
+#include "solvers/measured_data.h"
 #include "tools/check_command.h"
+#include "tools/diagnose_command.h"
 #include "tools/gripper_command.h"
 #include "tools/output.h"
 #include "tools/simulate_command.h"
@@ -275,6 +277,9 @@ int ExitFor(std::exception_ptr error, const std::string& prefix, int invalid_cod
   } catch (const hybrid::ParseError& e) {
     std::cerr << e.what() << "\n";
     return kExitModelError;
+  } catch (const hybrid::DataError& e) {
+    std::cerr << e.what() << "\n";
+    return kExitModelError;
   } catch (const OutputError& e) {
     std::cerr << "hybrid: " << e.what() << "\n";
     return kExitOutput;
@@ -435,6 +440,48 @@ int main(int argc, char** argv) {
                  "Also simulate the composed finger automata and compare with the closed form");
   hand->add_option("--model", hand_args.model, "Hand model for --simulate")->capture_default_str();
 
+  hybrid::cli::DiagnoseArgs diagnose_args;
+  diagnose_args.model = default_finger;
+  auto* diagnose = app.add_subcommand(
+      "diagnose",
+      "Compare measured finger data with the model: residuals per joint, mode and direction, "
+      "the physical cause (backlash, motor_offset, joint_range, sensor_bias, compliance, "
+      "theta3_law, none or unexplained), an extended model and its held-out gain");
+  diagnose
+      ->add_option("DATA", diagnose_args.data,
+                   "CSV: run,g,theta1,theta2,theta3[,gob,contact_link] (docs/diagnosis.md)")
+      ->required();
+  diagnose->add_option("--model", diagnose_args.model, "Finger automaton")->capture_default_str();
+  diagnose->add_flag("--json", diagnose_args.json, "Machine-readable output");
+  diagnose->add_option("--out-model", diagnose_args.out_model,
+                       "Write the extended model (accepted by simulate, dot and check)");
+  diagnose->add_option("--report", diagnose_args.report,
+                       "Write diagnosis.json and SVG plots (measured, baseline, extended) here");
+  diagnose
+      ->add_option("--significance", diagnose_args.significance,
+                   "Held-out gain (chi-square units) needed to name a cause")
+      ->capture_default_str();
+  diagnose->add_option("--threads", diagnose_args.threads, "Worker threads")->capture_default_str();
+
+  hybrid::cli::SynthesizeArgs synth_args;
+  synth_args.model = default_finger;
+  auto* synthesize = app.add_subcommand(
+      "synthesize",
+      "Write SYNTHETIC finger data (the model plus hidden effects, the report's noise and "
+      "outliers) in the CSV format of `hybrid diagnose`");
+  synthesize
+      ->add_option("--effect", synth_args.effects,
+                   "NAME=VALUE: a hidden effect, e.g. backlash=6, theta3_bias=2.5, "
+                   "ripple_amplitude=3; repeatable")
+      ->take_all();
+  synthesize->add_option("--seed", synth_args.seed, "Random seed")->capture_default_str();
+  synthesize->add_option("--free-runs", synth_args.free_runs, "Runs without an object")
+      ->capture_default_str();
+  synthesize->add_option("--samples", synth_args.samples, "Samples per run (even)")
+      ->capture_default_str();
+  synthesize->add_option("--model", synth_args.model, "Finger automaton")->capture_default_str();
+  synthesize->add_option("-o,--out", synth_args.out, "Output CSV (default: standard output)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -459,6 +506,17 @@ int main(int argc, char** argv) {
       return hybrid::cli::RunHand(hand_args);
     } catch (...) {
       return ExitFor(std::current_exception(), name, kExitUsage);
+    }
+  }
+
+  if (diagnose->parsed() || synthesize->parsed()) {
+    // Bad data (DataError) and bad models (ParseError) exit 1; a bad option value 2.
+    try {
+      return diagnose->parsed() ? hybrid::cli::RunDiagnose(diagnose_args)
+                                : hybrid::cli::RunSynthesize(synth_args);
+    } catch (...) {
+      return ExitFor(std::current_exception(),
+                     diagnose->parsed() ? "hybrid diagnose" : "hybrid synthesize", kExitUsage);
     }
   }
 

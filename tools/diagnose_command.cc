@@ -1,0 +1,282 @@
+#include "tools/diagnose_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "automaton/parser.h"
+#include "automaton/printer.h"
+#include "solvers/diagnosis.h"
+#include "solvers/finger_predictor.h"
+#include "solvers/measured_data.h"
+#include "solvers/synthetic_data.h"
+#include "tools/diagnosis_report.h"
+#include "tools/output.h"
+
+namespace hybrid::cli {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+const char* const kJoints[3] = {"theta1", "theta2", "theta3"};
+
+Automaton LoadFinger(const std::string& path) {
+  const System system = ParseModelFile(path);
+  if (system.components().size() != 1) {
+    throw std::invalid_argument(path + ": expected one finger automaton (spec/finger.ha), got " +
+                                std::to_string(system.components().size()) + " components");
+  }
+  return system.components()[0].automaton;
+}
+
+json PerJoint(const std::array<double, 3>& v) {
+  json j = json::object();
+  for (int i = 0; i < 3; ++i) j[kJoints[i]] = std::isfinite(v[i]) ? json(v[i]) : json(nullptr);
+  return j;
+}
+
+std::string Direction(int d) { return d > 0 ? "closing" : "opening"; }
+
+json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
+  json out;
+  out["data"] = {{"file", args.data},
+                 {"runs", d.curves.size()},
+                 {"samples", d.samples},
+                 {"outliers_clamped", PerJoint({static_cast<double>(d.outliers.clamped[0]),
+                                                static_cast<double>(d.outliers.clamped[1]),
+                                                static_cast<double>(d.outliers.clamped[2])})},
+                 {"outlier_rule",
+                  "report section 5.1: a change of more than 5 deg from the "
+                  "previous inlier and the next sample is clamped to within 5 "
+                  "deg of both"}};
+  out["cause"] = d.cause;
+  json params = json::object();
+  for (const auto& [p, v] : d.parameters) params[ParameterName(p)] = v;
+  out["parameters"] = params;
+  json units = json::object();
+  for (const auto& [p, v] : d.parameters) units[ParameterName(p)] = ParameterUnit(p);
+  out["parameter_units"] = units;
+  out["baseline_mse"] = PerJoint(d.baseline_mse);
+  out["extended_mse"] = PerJoint(d.extended_mse);
+  json noise = PerJoint(d.noise.variance);
+  noise["method"] = d.noise.method;
+  noise["dof"] = {
+      {"theta1", d.noise.dof[0]}, {"theta2", d.noise.dof[1]}, {"theta3", d.noise.dof[2]}};
+  out["noise_floor"] = noise;
+  out["mse_unit"] = "deg^2";
+  if (d.where) {
+    out["where"] = {
+        {"joint", kJoints[d.where->joint]},           {"mode", d.where->mode},
+        {"direction", Direction(d.where->direction)}, {"g_range", {d.where->g_min, d.where->g_max}},
+        {"mean_residual", d.where->mean_residual},    {"excess", d.where->excess}};
+  } else {
+    out["where"] = nullptr;
+  }
+  json candidates = json::array();
+  for (const CandidateFit& c : d.candidates) {
+    json names = json::array(), values = json::object();
+    for (size_t i = 0; i < c.parameters.size(); ++i) {
+      names.push_back(CauseName(c.parameters[i].cause));
+      values[ParameterName(c.parameters[i])] = c.values[i];
+    }
+    candidates.push_back({{"causes", names},
+                          {"parameters", values},
+                          {"heldout_mse", PerJoint(c.heldout_mse)},
+                          {"heldout_gain", c.gain},
+                          {"bic", c.bic},
+                          {"significant", c.significant}});
+  }
+  out["candidates"] = candidates;
+  json groups = json::array();
+  for (const ResidualGroup& g : d.residuals) {
+    groups.push_back({{"joint", kJoints[g.joint]},
+                      {"mode", g.mode},
+                      {"direction", Direction(g.direction)},
+                      {"samples", g.samples},
+                      {"bias", g.mean},
+                      {"trend_per_count", g.slope},
+                      {"rms", g.rms},
+                      {"excess", g.excess},
+                      {"g_range", {g.g_min, g.g_max}}});
+  }
+  out["residuals"] = groups;
+  json dir = json::object();
+  for (int j = 0; j < 3; ++j) dir[kJoints[j]] = d.direction_difference[j];
+  out["direction_dependence"] = dir;
+  json changes = json::array();
+  for (const ChangePoint& c : d.change_points) {
+    changes.push_back({{"run", c.run},
+                       {"sample", c.sample},
+                       {"g", c.g},
+                       {"from_mode", c.from_mode},
+                       {"to_mode", c.to_mode},
+                       {"joint", kJoints[c.joint]},
+                       {"jump", c.jump}});
+  }
+  out["change_points"] = changes;
+  out["seconds"] = seconds;
+  return out;
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
+  std::ostringstream out;
+  out << "data: " << args.data << ": " << d.curves.size() << " runs, " << d.samples
+      << " samples; outliers clamped (report's 5-degree rule): theta1 " << d.outliers.clamped[0]
+      << ", theta2 " << d.outliers.clamped[1] << ", theta3 " << d.outliers.clamped[2] << "\n";
+  out << "noise floor (" << d.noise.method << "): sd";
+  for (int j = 0; j < 3; ++j) {
+    out << " " << kJoints[j] << " " << Fixed(std::sqrt(d.noise.variance[j]), 2);
+  }
+  out << " deg\n";
+  out << "cause:";
+  for (const std::string& c : d.cause) out << " " << c;
+  out << "\n";
+  for (const auto& [p, v] : d.parameters) {
+    out << "  " << ParameterName(p) << " = " << Fixed(v, 4) << " " << ParameterUnit(p) << "\n";
+  }
+  if (d.where) {
+    out << "where: " << kJoints[d.where->joint] << ", mode " << d.where->mode << ", "
+        << Direction(d.where->direction) << ", g in [" << Fixed(d.where->g_min, 1) << ", "
+        << Fixed(d.where->g_max, 1) << "], mean residual " << Fixed(d.where->mean_residual, 2)
+        << " deg\n";
+  }
+  out << "held-out MSE (deg^2)      theta1    theta2    theta3\n";
+  auto row = [&](const char* name, const std::array<double, 3>& v) {
+    out << "  " << name;
+    for (double x : v)
+      out << "  " << std::string(8 - std::min<size_t>(8, Fixed(x, 3).size()), ' ') << Fixed(x, 3);
+    out << "\n";
+  };
+  row("baseline              ", d.baseline_mse);
+  row("extended              ", d.extended_mse);
+  row("noise floor (variance)", d.noise.variance);
+  out << "candidates (held-out gain in chi-square units; * significant):\n";
+  for (const CandidateFit& c : d.candidates) {
+    std::string name;
+    for (size_t i = 0; i < c.parameters.size(); ++i) {
+      if (i > 0) name += " + ";
+      name += ParameterName(c.parameters[i]) + "=" + Fixed(c.values[i], 3);
+    }
+    out << "  " << (c.significant ? "*" : " ") << " " << name << ": " << Fixed(c.gain, 1) << "\n";
+  }
+  out << "time: " << Fixed(seconds, 2) << " s\n";
+  return out.str();
+}
+
+}  // namespace
+
+int RunDiagnose(const DiagnoseArgs& args) {
+  if (args.threads < 1 || args.threads > 64) {
+    throw std::invalid_argument("--threads must lie in [1, 64]");
+  }
+  if (!(args.significance > 0) || !std::isfinite(args.significance)) {
+    throw std::invalid_argument("--significance must be positive");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  MeasuredData data = ReadMeasuredDataFile(args.data);
+  const FingerPredictor predictor(LoadFinger(args.model), FingerPredictor::FastOptions());
+  DiagnosisOptions options;
+  options.significance = args.significance;
+  options.threads = args.threads;
+  const Diagnosis d = Diagnose(predictor, std::move(data), options);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const json report = ToJson(d, args, seconds);
+  std::vector<std::pair<std::string, std::string>> files;
+  if (!args.out_model.empty()) {
+    std::ostringstream text;
+    text << "# Extended finger model written by `hybrid diagnose " << args.data << "`.\n";
+    text << "# Cause:";
+    for (const std::string& c : d.cause) text << " " << c;
+    text << "\n";
+    for (const auto& [p, v] : d.parameters) {
+      text << "#   " << ParameterName(p) << " = " << v << " " << ParameterUnit(p) << "\n";
+    }
+    text << "# g is the finger's drive position, g_motor the measured motor position; "
+            "theta<j>_measured (if any) the measured angles. See docs/diagnosis.md.\n";
+    text << PrintAutomaton(
+        d.parameters.empty()
+            ? predictor.finger()
+            : ExtendFingerModel(predictor.finger(), d.effects, predictor.StartState(d.effects)));
+    files.emplace_back(args.out_model, text.str());
+  }
+  if (!args.report.empty()) {
+    files.emplace_back(args.report + "/diagnosis.json", report.dump(2) + "\n");
+    for (auto& f : DiagnosisReportFiles(d, args.report)) files.push_back(std::move(f));
+  }
+  WriteOutputs(files);
+  WriteOutput("-", args.json ? report.dump(2) + "\n" : ToText(d, args, seconds));
+  return 0;
+}
+
+int RunSynthesize(const SynthesizeArgs& args) {
+  HiddenEffects hidden;
+  const FingerPredictor predictor(LoadFinger(args.model));
+  for (const std::string& e : args.effects) {
+    const size_t eq = e.find('=');
+    if (eq == std::string::npos)
+      throw std::invalid_argument("--effect " + e + ": expected NAME=VALUE");
+    const std::string name = e.substr(0, eq);
+    double value = 0.0;
+    try {
+      size_t used = 0;
+      value = std::stod(e.substr(eq + 1), &used);
+      if (used != e.size() - eq - 1 || !std::isfinite(value)) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--effect " + e + ": the value is not a finite number");
+    }
+    if (name == "ripple_amplitude") {
+      hidden.ripple_amplitude = value;
+    } else if (name == "ripple_period") {
+      hidden.ripple_period = value;
+    } else if (name == "theta3_hysteresis") {
+      hidden.theta3_hysteresis = value;
+    } else {
+      bool found = false;
+      for (const EffectParameter& p : AllEffectParameters()) {
+        if (ParameterName(p) == name) {
+          SetEffect(hidden.finger, p, value);
+          found = true;
+        }
+      }
+      if (!found) {
+        std::string names;
+        for (const EffectParameter& p : AllEffectParameters()) names += " " + ParameterName(p);
+        throw std::invalid_argument("--effect " + e + ": unknown effect '" + name + "' (one of:" +
+                                    names + " ripple_amplitude ripple_period theta3_hysteresis)");
+      }
+    }
+  }
+  SyntheticDesign design;
+  design.seed = args.seed;
+  design.free_runs = args.free_runs;
+  design.samples_per_run = args.samples;
+  const MeasuredData data = Synthesize(predictor, hidden, design);
+  std::vector<std::string> comment = {
+      "SYNTHETIC data (not measured): made by `hybrid synthesize` from the finger model",
+      "  " + args.model,
+      "with seed " + std::to_string(args.seed) + ", " + std::to_string(args.free_runs) +
+          " free runs, " + std::to_string(args.samples) + " samples per run, and hidden effects:"};
+  if (args.effects.empty()) comment.push_back("  none");
+  for (const std::string& e : args.effects) comment.push_back("  " + e);
+  comment.push_back(
+      "Noise: Gaussian, sd 0.7 / 0.7 / 1.2 deg (the report's section 5), theta3 "
+      "outliers (2%), 0.5% missing samples.");
+  std::ostringstream text;
+  WriteMeasuredData(text, data, comment);
+  WriteOutput(args.out, text.str());
+  return 0;
+}
+
+}  // namespace hybrid::cli

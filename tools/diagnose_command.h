@@ -1,0 +1,42 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hybrid::cli {
+
+/// Options of `hybrid diagnose` (see docs/cli.md and docs/diagnosis.md).
+struct DiagnoseArgs {
+  std::string data;       ///< the measured CSV
+  std::string model;      ///< the finger automaton (spec/finger.ha by default)
+  bool json = false;      ///< machine-readable output on standard output
+  std::string out_model;  ///< write the extended model here
+  std::string report;     ///< write diagnosis.json and SVG plots into this directory
+  double significance = 25.0;
+  int threads = 2;
+};
+
+/// Runs `hybrid diagnose`; returns 0. Throws hybrid::DataError for bad data (exit 1, with
+/// FILE:LINE:COL), hybrid::ParseError for a bad model, std::invalid_argument for bad options or a
+/// model that is not the finger, OutputError when an output cannot be written (no output file
+/// is then left half-written: every file is written atomically, all or nothing).
+int RunDiagnose(const DiagnoseArgs& args);
+
+/// Options of `hybrid synthesize`: data with hidden effects, for demos and tests.
+struct SynthesizeArgs {
+  std::string model;
+  std::string out = "-";
+  /// NAME=VALUE: an effect parameter (backlash, motor_offset, theta1_max, theta2_bias,
+  /// compliance_link2, theta3_fraction, ...) or one outside the diagnosable list
+  /// (ripple_amplitude, ripple_period, theta3_hysteresis).
+  std::vector<std::string> effects;
+  std::uint64_t seed = 1;
+  int free_runs = 4;
+  int samples = 512;
+};
+
+/// Runs `hybrid synthesize`; returns 0. Throws std::invalid_argument for a bad option (exit 2).
+int RunSynthesize(const SynthesizeArgs& args);
+
+}  // namespace hybrid::cli
