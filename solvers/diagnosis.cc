@@ -166,6 +166,7 @@ class Engine {
   const std::array<double, 3>& sigma() const { return sigma_; }
 
   FingerPrediction Checked(int r, const FingerEffects& e) const {
+    ++simulations_;
     FingerPrediction p = predictor_.Predict(data_.runs[r], e);
     if (p.status != SimulationStatus::kCompleted) {
       throw std::invalid_argument("Diagnose: the model stopped on run '" + data_.runs[r].label +
@@ -389,6 +390,11 @@ class Engine {
   std::vector<FingerPrediction> baseline_;
   std::vector<int> representative_;  // the first run with the same motor path and object
   mutable std::mutex memo_mutex_;
+
+ public:
+  mutable std::atomic<long> simulations_{0};
+
+ private:
   mutable std::map<std::string, std::shared_ptr<const FingerPrediction>> memo_;
   int samples_ = 0;
 };
@@ -527,6 +533,18 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
     if (d.change_points.size() > 50) d.change_points.resize(50);
   }
 
+  // A residual is systematic when its mean square exceeds the noise floor significantly.
+  auto systematic = [&](const std::array<double, 3>& mse, const std::vector<RunScore>& scores) {
+    for (int j = 0; j < 3; ++j) {
+      int n = 0;
+      for (const RunScore& s : scores) n += s.n[j];
+      if (n == 0) continue;
+      const double se = std::sqrt(2.0 / n + 2.0 / std::max(d.noise.dof[j], 1));
+      const double ratio = mse[j] / (sigma[j] * sigma[j]) - 1.0;
+      if (ratio > options.systematic_sigmas * se + options.systematic_margin) return true;
+    }
+    return false;
+  };
   // Single candidates.
   const std::vector<EffectParameter> all = AllEffectParameters();
   std::vector<Engine::Evaluated> singles;
@@ -573,7 +591,11 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
     named = one.fit.parameters;
     values = one.fit.values;
     final_scores = one.heldout;
-    // Pairs with the first cause.
+  }
+  // Pairs with the first cause, when it leaves a systematic residual (otherwise the residual is
+  // at the noise floor, and a second cause is not looked for).
+  if (first >= 0 && systematic(singles[first].fit.heldout_mse, singles[first].heldout)) {
+    const Engine::Evaluated& one = singles[first];
     FingerEffects base;
     SetEffect(base, all[first], one.fit.values[0]);
     std::vector<FingerPrediction> ref_predictions(R);
@@ -586,6 +608,8 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
       d.candidates.push_back(pairs.back().fit);
     }
     lap("pairs");
+    if (getenv("HYBRID_DIAGNOSE_TIMING"))
+      fprintf(stderr, "simulations: %ld\n", engine.simulations_.load());
     const int second = pick(pairs);
     if (second >= 0) {
       named = pairs[second].fit.parameters;
@@ -665,18 +689,6 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   for (size_t i = 0; i < named.size(); ++i) d.parameters.emplace_back(named[i], values[i]);
   d.extended_mse = mse_of(final_scores);
 
-  // Systematic residual left?
-  auto systematic = [&](const std::array<double, 3>& mse, const std::vector<RunScore>& scores) {
-    for (int j = 0; j < 3; ++j) {
-      int n = 0;
-      for (const RunScore& s : scores) n += s.n[j];
-      if (n == 0) continue;
-      const double se = std::sqrt(2.0 / n + 2.0 / std::max(d.noise.dof[j], 1));
-      const double ratio = mse[j] / (sigma[j] * sigma[j]) - 1.0;
-      if (ratio > options.systematic_sigmas * se + options.systematic_margin) return true;
-    }
-    return false;
-  };
   const bool base_systematic = systematic(d.baseline_mse, base_scores);
   const bool left = systematic(d.extended_mse, final_scores);
 

@@ -58,7 +58,7 @@ class FingerPredictor {
   /// About 1e-4 deg, four times faster on the phase-3 law (which CVODE integrates): far below
   /// the measurement noise. No interior double-crossing checks: the finger's guards cross once
   /// per piece (every flow is monotone along a piece of constant u).
-  static Options FastOptions() { return Options{1e-7, 1e-8, 0}; }
+  static Options FastOptions() { return Options{1e-6, 1e-7, 0}; }
   /// `finger` must be spec/finger.ha's automaton (names theta1..3, g, u, gob1, gob2, c1, c2);
   /// throws std::invalid_argument ("FingerPredictor: ...") otherwise.
   explicit FingerPredictor(Automaton finger);

@@ -306,9 +306,14 @@ void SmtEncoding::Classify() {
       const int w = ok ? var_slots_[info.driver] : -1;
       for (const auto& [v, f] : flows) {
         if (!ok || v == info.driver) continue;
-        // f = h * u or u * h.
+        // f = h * u or u * h (or c u: a second driver, e.g. a motor position beside the
+        // finger's drive, is separable with phi = 1).
         std::optional<Expression> h;
-        if (f.op() == Op::kMul) {
+        const auto affine = f.AsAffine();
+        if (affine && affine->constant == 0.0 && affine->terms.size() == 1 &&
+            affine->terms[0].first == u) {
+          h = Expression::Constant(affine->terms[0].second);
+        } else if (f.op() == Op::kMul) {
           if (f.args()[1].is_symbol() && f.args()[1].slot() == u)
             h = f.args()[0];
           else if (f.args()[0].is_symbol() && f.args()[0].slot() == u)

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -212,6 +213,12 @@ int RunDiagnose(const DiagnoseArgs& args) {
     files.emplace_back(args.out_model, text.str());
   }
   if (!args.report.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(args.report, error);
+    if (error) {
+      throw OutputError("cannot create the report directory '" + args.report +
+                        "': " + error.message());
+    }
     files.emplace_back(args.report + "/diagnosis.json", report.dump(2) + "\n");
     for (auto& f : DiagnosisReportFiles(d, args.report)) files.push_back(std::move(f));
   }
@@ -265,7 +272,7 @@ int RunSynthesize(const SynthesizeArgs& args) {
   const MeasuredData data = Synthesize(predictor, hidden, design);
   std::vector<std::string> comment = {
       "SYNTHETIC data (not measured): made by `hybrid synthesize` from the finger model",
-      "  " + args.model,
+      "  " + std::filesystem::path(args.model).filename().string(),
       "with seed " + std::to_string(args.seed) + ", " + std::to_string(args.free_runs) +
           " free runs, " + std::to_string(args.samples) + " samples per run, and hidden effects:"};
   if (args.effects.empty()) comment.push_back("  none");

@@ -55,3 +55,14 @@ echo "=== check ==="
 grep -c '"verdict": "proved"' "$out/check_hand.json" | sed 's/^/hand: proved properties: /'
 "$hybrid" check spec/finger.ha --modes --json > "$out/check_finger_modes.json"
 echo "wrote out/check_finger.json, out/check_hand.json, out/check_finger_modes.json"
+echo
+
+# Diagnosis from measured data (docs/diagnosis.md): the bundled demo data (SYNTHETIC: made by
+# `hybrid synthesize --effect backlash=6 --effect theta3_bias=2.5 --seed 7`, see its header) are
+# diagnosed; the extended model is written and `hybrid check` proves the finger's invariants on it.
+echo "=== diagnose ==="
+"$hybrid" diagnose data/finger_demo.csv --out-model "$out/finger_extended.ha" --report "$out/diagnosis"
+"$hybrid" diagnose data/finger_demo.csv --json > "$out/diagnosis.json"
+"$hybrid" check "$out/finger_extended.ha" --json > "$out/check_finger_extended.json"
+grep -c '"verdict": "proved"' "$out/check_finger_extended.json" | sed 's/^/extended finger: proved properties: /'
+echo "wrote out/diagnosis.json, out/diagnosis/ (SVG plots), out/finger_extended.ha, out/check_finger_extended.json"
