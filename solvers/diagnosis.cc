@@ -4,10 +4,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <map>
@@ -166,7 +164,6 @@ class Engine {
   const std::array<double, 3>& sigma() const { return sigma_; }
 
   FingerPrediction Checked(int r, const FingerEffects& e) const {
-    ++simulations_;
     FingerPrediction p = predictor_.Predict(data_.runs[r], e);
     if (p.status != SimulationStatus::kCompleted) {
       throw std::invalid_argument("Diagnose: the model stopped on run '" + data_.runs[r].label +
@@ -390,11 +387,6 @@ class Engine {
   std::vector<FingerPrediction> baseline_;
   std::vector<int> representative_;  // the first run with the same motor path and object
   mutable std::mutex memo_mutex_;
-
- public:
-  mutable std::atomic<long> simulations_{0};
-
- private:
   mutable std::map<std::string, std::shared_ptr<const FingerPrediction>> memo_;
   int samples_ = 0;
 };
@@ -549,13 +541,8 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   const std::vector<EffectParameter> all = AllEffectParameters();
   std::vector<Engine::Evaluated> singles;
   for (const EffectParameter& p : all) {
-    const auto t0 = std::chrono::steady_clock::now();
     singles.push_back(
         engine.Evaluate(p, FingerEffects{}, std::nullopt, {}, base_scores, base_predictions));
-    if (getenv("HYBRID_DIAGNOSE_TIMING")) {
-      fprintf(stderr, "%s: %.3f s\n", ParameterName(p).c_str(),
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
     d.candidates.push_back(singles.back().fit);
   }
   auto pick = [&](const std::vector<Engine::Evaluated>& evs) -> int {
@@ -574,13 +561,6 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
       }
     }
     return best;
-  };
-  auto lap = [t0 = std::chrono::steady_clock::now()](const char* what) mutable {
-    if (getenv("HYBRID_DIAGNOSE_TIMING")) {
-      const auto now = std::chrono::steady_clock::now();
-      fprintf(stderr, "%s: %.3f s\n", what, std::chrono::duration<double>(now - t0).count());
-      t0 = now;
-    }
   };
   const int first = pick(singles);
   std::vector<EffectParameter> named;
@@ -607,9 +587,6 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
           engine.Evaluate(p, base, all[first], one.fold_values, one.heldout, ref_predictions));
       d.candidates.push_back(pairs.back().fit);
     }
-    lap("pairs");
-    if (getenv("HYBRID_DIAGNOSE_TIMING"))
-      fprintf(stderr, "simulations: %ld\n", engine.simulations_.load());
     const int second = pick(pairs);
     if (second >= 0) {
       named = pairs[second].fit.parameters;
@@ -684,7 +661,6 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
     effects = FingerEffects{};
     for (size_t i = 0; i < named.size(); ++i) SetEffect(effects, named[i], values[i]);
   }
-  lap("refine");
   d.effects = effects;
   for (size_t i = 0; i < named.size(); ++i) d.parameters.emplace_back(named[i], values[i]);
   d.extended_mse = mse_of(final_scores);
