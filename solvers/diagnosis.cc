@@ -595,6 +595,17 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
     }
   }
 
+  // Unexplained: the best extension (or the baseline, when nothing is significant) still leaves
+  // a systematic residual. No extension is adopted then; `where` locates the residual.
+  const bool base_systematic = systematic(d.baseline_mse, base_scores);
+  const bool unexplained = systematic(mse_of(final_scores), final_scores) ||
+                           (named.empty() && base_systematic);
+  if (unexplained) {
+    named.clear();
+    values.clear();
+    final_scores = base_scores;
+  }
+
   // Refine the named parameters on all runs (Ceres; Huber loss per sample).
   FingerEffects effects;
   for (size_t i = 0; i < named.size(); ++i) SetEffect(effects, named[i], values[i]);
@@ -665,9 +676,6 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   for (size_t i = 0; i < named.size(); ++i) d.parameters.emplace_back(named[i], values[i]);
   d.extended_mse = mse_of(final_scores);
 
-  const bool base_systematic = systematic(d.baseline_mse, base_scores);
-  const bool left = systematic(d.extended_mse, final_scores);
-
   // Final predictions and curves.
   std::vector<FingerPrediction> final_predictions(R);
   ParallelFor(R, options.threads,
@@ -681,7 +689,7 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
     c.extended = final_predictions[r].theta;
     d.curves.push_back(std::move(c));
   }
-  if (left || (named.empty() && base_systematic)) {
+  if (unexplained) {
     d.cause = {"unexplained"};
     const std::vector<ResidualGroup> groups = analyse(final_predictions);
     const ResidualGroup* worst = nullptr;
