@@ -310,6 +310,10 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
   // The play's transitions first: they take priority over the finger's at the same instant.
   const Expression zero = Expression::Constant(0.0);
   const Expression top = Expression::Constant(kMotorMax);
+  // A finger stopped at an end of the motor range engages again only from 1e-6 counts inside it
+  // (a strict `g > 0` would hold at a rounding-level g and chatter with the stop).
+  const Expression zero_in = Expression::Constant(1e-6);
+  const Expression top_in = Expression::Constant(kMotorMax - 1e-6);
   auto add = [&](const std::string& name, ModeId from, ModeId to, std::vector<Comparison> guard) {
     Transition t;
     t.name = name;
@@ -325,10 +329,10 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
     add("stop_" + name + "_closing", closing, slack,
         {Compare(g, Relation::kGreaterEqual, top), Compare(u, Relation::kGreater, zero)});
     add("engage_" + name + "_closing", slack, closing,
-        {Compare(gm - d, Relation::kGreaterEqual, g), Compare(g, Relation::kLess, top),
+        {Compare(gm - d, Relation::kGreaterEqual, g), Compare(g, Relation::kLessEqual, top_in),
          Compare(u, Relation::kGreater, zero)});
     add("engage_" + name + "_opening", slack, opening,
-        {Compare(gm - d + b, Relation::kLessEqual, g), Compare(g, Relation::kGreater, zero),
+        {Compare(gm - d + b, Relation::kLessEqual, g), Compare(g, Relation::kGreaterEqual, zero_in),
          Compare(u, Relation::kLess, zero)});
     add("reverse_" + name + "_opening", opening, slack, {Compare(u, Relation::kGreater, zero)});
     add("stop_" + name + "_opening", opening, slack,

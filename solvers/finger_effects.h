@@ -87,10 +87,11 @@ Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effe
 ///   finger frozen while the motor moves) and M_opening (engaged, g = g_motor - d + b); the
 ///   finger's transitions are kept in the engaged copies; the play's transitions come first
 ///   (priority): closing -> slack when u < 0 or g reaches 255, slack -> closing when
-///   g_motor - d >= g and u > 0, slack -> opening when g_motor - d + b <= g and u < 0,
-///   opening -> slack when u > 0 or g reaches 0. The new variable g_motor is the measured motor
-///   position: it moves with g in the engaged copies (and stalls with it where the finger stops
-///   the motor, phase 4) and at rate u in the slack copies; g stays the finger's drive position;
+///   g_motor - d >= g, g <= 255 - 1e-6 and u > 0, slack -> opening when g_motor - d + b <= g,
+///   g >= 1e-6 and u < 0, opening -> slack when u > 0 or g reaches 0. The new variable g_motor is
+///   the measured motor position: it moves with g in the engaged copies (and stalls with it where
+///   the finger stops the motor, phase 4) and at rate u in the slack copies; g stays the finger's
+///   drive position;
 /// - sensor biases: variables theta<j>_measured = theta<j> + bias (same flows and resets), only
 ///   for non-zero biases.
 /// The initial state is the motor at 0 and the finger where DrivePositions puts it (for d < 0,

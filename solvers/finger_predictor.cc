@@ -14,6 +14,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // gob beyond the motor range: no object (spec/finger.ha's parameter range is [0, 256]).
 constexpr double kNoObject = 256.0;
 constexpr double kMotorMax = 255.0;
+// Simulators kept by FingerPredictor (each holds the compiled model, about 100 kB).
+constexpr size_t kMaxCached = 256;
 
 // Step-signal points with strictly increasing times: of several points at one time the last
 // holds (pieces shorter than the time's rounding vanish), and repeated values are merged.
@@ -81,6 +83,9 @@ std::shared_ptr<const FingerPredictor::Entry> FingerPredictor::SimulatorFor(
   }
   auto sim = std::make_shared<const Entry>(System::Of(std::move(a)));
   std::lock_guard<std::mutex> lock(mutex_);
+  // Bounded: a fit visits many parameter values once (entries in use stay alive through their
+  // shared_ptr).
+  if (cache_.size() >= kMaxCached) cache_.clear();
   return cache_.emplace(key, std::move(sim)).first->second;
 }
 

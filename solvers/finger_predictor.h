@@ -42,10 +42,15 @@ struct FingerPrediction {
 /// along q, so that time is the drive's path length and each sample is recorded at its position
 /// on the path (the model is rate-independent: every flow is proportional to u). Sensor biases
 /// are added to the angles. This equals simulating ExtendFingerModel's automaton with the motor
-/// path (tests/solvers/finger_predictor_test.cc checks it to 1e-6 deg).
+/// path (tests/solvers/finger_predictor_test.cc checks it to 1e-6 deg) whenever the motor does
+/// not travel past a point where the finger stalled it (phase 4), as a physical motor cannot.
+/// Data that do (the motor's g goes on past the stall) are still predicted: the finger stays
+/// stopped, reverses when g does, and stops at the ends of the motor range; the extended
+/// automaton's g_motor instead stalls with the finger, so after such over-travel the two may
+/// differ by the over-travel.
 ///
-/// Simulators are built once per distinct (dynamic effects, object) and cached; Predict is safe
-/// to call from several threads.
+/// Simulators are built once per distinct (dynamic effects, object) and cached (at most 256;
+/// the cache is emptied when full); Predict is safe to call from several threads.
 class FingerPredictor {
  public:
   /// Integration settings (SimulationOptions). The defaults keep the angles within about 1e-7

@@ -15,6 +15,7 @@
 #include "solvers/measured_data.h"
 #include "solvers/synthetic_data.h"
 #include "tools/diagnosis_report.h"
+#include "tools/gripper_command.h"
 #include "tools/output.h"
 
 namespace hybrid::cli {
@@ -24,13 +25,19 @@ using json = nlohmann::ordered_json;
 
 const char* const kJoints[3] = {"theta1", "theta2", "theta3"};
 
-Automaton LoadFinger(const std::string& path) {
+// The finger automaton of `path`: an invalid model (ParseError) or one that is not the finger
+// (InputError) exits 1.
+FingerPredictor LoadPredictor(const std::string& path, FingerPredictor::Options options) {
   const System system = ParseModelFile(path);
   if (system.components().size() != 1) {
-    throw std::invalid_argument(path + ": expected one finger automaton (spec/finger.ha), got " +
-                                std::to_string(system.components().size()) + " components");
+    throw InputError(path + ": expected one finger automaton (spec/finger.ha), got " +
+                     std::to_string(system.components().size()) + " components");
   }
-  return system.components()[0].automaton;
+  try {
+    return FingerPredictor(system.components()[0].automaton, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(path + ": " + e.what());
+  }
 }
 
 json PerJoint(const std::array<double, 3>& v) {
@@ -46,9 +53,10 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   out["data"] = {{"file", args.data},
                  {"runs", d.curves.size()},
                  {"samples", d.samples},
-                 {"outliers_clamped", PerJoint({static_cast<double>(d.outliers.clamped[0]),
-                                                static_cast<double>(d.outliers.clamped[1]),
-                                                static_cast<double>(d.outliers.clamped[2])})},
+                 {"outliers_clamped",
+                  {{"theta1", d.outliers.clamped[0]},
+                   {"theta2", d.outliers.clamped[1]},
+                   {"theta3", d.outliers.clamped[2]}}},
                  {"outlier_rule",
                   "report section 5.1: a change of more than 5 deg from the "
                   "previous inlier and the next sample is clamped to within 5 "
@@ -186,7 +194,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
   }
   const auto start = std::chrono::steady_clock::now();
   MeasuredData data = ReadMeasuredDataFile(args.data);
-  const FingerPredictor predictor(LoadFinger(args.model), FingerPredictor::FastOptions());
+  const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::FastOptions());
   DiagnosisOptions options;
   options.significance = args.significance;
   options.threads = args.threads;
@@ -214,7 +222,10 @@ int RunDiagnose(const DiagnoseArgs& args) {
   }
   if (!args.report.empty()) {
     std::error_code error;
-    std::filesystem::create_directories(args.report, error);
+    // One level only: a mistyped parent is an error, not a new directory tree.
+    if (!std::filesystem::is_directory(args.report)) {
+      std::filesystem::create_directory(args.report, error);
+    }
     if (error) {
       throw OutputError("cannot create the report directory '" + args.report +
                         "': " + error.message());
@@ -229,7 +240,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
 
 int RunSynthesize(const SynthesizeArgs& args) {
   HiddenEffects hidden;
-  const FingerPredictor predictor(LoadFinger(args.model));
+  const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::Options{});
   for (const std::string& e : args.effects) {
     const size_t eq = e.find('=');
     if (eq == std::string::npos)

@@ -454,7 +454,7 @@ TEST(Parser, FingerModel) {
   EXPECT_EQ(a.variables().size(), 6u);  // theta1..3, g, theta3_s, g_s
   EXPECT_EQ(a.discrete_variables().size(), 6u);
   EXPECT_EQ(a.inputs().size(), 1u);
-  EXPECT_EQ(a.parameters().size(), 11u);
+  EXPECT_EQ(a.parameters().size(), 13u);
   EXPECT_EQ(a.initial_states().size(), 1u);
   EXPECT_EQ(a.mode(a.initial_states()[0].mode).name, "c000_l000");
   EXPECT_EQ(a.properties().size(), 13u);
