@@ -31,30 +31,7 @@ std::string Px(double value) {
 // A value for a label: rounded to two decimals, printed shortest ("110", "62.5").
 std::string Label(double value) { return FormatNumber(std::round(value * 100.0) / 100.0 + 0.0); }
 
-// Text content for XML (quotes need no escaping outside attributes); control characters other
-// than tab and newline become spaces.
-std::string Escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      default: {
-        // Control characters are not allowed in XML 1.0.
-        const bool control = static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n';
-        out += control ? ' ' : c;
-      }
-    }
-  }
-  return out;
-}
+std::string Escape(std::string_view text) { return XmlEscape(text); }
 
 void OpenSvg(std::ostringstream& out, double width, double height, const std::string& title) {
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Px(width) << "\" height=\""
@@ -514,6 +491,36 @@ std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string&
   }
   out << "</g>\n</svg>\n";
   return out.str();
+}
+
+std::string XmlEscape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default: {
+        // Control characters other than tab and newline are not allowed in XML 1.0.
+        const bool control = static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n';
+        out += control ? ' ' : c;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace hybrid::gripper

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <tuple>
 
+#include "gripper/svg_figures.h"
 #include "solvers/finger_effects.h"
 
 namespace hybrid::cli {
@@ -40,38 +41,7 @@ std::string Num(double x) {
   return s;
 }
 
-/// XML-escapes text and attribute values.
-std::string Escape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        // Control characters other than tab/newline are not allowed in XML 1.0.
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n') {
-          out += ' ';
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
+std::string Escape(std::string_view text) { return gripper::XmlEscape(text); }
 
 double At(const std::vector<double>& v, std::size_t i) {
   return i < v.size() ? v[i] : std::nan("");
