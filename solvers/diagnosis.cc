@@ -397,7 +397,49 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
                    const DiagnosisOptions& options) {
   if (data.runs.empty()) throw std::invalid_argument("Diagnose: the data have no runs");
   Diagnosis d;
-  d.outliers = CleanOutliers(data, options.outlier_threshold);
+  // The report's outlier rule, applied to the residual against the baseline model: "a change in
+  // sensed angle of more than 5 degrees from one value of g to the next" cannot happen on the
+  // robot, except where the model itself moves that fast (the phase-3 law near g = 255 does),
+  // so the rule looks at changes beyond the model's.
+  {
+    const int runs = static_cast<int>(data.runs.size());
+    std::vector<FingerPrediction> base(runs);
+    ParallelFor(runs, options.threads, [&](int r) {
+      base[r] = predictor.Predict(data.runs[r], FingerEffects{});
+      if (base[r].status != SimulationStatus::kCompleted) {
+        throw std::invalid_argument("Diagnose: the model stopped on run '" + data.runs[r].label +
+                                    "': " + base[r].message);
+      }
+    });
+    MeasuredData residual = data;
+    for (int r = 0; r < runs; ++r) {
+      for (int j = 0; j < 3; ++j) {
+        for (size_t k = 0; k < data.runs[r].g.size(); ++k) {
+          residual.runs[r].theta[j][k] -= base[r].theta[j][k];
+        }
+      }
+    }
+    d.outliers = CleanOutliers(residual, options.outlier_threshold);
+    for (int r = 0; r < runs; ++r) {
+      for (int j = 0; j < 3; ++j) {
+        for (size_t k = 0; k < data.runs[r].g.size(); ++k) {
+          data.runs[r].theta[j][k] = residual.runs[r].theta[j][k] + base[r].theta[j][k];
+        }
+      }
+    }
+    // Entries back in measured angles.
+    for (OutlierReport::Entry& e : d.outliers.entries) {
+      for (int r = 0; r < runs; ++r) {
+        const MeasuredRun& run = data.runs[r];
+        if (run.label != e.run) continue;
+        const auto it = std::find(run.lines.begin(), run.lines.end(), e.line);
+        if (it == run.lines.end()) continue;
+        const double model = base[r].theta[e.joint - 1][it - run.lines.begin()];
+        e.measured += model;
+        e.cleaned += model;
+      }
+    }
+  }
   d.noise = EstimateNoiseFloor(data);
   d.samples = data.samples();
   const Engine engine(predictor, data, options, d.noise);
@@ -598,8 +640,8 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   // Unexplained: the best extension (or the baseline, when nothing is significant) still leaves
   // a systematic residual. No extension is adopted then; `where` locates the residual.
   const bool base_systematic = systematic(d.baseline_mse, base_scores);
-  const bool unexplained = systematic(mse_of(final_scores), final_scores) ||
-                           (named.empty() && base_systematic);
+  const bool unexplained =
+      systematic(mse_of(final_scores), final_scores) || (named.empty() && base_systematic);
   if (unexplained) {
     named.clear();
     values.clear();
