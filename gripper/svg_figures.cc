@@ -493,7 +493,7 @@ std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string&
   return out.str();
 }
 
-std::string XmlEscape(std::string_view text) {
+std::string XmlEscape(std::string_view text, bool attribute) {
   std::string out;
   out.reserve(text.size());
   for (char c : text) {
@@ -508,10 +508,10 @@ std::string XmlEscape(std::string_view text) {
         out += "&gt;";
         break;
       case '"':
-        out += "&quot;";
+        out += attribute ? "&quot;" : "\"";
         break;
       case '\'':
-        out += "&apos;";
+        out += attribute ? "&apos;" : "'";
         break;
       default: {
         // Control characters other than tab and newline are not allowed in XML 1.0.

@@ -85,8 +85,9 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
 /// decimals, so the output is deterministic. Does not throw (apart from std::bad_alloc).
 std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title);
 
-/// `text` escaped for XML text and attribute values (& < > " '); control characters other than
-/// tab and newline (not allowed in XML 1.0) become spaces. Shared by every SVG writer.
-std::string XmlEscape(std::string_view text);
+/// `text` escaped for XML: & < > always, and " ' too when `attribute` (text content needs no
+/// quote escaping); control characters other than tab and newline (not allowed in XML 1.0)
+/// become spaces. Shared by every SVG writer.
+std::string XmlEscape(std::string_view text, bool attribute = false);
 
 }  // namespace hybrid::gripper

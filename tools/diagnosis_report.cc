@@ -41,7 +41,7 @@ std::string Num(double x) {
   return s;
 }
 
-std::string Escape(std::string_view text) { return gripper::XmlEscape(text); }
+std::string Escape(std::string_view text) { return gripper::XmlEscape(text, true); }
 
 double At(const std::vector<double>& v, std::size_t i) {
   return i < v.size() ? v[i] : std::nan("");
