@@ -136,8 +136,10 @@ double Minimise(const Profile& p, const std::vector<char>& use) {
 
 class Engine {
  public:
+  // `baseline`: the model's predictions of every run with no effect (Diagnose computes them
+  // once, before cleaning).
   Engine(const FingerPredictor& predictor, const MeasuredData& data, const DiagnosisOptions& o,
-         const NoiseFloor& noise)
+         const NoiseFloor& noise, std::vector<FingerPrediction> baseline)
       : predictor_(predictor), data_(data), o_(o) {
     for (int j = 0; j < 3; ++j) {
       sigma_[j] = std::sqrt(std::max(noise.variance[j], 1e-12));
@@ -154,8 +156,7 @@ class Engine {
         }
       }
     }
-    baseline_.resize(runs);
-    ParallelFor(runs, o.threads, [&](int r) { baseline_[r] = Checked(r, FingerEffects{}); });
+    baseline_ = std::move(baseline);
     for (const MeasuredRun& run : data.runs) samples_ += static_cast<int>(run.g.size());
   }
 
@@ -401,9 +402,9 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   // sensed angle of more than 5 degrees from one value of g to the next" cannot happen on the
   // robot, except where the model itself moves that fast (the phase-3 law near g = 255 does),
   // so the rule looks at changes beyond the model's.
+  const int runs = static_cast<int>(data.runs.size());
+  std::vector<FingerPrediction> base(runs);
   {
-    const int runs = static_cast<int>(data.runs.size());
-    std::vector<FingerPrediction> base(runs);
     ParallelFor(runs, options.threads, [&](int r) {
       base[r] = predictor.Predict(data.runs[r], FingerEffects{});
       if (base[r].status != SimulationStatus::kCompleted) {
@@ -442,7 +443,7 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   }
   d.noise = EstimateNoiseFloor(data);
   d.samples = data.samples();
-  const Engine engine(predictor, data, options, d.noise);
+  const Engine engine(predictor, data, options, d.noise, std::move(base));
   const int R = engine.runs();
   const std::array<double, 3> sigma = engine.sigma();
 
