@@ -18,6 +18,7 @@ packages=(
   nlohmann-json3-dev     # --json output
   graphviz               # `dot -Tsvg` for the rendered mode graphs
   clang-format
+  clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz/, tools/fuzz.sh) and their sanitizer runtimes
   python3                # tools/generate_finger.py (checked by a test), benchmark scripts
   python3-scipy python3-numpy  # tools/compare_scipy.py: the finger simulated by solve_ivp
 )

@@ -1,7 +1,49 @@
 #!/usr/bin/env bash
-# Installs, builds and runs every test (rapidcheck seeds pinned in tests/CMakeLists.txt).
+# Installs, builds and runs every test (rapidcheck seeds pinned in tests/CMakeLists.txt), in three
+# stages, all run by default (this is what `.ci/run` calls):
+#   release    the Release build in build/ and its whole suite (ctest);
+#   sanitized  the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer with leak
+#              detection on (build-asan/, -O1, fewer rapidcheck cases); any finding fails its test;
+#   fuzz       every libFuzzer harness (tests/fuzz/) for a short bounded time (tools/fuzz.sh).
+# Usage: tools/test.sh [release] [sanitized] [fuzz]      (no argument: all three)
+# Environment: HYBRID_FUZZ_SECONDS (default 20) seconds per harness in the fuzz stage.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/tools/build.sh"
-cd "$root/build"
-ctest --output-on-failure -j "$(nproc)"
+stages=("$@")
+[ ${#stages[@]} -gt 0 ] || stages=(release sanitized fuzz)
+jobs=$(nproc)
+
+run_release() {
+  "$root/tools/build.sh"
+  (cd "$root/build" && ctest --output-on-failure -j "$jobs")
+}
+
+run_sanitized() {
+  "$root/tools/setup.sh"
+  cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHYBRID_SANITIZE=ON \
+    -DHYBRID_BUILD_BENCHMARKS=OFF \
+    -DHYBRID_RC_PARAMS="seed=20261121 max_success=60" \
+    -DHYBRID_RC_PARAMS_SLOW="seed=20261121 max_success=20"
+  cmake --build "$root/build-asan" -j "$jobs"
+  # Leak detection on; any report aborts the test (non-zero exit); suppressions only for the
+  # uninstrumented system libraries' own allocations (tests/sanitizer/lsan.supp says which and why).
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=0:strict_string_checks=1"
+  export LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp:print_suppressions=0"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  (cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" --timeout 900)
+}
+
+run_fuzz() {
+  "$root/tools/fuzz.sh" --seconds "${HYBRID_FUZZ_SECONDS:-20}"
+}
+
+for stage in "${stages[@]}"; do
+  echo "=== test stage: $stage ==="
+  case "$stage" in
+    release) run_release ;;
+    sanitized) run_sanitized ;;
+    fuzz) run_fuzz ;;
+    *) echo "tools/test.sh: unknown stage '$stage' (expected release, sanitized or fuzz)" >&2; exit 2 ;;
+  esac
+done
+echo "=== all test stages passed: ${stages[*]} ==="
