@@ -1,11 +1,11 @@
 #include "gripper/obstacle.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <vector>
 
 #include "automaton/expression.h"
+#include "automaton/number_syntax.h"
 
 namespace hybrid::gripper {
 namespace {
@@ -50,28 +50,26 @@ Obstacle Obstacle::Parse(std::string_view text) {
     const char* field = text.data() + at;
     const char* end = text.data() + text.size();
     const char* stop = std::find(field, end, ',');
-    // The number itself: without surrounding spaces, and without a leading '+'.
+    // The number itself, without surrounding spaces, in the decimal syntax of
+    // automaton/number_syntax.h.
     const char* begin = field;
     while (begin < stop && *begin == ' ') ++begin;
     const char* last = stop;
     while (last > begin && last[-1] == ' ') --last;
-    const char* digits = begin < last && *begin == '+' ? begin + 1 : begin;
-    double value = 0.0;
-    const auto [ptr, ec] = std::from_chars(digits, last, value);
     const int column = static_cast<int>(begin - text.data()) + 1;
-    const std::string shown(begin, last);
-    if (begin == last) throw ObstacleParseError(column, "expected a number");
-    if (ec == std::errc::result_out_of_range) {
-      throw ObstacleParseError(column, "number '" + shown + "' is out of the range of a double");
+    const std::string_view number(begin, static_cast<size_t>(last - begin));
+    const NumberRead<double> read = ReadDecimal(number);
+    if (read.error == NumberError::kEmpty) throw ObstacleParseError(column, "expected a number");
+    if (read.error == NumberError::kSyntax) {
+      throw ObstacleParseError(column + static_cast<int>(read.stop),
+                               "malformed number '" + std::string(number) + "'");
     }
-    if (ec != std::errc() || ptr != last) {
+    if (read.error == NumberError::kOverflow) {
       throw ObstacleParseError(
-          column + static_cast<int>((ec == std::errc() ? ptr : digits) - begin),
-          "malformed number '" + shown + "'");
+          column, "number '" + std::string(number) + "' is out of the range of a double");
     }
-    if (!std::isfinite(value)) {
-      throw ObstacleParseError(column, "number '" + shown + "' is not finite");
-    }
+    if (!read.ok()) throw ObstacleParseError(column, NumberErrorMessage(number, read.error));
+    const double value = read.value;
     numbers.push_back({value, column});
     if (stop == end) break;
     at = static_cast<size_t>(stop - text.data()) + 1;

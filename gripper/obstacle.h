@@ -41,8 +41,10 @@ class Obstacle {
   static Obstacle Bar(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius);
 
   /// Parses "circle:X,Y,R" or "segment:X1,Y1,X2,Y2[,R]" (metres, finger frame; R of a segment
-  /// defaults to kDefaultBarRadius; numbers may carry a sign and surrounding spaces). Throws
-  /// ObstacleParseError naming the column.
+  /// defaults to kDefaultBarRadius). Each number is in the decimal syntax of
+  /// automaton/number_syntax.h (one optional sign, no hexadecimal, no inf or nan), with spaces
+  /// around it allowed. Throws ObstacleParseError naming the column (of the first character
+  /// that does not fit, for a malformed number).
   static Obstacle Parse(std::string_view text);
   static constexpr double kDefaultBarRadius = 0.005;
 

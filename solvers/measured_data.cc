@@ -1,6 +1,7 @@
 #include "solvers/measured_data.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -12,6 +13,8 @@
 #include <string_view>
 #include <system_error>
 #include <utility>
+
+#include "automaton/number_syntax.h"
 
 namespace hybrid {
 
@@ -27,6 +30,15 @@ constexpr double kMaxCounts = 255.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+
+// Whether `cell` is a sign and "nan", "inf" or "infinity" in any case (refused as not finite,
+// a friendlier message than "not a number").
+bool NamesNonFinite(std::string_view cell) {
+  if (!cell.empty() && (cell.front() == '+' || cell.front() == '-')) cell.remove_prefix(1);
+  std::string lower(cell);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == "nan" || lower == "inf" || lower == "infinity";
+}
 
 std::string_view Trim(std::string_view s) {
   while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
@@ -162,23 +174,22 @@ class Reader {
     }
   }
 
-  // The number in non-empty `cell` (column `column`, 1-based), finite.
+  // The number in non-empty `cell` (column `column`, 1-based), finite, in the decimal syntax of
+  // automaton/number_syntax.h.
   double ParseNumber(std::string_view cell, int column, Field field) const {
-    double value = 0.0;
-    const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+    const NumberRead<double> r = ReadDecimal(cell);
     const std::string quoted = Quoted(cell);
-    if (ec == std::errc::result_out_of_range && end == cell.data() + cell.size()) {
-      const size_t e = cell.find_first_of("eE");
-      if (e != std::string_view::npos && e + 1 < cell.size() && cell[e + 1] == '-') {
+    switch (r.error) {
+      case NumberError::kNone:
+        return r.value;
+      case NumberError::kOverflow:
+        FailCell(column, field, "not finite (out of the range of a double): " + quoted);
+      case NumberError::kUnderflow:
         FailCell(column, field, "too small for a double: " + quoted);
-      }
-      FailCell(column, field, "not finite (out of the range of a double): " + quoted);
+      default:
+        FailCell(column, field,
+                 (NamesNonFinite(cell) ? "not finite: " : "not a number: ") + quoted);
     }
-    if (ec != std::errc() || end != cell.data() + cell.size()) {
-      FailCell(column, field, "not a number: " + quoted);
-    }
-    if (!std::isfinite(value)) FailCell(column, field, "not finite: " + quoted);
-    return value;
   }
 
   double ParseCounts(std::string_view cell, int column, Field field) const {

@@ -18,8 +18,10 @@
 // kMinRunSamples rows. A line whose first non-blank character is `#` is a comment; a line of only
 // blanks is ignored; both may appear anywhere, also before the header. Cells are trimmed of
 // surrounding spaces and tabs. Lines may end with "\r\n"; a UTF-8 byte-order mark at the start
-// of the file is skipped. Numbers are read with std::from_chars (locale-independent, decimal or
-// scientific notation, no leading '+'), and the whole trimmed cell must be a number.
+// of the file is skipped. Numbers are in the one decimal syntax of the command line
+// (automaton/number_syntax.h: an optional sign, digits with an optional fraction and exponent; no
+// hexadecimal, inf or nan), read with std::from_chars (locale-independent), and the whole
+// trimmed cell must be a number.
 
 #include <array>
 #include <istream>

@@ -21,7 +21,7 @@ constexpr double kOutlierMin = 10.0;
 constexpr double kOutlierMax = 25.0;
 
 [[noreturn]] void Fail(const std::string& message) {
-  throw std::invalid_argument("Synthesize: " + message);
+  throw std::invalid_argument("synthetic data: " + message);
 }
 
 std::string Number(double v) {
@@ -49,14 +49,24 @@ class Draws {
 };
 
 void CheckDesign(const HiddenEffects& hidden, const SyntheticDesign& design) {
-  if (design.free_runs < 0)
-    Fail("free_runs is negative (" + std::to_string(design.free_runs) + ")");
+  if (design.free_runs < 0 || design.free_runs > kMaxSyntheticFreeRuns) {
+    Fail("free_runs must lie in [0, " + std::to_string(kMaxSyntheticFreeRuns) + "] (is " +
+         std::to_string(design.free_runs) + ")");
+  }
   if (design.free_runs == 0 && design.link1_gob.empty() && design.link2_gob.empty()) {
     Fail("the design has no runs");
   }
   if (design.samples_per_run < kMinRunSamples || design.samples_per_run % 2 != 0) {
     Fail("samples_per_run must be even and at least " + std::to_string(kMinRunSamples) + " (is " +
          std::to_string(design.samples_per_run) + ")");
+  }
+  const std::int64_t runs = static_cast<std::int64_t>(design.free_runs) +
+                            static_cast<std::int64_t>(design.link1_gob.size()) +
+                            static_cast<std::int64_t>(design.link2_gob.size());
+  if (runs * design.samples_per_run > kMaxSyntheticSamples) {
+    Fail(std::to_string(runs) + " runs of " + std::to_string(design.samples_per_run) +
+         " samples are " + std::to_string(runs * design.samples_per_run) + " rows; at most " +
+         std::to_string(kMaxSyntheticSamples) + " are made");
   }
   for (const auto* gobs : {&design.link1_gob, &design.link2_gob}) {
     for (const double gob : *gobs) {
@@ -200,7 +210,7 @@ std::string CsvNumber(double v) {
 }
 
 [[noreturn]] void WriteFail(const std::string& message) {
-  throw std::invalid_argument("WriteMeasuredData: " + message);
+  throw std::invalid_argument("cannot write measured data: " + message);
 }
 
 }  // namespace

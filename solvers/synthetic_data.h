@@ -34,9 +34,17 @@ struct HiddenEffects {
   double theta3_hysteresis = 0.0;
 };
 
+/// Caps on the size of synthetic data, checked by Synthesize before anything is allocated. At
+/// about 300 bytes per row at the peak of `hybrid synthesize` (the data, the CSV text and its
+/// copy), kMaxSyntheticSamples rows take about 0.3 GB and a few seconds.
+/// The most rows (samples over all runs) of a design.
+inline constexpr std::int64_t kMaxSyntheticSamples = 1000000;
+/// The most free-space runs of a design.
+inline constexpr int kMaxSyntheticFreeRuns = 10000;
+
 /// The runs of synthetic data and its measurement errors.
 struct SyntheticDesign {
-  /// Free-space runs (>= 0): g from 0 up to 230 and back to 0.
+  /// Free-space runs, in [0, kMaxSyntheticFreeRuns]: g from 0 up to 230 and back to 0.
   int free_runs = 4;
   /// One run per entry (counts, in [0, 255]): an object touching link 1 at gob; g commanded from
   /// 0 up to 255 and back to 0. The measured g stops where the finger stops the motor (the
@@ -45,7 +53,8 @@ struct SyntheticDesign {
   std::vector<double> link1_gob = {80, 80, 100};
   /// The same for an object touching link 2.
   std::vector<double> link2_gob = {170, 170, 190};
-  /// Samples per run: even, >= kMinRunSamples. The first half closes, the commanded g evenly
+  /// Samples per run: even, >= kMinRunSamples, and the rows of all runs (runs times samples)
+  /// at most kMaxSyntheticSamples. The first half closes, the commanded g evenly
   /// spaced from 0 to the top inclusive; the second half opens through the same positions in
   /// reverse (the top is commanded twice, once per half), so that repeated runs have identical g.
   /// Positions are rounded to multiples of 1/64 count (as is where the motor stops), so that
@@ -88,9 +97,10 @@ struct SyntheticDesign {
 /// designs that differ only in those share their draws (e.g. the noise of a design with outliers
 /// equals that of the same design without them). MeasuredData::source is "synthetic" and
 /// MeasuredRun::lines are the lines WriteMeasuredData without a comment gives (2, 3, ...). Throws
-/// std::invalid_argument ("Synthesize: ...") for a bad design (no runs, free_runs < 0,
-/// samples_per_run < kMinRunSamples or odd, a gob outside [0, 255], noise negative or not finite, a
-/// probability outside [0, 1]) or bad hidden effects (non-finite ripple or hysteresis,
+/// std::invalid_argument ("synthetic data: ...") for a bad design, before allocating anything
+/// (no runs, free_runs outside [0, kMaxSyntheticFreeRuns], samples_per_run < kMinRunSamples or
+/// odd, more than kMaxSyntheticSamples rows, a gob outside [0, 255], noise negative or not
+/// finite, a probability outside [0, 1]) or bad hidden effects (non-finite ripple or hysteresis,
 /// ripple_period <= 0; FingerPredictor::Predict's own checks), or if a prediction does not complete
 /// (naming the run and the predictor's message).
 MeasuredData Synthesize(const FingerPredictor& predictor, const HiddenEffects& hidden,
@@ -101,10 +111,10 @@ MeasuredData Synthesize(const FingerPredictor& predictor, const HiddenEffects& h
 /// `run,g,theta1,theta2,theta3,gob,contact_link`, then one row per sample. Numbers are written
 /// with at most 6 decimals, trailing zeros dropped (`%.6f`: they read back within 5e-7); a
 /// missing angle (NaN) and the gob and contact_link of a free-space run are empty cells. Throws
-/// std::invalid_argument ("WriteMeasuredData: ...") for what could not be read back: a label that
-/// is empty, starts with '#' or a blank, ends with a blank or holds ',', '"', '\r' or '\n';
-/// vectors of a run of unequal lengths; a value that is infinite (or NaN other than an angle);
-/// only one of gob and contact_link set.
+/// std::invalid_argument ("cannot write measured data: ...") for what could not be read back: a
+/// label that is empty, starts with '#' or a blank, ends with a blank or holds ',', '"', '\r' or
+/// '\n'; vectors of a run of unequal lengths; a value that is infinite (or NaN other than an
+/// angle); only one of gob and contact_link set.
 void WriteMeasuredData(std::ostream& out, const MeasuredData& data,
                        const std::vector<std::string>& comment);
 

@@ -16,6 +16,7 @@
 #include "solvers/synthetic_data.h"
 #include "tools/diagnosis_report.h"
 #include "tools/gripper_command.h"
+#include "tools/options.h"
 #include "tools/output.h"
 
 namespace hybrid::cli {
@@ -187,11 +188,26 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
 
 int RunDiagnose(const DiagnoseArgs& args) {
   if (args.threads < 1 || args.threads > 64) {
-    throw std::invalid_argument("--threads must lie in [1, 64]");
+    throw UsageError("--threads must lie in [1, 64]");
   }
   if (!(args.significance > 0) || !std::isfinite(args.significance)) {
-    throw std::invalid_argument("--significance must be positive");
+    throw UsageError("--significance must be positive");
   }
+  const std::vector<NamedFile> inputs = {{"DATA", args.data}, {"--model", args.model}};
+  const auto outputs = [&](const std::vector<std::pair<std::string, std::string>>& report) {
+    std::vector<NamedFile> out = {{"--out-model", args.out_model}};
+    for (const auto& [path, text] : report) out.push_back({"--report", path});
+    return out;
+  };
+  // The report's files with fixed names; the run files are known after the diagnosis.
+  std::vector<std::pair<std::string, std::string>> report_files;
+  if (!args.report.empty()) {
+    for (const char* name : {"diagnosis.json", "residuals.svg", "summary.svg"}) {
+      report_files.emplace_back(args.report + "/" + name, "");
+    }
+  }
+  CheckDistinctFiles(inputs, outputs(report_files));
+  CheckOutputPlaces({{"--out-model", args.out_model}}, {{"--report", args.report}});
   const auto start = std::chrono::steady_clock::now();
   MeasuredData data = ReadMeasuredDataFile(args.data);
   const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::FastOptions());
@@ -221,39 +237,59 @@ int RunDiagnose(const DiagnoseArgs& args) {
     files.emplace_back(args.out_model, text.str());
   }
   if (!args.report.empty()) {
-    std::error_code error;
-    // One level only: a mistyped parent is an error, not a new directory tree.
-    if (!std::filesystem::is_directory(args.report)) {
-      std::filesystem::create_directory(args.report, error);
-    }
-    if (error) {
-      throw OutputError("cannot create the report directory '" + args.report +
-                        "': " + error.message());
-    }
-    files.emplace_back(args.report + "/diagnosis.json", report.dump(2) + "\n");
-    for (auto& f : DiagnosisReportFiles(d, args.report)) files.push_back(std::move(f));
+    report_files = DiagnosisReportFiles(d, args.report);
+    report_files.insert(report_files.begin(),
+                        {args.report + "/diagnosis.json", report.dump(2) + "\n"});
+    CheckDistinctFiles(inputs, outputs(report_files));
+    for (auto& f : report_files) files.push_back(std::move(f));
   }
-  WriteOutputs(files);
+  // The report directory is created (with its parents) only now, and removed again if a file
+  // cannot be written.
+  WriteOutputs(files, args.report.empty() ? std::vector<std::string>{}
+                                          : std::vector<std::string>{args.report});
   WriteOutput("-", args.json ? report.dump(2) + "\n" : ToText(d, args, seconds));
   return 0;
 }
 
+// Checks the sizes of `hybrid synthesize` before anything is allocated (the caps of
+// solvers/synthetic_data.h). Throws UsageError naming the option.
+void CheckSyntheticSize(const SynthesizeArgs& args) {
+  if (args.free_runs < 0 || args.free_runs > kMaxSyntheticFreeRuns) {
+    throw UsageError("--free-runs must lie in [0, " + std::to_string(kMaxSyntheticFreeRuns) +
+                     "] (got " + std::to_string(args.free_runs) + ")");
+  }
+  if (args.samples < kMinRunSamples || args.samples % 2 != 0 ||
+      args.samples > kMaxSyntheticSamples) {
+    throw UsageError("--samples must be even and lie in [" + std::to_string(kMinRunSamples) + ", " +
+                     std::to_string(kMaxSyntheticSamples) + "] (got " +
+                     std::to_string(args.samples) + ")");
+  }
+  const SyntheticDesign design;
+  const std::int64_t runs = static_cast<std::int64_t>(args.free_runs) +
+                            static_cast<std::int64_t>(design.link1_gob.size()) +
+                            static_cast<std::int64_t>(design.link2_gob.size());
+  if (runs * args.samples > kMaxSyntheticSamples) {
+    throw UsageError("--free-runs " + std::to_string(args.free_runs) + " and --samples " +
+                     std::to_string(args.samples) + " make " + std::to_string(runs) + " runs of " +
+                     std::to_string(args.samples) + " samples, " +
+                     std::to_string(runs * args.samples) + " rows; at most " +
+                     std::to_string(kMaxSyntheticSamples) + " rows are made");
+  }
+}
+
 int RunSynthesize(const SynthesizeArgs& args) {
+  CheckSyntheticSize(args);
+  CheckDistinctFiles({{"--model", args.model}}, {{"--out", args.out}});
+  CheckOutputPlaces({{"--out", args.out}});
   HiddenEffects hidden;
   const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::Options{});
   for (const std::string& e : args.effects) {
     const size_t eq = e.find('=');
-    if (eq == std::string::npos)
-      throw std::invalid_argument("--effect " + e + ": expected NAME=VALUE");
-    const std::string name = e.substr(0, eq);
-    double value = 0.0;
-    try {
-      size_t used = 0;
-      value = std::stod(e.substr(eq + 1), &used);
-      if (used != e.size() - eq - 1 || !std::isfinite(value)) throw std::invalid_argument("");
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--effect " + e + ": the value is not a finite number");
+    if (eq == std::string::npos || eq == 0) {
+      throw UsageError("--effect '" + e + "': expected NAME=VALUE");
     }
+    const std::string name = e.substr(0, eq);
+    const double value = OptionNumber("--effect " + e, e.substr(eq + 1));
     if (name == "ripple_amplitude") {
       hidden.ripple_amplitude = value;
     } else if (name == "ripple_period") {
@@ -271,8 +307,8 @@ int RunSynthesize(const SynthesizeArgs& args) {
       if (!found) {
         std::string names;
         for (const EffectParameter& p : AllEffectParameters()) names += " " + ParameterName(p);
-        throw std::invalid_argument("--effect " + e + ": unknown effect '" + name + "' (one of:" +
-                                    names + " ripple_amplitude ripple_period theta3_hysteresis)");
+        throw UsageError("--effect " + e + ": unknown effect '" + name + "' (one of:" + names +
+                         " ripple_amplitude ripple_period theta3_hysteresis)");
       }
     }
   }

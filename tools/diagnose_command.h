@@ -17,10 +17,14 @@ struct DiagnoseArgs {
   int threads = 2;
 };
 
-/// Runs `hybrid diagnose`; returns 0. Throws hybrid::DataError for bad data (exit 1, with
-/// FILE:LINE:COL), hybrid::ParseError for a bad model, std::invalid_argument for bad options or a
-/// model that is not the finger, OutputError when an output cannot be written (no output file
-/// is then left half-written: every file is written atomically, all or nothing).
+/// Runs `hybrid diagnose`; returns 0. Before any work: UsageError (tools/options.h, exit 2) for
+/// bad option values and for outputs (--out-model, the report's files) naming one file or an
+/// input (DATA, --model); OutputError when --out-model's directory does not exist or --report
+/// lies below a file. Then hybrid::DataError for bad data (exit 1, with FILE:LINE:COL),
+/// hybrid::ParseError for a bad model, InputError for a model that is not the finger, and
+/// OutputError when an output cannot be written. The outputs are written all or nothing: the
+/// report directory (created with its parents) and every file appear only when all are
+/// written; on a failure nothing new is left.
 int RunDiagnose(const DiagnoseArgs& args);
 
 /// Options of `hybrid synthesize`: data with hidden effects, for demos and tests.
@@ -36,7 +40,11 @@ struct SynthesizeArgs {
   int samples = 512;
 };
 
-/// Runs `hybrid synthesize`; returns 0. Throws std::invalid_argument for a bad option (exit 2).
+/// Runs `hybrid synthesize`; returns 0. Throws UsageError or std::invalid_argument for a bad
+/// option (exit 2): --free-runs outside [0, kMaxSyntheticFreeRuns], --samples odd or outside
+/// [kMinRunSamples, kMaxSyntheticSamples], more than kMaxSyntheticSamples rows in all
+/// (solvers/synthetic_data.h; checked before anything is allocated), a malformed or unknown
+/// --effect, --out naming the --model.
 int RunSynthesize(const SynthesizeArgs& args);
 
 }  // namespace hybrid::cli

@@ -444,7 +444,7 @@ std::string SummaryFile(const Diagnosis& d) {
 
 std::vector<std::pair<std::string, std::string>> DiagnosisReportFiles(const Diagnosis& d,
                                                                       const std::string& dir) {
-  if (dir.empty()) throw std::invalid_argument("DiagnosisReportFiles: empty report directory");
+  if (dir.empty()) throw std::invalid_argument("the report directory is empty");
   std::vector<std::pair<std::string, std::string>> files;
   std::set<std::string> used;
   for (std::size_t r = 0; r < d.curves.size(); ++r) {

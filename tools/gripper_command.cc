@@ -15,7 +15,9 @@
 #include "gripper/hand.h"
 #include "gripper/svg_figures.h"
 #include "solvers/simulator.h"
+#include "tools/options.h"
 #include "tools/output.h"
+#include "tools/user_message.h"
 
 namespace hybrid::cli {
 namespace {
@@ -36,10 +38,10 @@ std::vector<Obstacle> ParseObjects(const std::vector<std::string>& texts) {
     try {
       out.push_back(Obstacle::Parse(text));
     } catch (const gripper::ObstacleParseError& e) {
-      throw InputError("--object '" + text + "': column " + std::to_string(e.column()) + ": " +
+      throw UsageError("--object '" + text + "': column " + std::to_string(e.column()) + ": " +
                        e.what());
     } catch (const std::invalid_argument& e) {
-      throw InputError("--object '" + text + "': " + e.what());
+      throw UsageError("--object '" + text + "': " + UserMessage(e.what()));
     }
   }
   return out;
@@ -52,18 +54,6 @@ void CheckMotor(const std::string& option, double g) {
     throw std::invalid_argument(option + " must be a motor position in [0, 255] (got " + value +
                                 ")");  // the spread motor has the same range
   }
-}
-
-// The message of a model-level exception without its API prefixes ("Hand: finger A:
-// GeometricFinger: object ..." -> "finger A: object ...").
-std::string UserMessage(const std::string& what) {
-  std::string out = what;
-  for (const std::string prefix : {"Hand::ComposedAutomata: ", "Hand: ", "GeometricFinger: "}) {
-    for (auto at = out.find(prefix); at != std::string::npos; at = out.find(prefix)) {
-      out.erase(at, prefix.size());
-    }
-  }
-  return out;
 }
 
 json ConfigurationJson(double g, const FingerConfiguration& q) {
@@ -216,6 +206,11 @@ std::vector<double> DefaultFrames(const std::vector<double>& at) {
 
 int RunFinger(const FingerArgs& args_in) {
   FingerArgs args = args_in;
+  const std::vector<NamedFile> outputs = {{"--draw", args.draw}, {"--plot", args.plot}};
+  CheckDistinctFiles(
+      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
+      outputs);
+  CheckOutputPlaces(outputs);
   if (args.g) {
     CheckMotor("--g", *args.g);
     *args.g += 0.0;  // -0 -> 0
@@ -339,6 +334,10 @@ int RunFinger(const FingerArgs& args_in) {
 }
 
 int RunHand(const HandArgs& args) {
+  CheckDistinctFiles(
+      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
+      {{"--draw", args.draw}});
+  CheckOutputPlaces({{"--draw", args.draw}});
   CheckMotor("--g", args.g);
   std::array<double, 3> commands = {args.g, args.g, args.g};
   const std::array<std::optional<double>, 3> per = {args.g_a, args.g_b, args.g_c};

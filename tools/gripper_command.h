@@ -37,8 +37,11 @@ struct HandArgs {
 
 /// `hybrid finger` and `hybrid hand`. Return the exit code (0, or 5 when --simulate disagrees
 /// with the closed form or does not complete). Throw std::invalid_argument for bad option values
-/// (exit 2), InputError for bad objects (exit 1, message names the option and column),
-/// hybrid::ParseError for a bad model, OutputError when a file cannot be written.
+/// (exit 2), UsageError (tools/options.h, exit 2) for a malformed --object (the message names
+/// the option and the column) and for outputs that name one file or the --model read by
+/// --simulate, InputError for objects the gripper cannot hold (exit 1), hybrid::ParseError for
+/// a bad model, OutputError when a file cannot be written (checked first for a missing
+/// directory; the files are written all or nothing).
 int RunFinger(const FingerArgs& args);
 int RunHand(const HandArgs& args);
 

@@ -14,7 +14,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <new>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "automaton/dot_writer.h"
@@ -25,8 +27,10 @@
 #include "tools/check_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/gripper_command.h"
+#include "tools/options.h"
 #include "tools/output.h"
 #include "tools/simulate_command.h"
+#include "tools/user_message.h"
 
 namespace {
 
@@ -34,6 +38,8 @@ using hybrid::Automaton;
 using hybrid::ModeGraph;
 using hybrid::ModeId;
 using hybrid::System;
+using hybrid::cli::AddNumberListOption;
+using hybrid::cli::AddNumberOption;
 using hybrid::cli::OutputError;
 using hybrid::cli::WriteOutput;
 using json = nlohmann::ordered_json;
@@ -265,31 +271,49 @@ std::string InfoText(const json& info) {
   return out.str();
 }
 
-// The message and exit code of an exception from a command (docs/cli.md): bad input (InputError,
-// ParseError) 1, an unwritable output 3, std::invalid_argument `invalid_code` (1 for a model
-// that fails validation, 2 for a bad option value), anything else an internal error (4).
+// The message and exit code of an exception from a command (docs/cli.md): a bad option value
+// (UsageError) 2; bad input (InputError, ParseError, DataError) 1; an unwritable output 3;
+// std::invalid_argument `invalid_code` (1 for a model that fails validation, 2 for a bad option
+// value); exhausted memory and anything else 4. Messages never name C++ functions or types
+// (tools/user_message.h).
 int ExitFor(std::exception_ptr error, const std::string& prefix, int invalid_code) {
+  using hybrid::cli::UserMessage;
   try {
     std::rethrow_exception(error);
+  } catch (const hybrid::cli::UsageError& e) {
+    std::cerr << "hybrid: " << UserMessage(e.what()) << "\n";
+    return kExitUsage;
   } catch (const hybrid::cli::InputError& e) {
-    std::cerr << prefix << ": " << e.what() << "\n";
+    std::cerr << prefix << ": " << UserMessage(e.what()) << "\n";
     return kExitModelError;
   } catch (const hybrid::ParseError& e) {
-    std::cerr << e.what() << "\n";
+    std::cerr << UserMessage(e.what()) << "\n";
     return kExitModelError;
   } catch (const hybrid::DataError& e) {
-    std::cerr << e.what() << "\n";
+    std::cerr << UserMessage(e.what()) << "\n";
     return kExitModelError;
   } catch (const OutputError& e) {
-    std::cerr << "hybrid: " << e.what() << "\n";
+    std::cerr << "hybrid: " << UserMessage(e.what()) << "\n";
     return kExitOutput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hybrid: out of memory: " << prefix
+              << " needs more memory than the system could give; make the problem smaller (a "
+                 "shorter horizon, fewer samples, runs or modes)\n";
+  } catch (const std::length_error&) {
+    std::cerr << "hybrid: out of memory: " << prefix
+              << " asked for a block of memory larger than any the system can give; make the "
+                 "problem smaller\n";
   } catch (const std::invalid_argument& e) {
-    std::cerr << prefix << ": " << e.what() << "\n";
+    std::cerr << prefix << ": " << UserMessage(e.what()) << "\n";
     return invalid_code;
   } catch (const std::exception& e) {
-    std::cerr << "hybrid: internal error: " << e.what() << "\n";
+    const std::string what = UserMessage(e.what());
+    std::cerr << "hybrid: internal error"
+              << (hybrid::cli::NamesCppInternals(what) ? std::string() : ": " + what)
+              << " (a bug: please report it with the command that caused it)\n";
   } catch (...) {
-    std::cerr << "hybrid: internal error\n";
+    std::cerr << "hybrid: internal error (a bug: please report it with the command that caused "
+                 "it)\n";
   }
   return kExitInternal;
 }
@@ -325,7 +349,6 @@ int main(int argc, char** argv) {
                 "component");
 
   hybrid::cli::SimulateArgs sim_args;
-  double until = 0.0;
   auto* simulate = app.add_subcommand(
       "simulate", "Simulate a model with exact event location (CVODE); default: its scenario");
   simulate->add_option("MODEL", sim_args.model, "Model file (.ha)")->required();
@@ -339,11 +362,11 @@ int main(int argc, char** argv) {
                        "CSV with a 'time' column and one column per input");
   simulate->add_option("--csv-shape", sim_args.csv_shape,
                        "How CSV rows are joined: step (default) or linear");
-  auto* until_option =
-      simulate->add_option("--until", until, "Horizon (default: the scenario's 'until')");
-  simulate->add_option("--sample", sim_args.sample,
-                       "Also record the state every DT (default: only the start, the end and "
-                       "both sides of each event)");
+  AddNumberOption(simulate, "--until", &sim_args.until,
+                  "Horizon (default: the scenario's 'until')");
+  AddNumberOption(simulate, "--sample", &sim_args.sample,
+                  "Also record the state every DT (default: only the start, the end and "
+                  "both sides of each event)");
   simulate->add_option("--out", sim_args.out, "Trajectory CSV: time, kind, mode, variables");
   simulate->add_option("--events", sim_args.events, "Event log CSV");
   simulate->add_flag("--json", sim_args.json, "JSON summary with every event on standard output");
@@ -362,38 +385,29 @@ int main(int argc, char** argv) {
   check->add_flag("--json", check_args.json, "Machine-readable output");
   check->add_flag("--modes", check_args.modes,
                   "Also report which modes (discrete states) some run reaches");
-  check
-      ->add_option("--depth", check_args.depth,
-                   "prove: longest counterexample or witness searched, in steps (flow segments "
-                   "and jumps)")
-      ->capture_default_str();
-  check->add_option("--induction", check_args.induction, "prove: largest k of k-induction")
-      ->capture_default_str();
-  check
-      ->add_option("--budget", check_args.budget,
-                   "prove: seconds for the counterexample and witness search per automaton")
-      ->capture_default_str();
-  check->add_option("--runs", check_args.runs, "sample: random runs per property")
-      ->capture_default_str();
-  check->add_option("--seed", check_args.seed, "sample: random seed")->capture_default_str();
+  AddNumberOption(check, "--depth", &check_args.depth,
+                  "prove: longest counterexample or witness searched, in steps (flow segments "
+                  "and jumps)");
+  AddNumberOption(check, "--induction", &check_args.induction, "prove: largest k of k-induction");
+  AddNumberOption(check, "--budget", &check_args.budget,
+                  "prove: seconds for the counterexample and witness search per automaton");
+  AddNumberOption(check, "--runs", &check_args.runs, "sample: random runs per property");
+  AddNumberOption(check, "--seed", &check_args.seed, "sample: random seed");
 
   // The gripper (gripper/): closed form, objects by geometry, the hand.
   const std::string default_finger = std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha";
   const std::string default_hand = std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha";
   hybrid::cli::FingerArgs finger_args;
   finger_args.model = default_finger;
-  double g_value = 0.0;
-  std::array<double, 3> gob = {std::nan(""), std::nan(""), std::nan("")};
   auto* finger = app.add_subcommand(
       "finger",
       "One Robotiq finger, closed form (report section 4): joint angles at motor position G, "
       "against objects given by contact positions or by geometry");
-  auto* g_option = finger->add_option("--g", g_value, "Motor position in [0, 255]");
-  std::array<CLI::Option*, 3> gob_options{};
+  AddNumberOption(finger, "--g", &finger_args.g, "Motor position in [0, 255]");
   for (int i = 0; i < 3; ++i) {
-    gob_options[i] = finger->add_option("--gob" + std::to_string(i + 1), gob[i],
-                                        "Motor position where link " + std::to_string(i + 1) +
-                                            " is blocked by an object (the report's g_ob)");
+    AddNumberOption(finger, "--gob" + std::to_string(i + 1), &finger_args.gob[i],
+                    "Motor position where link " + std::to_string(i + 1) +
+                        " is blocked by an object (the report's g_ob)");
   }
   finger->add_option("--object", finger_args.objects,
                      "An object in the finger plane (metres; x towards the palm centre, y along "
@@ -401,10 +415,8 @@ int main(int argc, char** argv) {
                      "segment:X1,Y1,X2,Y2[,R]; repeatable");
   finger->add_flag("--json", finger_args.json, "Machine-readable output");
   finger->add_option("--draw", finger_args.draw, "Write an SVG drawing of the finger (see --at)");
-  finger
-      ->add_option("--at", finger_args.draw_at,
-                   "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)")
-      ->delimiter(',');
+  AddNumberListOption(finger, "--at", &finger_args.draw_at,
+                      "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)");
   finger->add_option("--plot", finger_args.plot,
                      "Write an SVG plot of theta1..3 against g (as the report's figure 5.4)");
   finger->add_flag("--simulate", finger_args.simulate,
@@ -415,7 +427,6 @@ int main(int argc, char** argv) {
 
   hybrid::cli::HandArgs hand_args;
   hand_args.model = default_hand;
-  double g_a = 0, g_b = 0, g_c = 0, spread = 0;
   auto* hand = app.add_subcommand(
       "hand", "The three-finger hand closing on objects: fingers A, B, C and the spread modes");
   hand->add_option("--object", hand_args.objects,
@@ -424,18 +435,17 @@ int main(int argc, char** argv) {
                    "the height of joint 1): circle:X,Y,R or segment:X1,Y1,X2,Y2[,R]; repeatable");
   hand->add_option("--mode", hand_args.mode, "Operating mode: basic, wide, pinch or scissor")
       ->capture_default_str();
-  auto* spread_option =
-      hand->add_option("--spread", spread, "Spread motor position in [0, 255] (overrides --mode)");
-  hand->add_option("--g", hand_args.g, "One motor command for all fingers, in [0, 255]")
-      ->capture_default_str();
-  auto* ga = hand->add_option("--g-a", g_a, "Motor command of finger A (one command per finger)");
-  auto* gb = hand->add_option("--g-b", g_b, "Motor command of finger B");
-  auto* gc = hand->add_option("--g-c", g_c, "Motor command of finger C");
+  AddNumberOption(hand, "--spread", &hand_args.spread,
+                  "Spread motor position in [0, 255] (overrides --mode)");
+  AddNumberOption(hand, "--g", &hand_args.g, "One motor command for all fingers, in [0, 255]");
+  AddNumberOption(hand, "--g-a", &hand_args.g_a,
+                  "Motor command of finger A (one command per finger)");
+  AddNumberOption(hand, "--g-b", &hand_args.g_b, "Motor command of finger B");
+  AddNumberOption(hand, "--g-c", &hand_args.g_c, "Motor command of finger C");
   hand->add_flag("--json", hand_args.json, "Machine-readable output");
   hand->add_option("--draw", hand_args.draw, "Write an SVG drawing of the hand (see --at)");
-  hand->add_option("--at", hand_args.draw_at,
-                   "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)")
-      ->delimiter(',');
+  AddNumberListOption(hand, "--at", &hand_args.draw_at,
+                      "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)");
   hand->add_flag("--simulate", hand_args.simulate,
                  "Also simulate the composed finger automata and compare with the closed form");
   hand->add_option("--model", hand_args.model, "Hand model for --simulate")->capture_default_str();
@@ -457,11 +467,9 @@ int main(int argc, char** argv) {
                        "Write the extended model (accepted by simulate, dot and check)");
   diagnose->add_option("--report", diagnose_args.report,
                        "Write diagnosis.json and SVG plots (measured, baseline, extended) here");
-  diagnose
-      ->add_option("--significance", diagnose_args.significance,
-                   "Held-out gain (chi-square units) needed to name a cause")
-      ->capture_default_str();
-  diagnose->add_option("--threads", diagnose_args.threads, "Worker threads")->capture_default_str();
+  AddNumberOption(diagnose, "--significance", &diagnose_args.significance,
+                  "Held-out gain (chi-square units) needed to name a cause");
+  AddNumberOption(diagnose, "--threads", &diagnose_args.threads, "Worker threads");
 
   hybrid::cli::SynthesizeArgs synth_args;
   synth_args.model = default_finger;
@@ -474,11 +482,9 @@ int main(int argc, char** argv) {
                    "NAME=VALUE: a hidden effect, e.g. backlash=6, theta3_bias=2.5, "
                    "ripple_amplitude=3; repeatable")
       ->take_all();
-  synthesize->add_option("--seed", synth_args.seed, "Random seed")->capture_default_str();
-  synthesize->add_option("--free-runs", synth_args.free_runs, "Runs without an object")
-      ->capture_default_str();
-  synthesize->add_option("--samples", synth_args.samples, "Samples per run (even)")
-      ->capture_default_str();
+  AddNumberOption(synthesize, "--seed", &synth_args.seed, "Random seed");
+  AddNumberOption(synthesize, "--free-runs", &synth_args.free_runs, "Runs without an object");
+  AddNumberOption(synthesize, "--samples", &synth_args.samples, "Samples per run (even)");
   synthesize->add_option("--model", synth_args.model, "Finger automaton")->capture_default_str();
   synthesize->add_option("-o,--out", synth_args.out, "Output CSV (default: standard output)");
 
@@ -492,18 +498,8 @@ int main(int argc, char** argv) {
   if (finger->parsed() || hand->parsed()) {
     const std::string name = finger->parsed() ? "hybrid finger" : "hybrid hand";
     try {
-      if (finger->parsed()) {
-        if (g_option->count() > 0) finger_args.g = g_value;
-        for (int i = 0; i < 3; ++i) {
-          if (gob_options[i]->count() > 0) finger_args.gob[i] = gob[i];
-        }
-        return hybrid::cli::RunFinger(finger_args);
-      }
-      if (spread_option->count() > 0) hand_args.spread = spread;
-      if (ga->count() > 0) hand_args.g_a = g_a;
-      if (gb->count() > 0) hand_args.g_b = g_b;
-      if (gc->count() > 0) hand_args.g_c = g_c;
-      return hybrid::cli::RunHand(hand_args);
+      return finger->parsed() ? hybrid::cli::RunFinger(finger_args)
+                              : hybrid::cli::RunHand(hand_args);
     } catch (...) {
       return ExitFor(std::current_exception(), name, kExitUsage);
     }
@@ -532,9 +528,12 @@ int main(int argc, char** argv) {
 
   try {
     if (simulate->parsed()) {
-      if (until_option->count() > 0) sim_args.until = until;
       model = sim_args.model;
       return hybrid::cli::RunSimulate(sim_args);
+    }
+    if (dot->parsed()) {
+      hybrid::cli::CheckDistinctFiles({{"MODEL", model}}, {{"-o", output}});
+      hybrid::cli::CheckOutputPlaces({{"-o", output}});
     }
     const System system = hybrid::ParseModelFile(model);
     if (info->parsed()) {
@@ -551,7 +550,7 @@ int main(int argc, char** argv) {
       try {
         text = hybrid::WriteDot(system, {.product = product});
       } catch (const std::invalid_argument& e) {
-        std::cerr << model << ": cannot draw the product: " << e.what()
+        std::cerr << model << ": cannot draw the product: " << hybrid::cli::UserMessage(e.what())
                   << " (omit --product to draw one cluster per component)\n";
         return kExitModelError;
       }

@@ -8,9 +8,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "automaton/number_syntax.h"
 #include "automaton/parser.h"
 #include "solvers/simulator.h"
+#include "tools/options.h"
 #include "tools/output.h"
+#include "tools/user_message.h"
 
 namespace hybrid::cli {
 namespace {
@@ -32,15 +35,16 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
   return cells;
 }
 
+// The number in `cell` (decimal syntax, automaton/number_syntax.h); ParseError at its row and
+// column otherwise.
 double CsvNumber(const std::string& file, int row, int column, const std::string& cell) {
-  char* end = nullptr;
-  const double v = std::strtod(cell.c_str(), &end);
-  if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
+  const NumberRead<double> r = ReadDecimal(cell);
+  if (!r.ok()) {
     throw ParseError(file, row, column,
-                     "'" + cell + "' is not a finite number (CSV row " + std::to_string(row) +
+                     NumberErrorMessage(cell, r.error) + " (CSV row " + std::to_string(row) +
                          ", column " + std::to_string(column) + ")");
   }
-  return v;
+  return r.value;
 }
 
 // Reads `time,NAME,...` rows into one signal per input column.
@@ -221,67 +225,86 @@ std::string SummaryText(const Simulator& sim, const SimulationResult& r, double 
   return out.str();
 }
 
-}  // namespace
-
-int RunSimulate(const SimulateArgs& args) {
-  System system = ParseModelFile(args.model);
-  for (const std::string& spec : args.parameters) {
+// Applies the `--set NAME=VALUE` overrides to `system`. Throws UsageError naming the option.
+void SetParameters(const std::vector<std::string>& specs, System& system) {
+  for (const std::string& spec : specs) {
     const auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0) {
-      throw std::invalid_argument("--set '" + spec + "': expected NAME=VALUE");
+      throw UsageError("--set '" + spec + "': expected NAME=VALUE");
     }
-    const std::string name = spec.substr(0, eq), text = spec.substr(eq + 1);
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value)) {
-      throw std::invalid_argument("--set " + name + ": '" + text + "' is not a finite number");
-    }
+    const std::string name = spec.substr(0, eq);
+    const double value = OptionNumber("--set " + name, spec.substr(eq + 1));
     try {
       system.SetParameter(name, value);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("--set " + name + ": " + e.what());
+      throw UsageError("--set " + name + ": " + UserMessage(e.what()));
     }
   }
-  const SymbolTable& symbols = system.symbols();
-  std::vector<InputSignal> signals;
-  if (!args.input_csv.empty()) {
-    if (args.csv_shape != "step" && args.csv_shape != "linear") {
-      throw std::invalid_argument("--csv-shape must be 'step' or 'linear'");
-    }
-    signals = ReadInputCsv(
-        args.input_csv,
-        args.csv_shape == "step" ? InputSignal::Shape::kStep : InputSignal::Shape::kLinear,
-        symbols);
-  }
-  for (const std::string& spec : args.inputs) {
+}
+
+// The signals of `--input NAME=SIGNAL` (each replacing any earlier signal of NAME in
+// `signals`). Throws UsageError naming the option.
+void OverrideInputs(const std::vector<std::string>& specs, const SymbolTable& symbols,
+                    std::vector<InputSignal>& signals) {
+  for (const std::string& spec : specs) {
     const auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0) {
-      throw std::invalid_argument("--input '" + spec + "': expected NAME=SIGNAL");
+      throw UsageError("--input '" + spec + "': expected NAME=SIGNAL");
     }
     const std::string name = spec.substr(0, eq);
     const auto slot = symbols.Find(name);
     if (!slot || symbols[*slot].kind != SymbolKind::kInput) {
       std::string known;
       for (int s : symbols.SlotsOfKind(SymbolKind::kInput)) known += " " + symbols[s].name;
-      throw std::invalid_argument("--input: '" + name + "' is not an input of the model (inputs:" +
-                                  (known.empty() ? " none" : known) + ")");
+      throw UsageError("--input: '" + name + "' is not an input of the model (inputs:" +
+                       (known.empty() ? " none" : known) + ")");
     }
-    InputSignal s = ParseSignal(spec.substr(eq + 1), "--input " + name);
+    InputSignal s;
+    try {
+      s = ParseSignal(spec.substr(eq + 1), "--input " + name);
+    } catch (const ParseError& e) {
+      throw UsageError(e.what());  // "--input u:1:12: ...": the option and the column
+    }
     s.slot = *slot;
     std::erase_if(signals, [&](const InputSignal& x) { return x.slot == s.slot; });
     signals.push_back(std::move(s));
   }
+}
+
+}  // namespace
+
+int RunSimulate(const SimulateArgs& args) {
+  CheckDistinctFiles({{"MODEL", args.model}, {"--input-csv", args.input_csv}},
+                     {{"--out", args.out}, {"--events", args.events}});
+  if (args.input_csv.empty() ? false : args.csv_shape != "step" && args.csv_shape != "linear") {
+    throw UsageError("--csv-shape must be 'step' or 'linear'");
+  }
+  if (!(args.sample >= 0.0)) throw UsageError("--sample must be a number >= 0");
+  if (args.until && !(*args.until > 0.0)) {
+    throw UsageError("--until: the horizon must be positive and finite");
+  }
+  CheckOutputPlaces({{"--out", args.out}, {"--events", args.events}});
+  System system = ParseModelFile(args.model);
+  SetParameters(args.parameters, system);
+  const SymbolTable& symbols = system.symbols();
+  std::vector<InputSignal> signals;
+  if (!args.input_csv.empty()) {
+    signals = ReadInputCsv(
+        args.input_csv,
+        args.csv_shape == "step" ? InputSignal::Shape::kStep : InputSignal::Shape::kLinear,
+        symbols);
+  }
+  OverrideInputs(args.inputs, symbols, signals);
   SimulationOptions options;
   options.until = args.until;
-  if (args.sample < 0.0 || !std::isfinite(args.sample)) {
-    throw std::invalid_argument("--sample must be a non-negative number");
-  }
   options.sample_step = args.sample;
   const Simulator sim(system);
   const SimulationResult result = sim.Run(options, signals);
   const double until = options.until ? *options.until : system.scenario()->until;
-  if (!args.out.empty()) WriteOutput(args.out, TraceCsv(sim, result));
-  if (!args.events.empty()) WriteOutput(args.events, EventsCsv(sim, result));
+  std::vector<std::pair<std::string, std::string>> files;
+  if (!args.out.empty()) files.emplace_back(args.out, TraceCsv(sim, result));
+  if (!args.events.empty()) files.emplace_back(args.events, EventsCsv(sim, result));
+  WriteOutputs(files);
   WriteOutput("-", args.json ? ResultJson(sim, result, until).dump(2) + "\n"
                              : SummaryText(sim, result, until));
   return result.status == SimulationStatus::kCompleted ? 0 : kExitStoppedEarly;

@@ -20,9 +20,14 @@ struct SimulateArgs {
   bool json = false;                    ///< JSON summary (with every event) on standard output
 };
 
-/// Runs `hybrid simulate`; returns the process exit code (0 completed, 5 stopped early). Throws
-/// hybrid::ParseError for a bad model, signal or CSV (with position), std::invalid_argument for
-/// bad options, and OutputError (tools/output.h) when a file cannot be written.
+/// Runs `hybrid simulate`; returns the process exit code (0 completed, 5 stopped early). Throws,
+/// before simulating: UsageError (tools/options.h, exit 2) for bad option values (a malformed
+/// or unknown `--set` or `--input`, `--csv-shape`, a negative `--sample`, a `--until` that is not
+/// positive, `--out` and `--events` naming one file or an output naming the model or the input
+/// CSV); OutputError when an output's directory does not exist; hybrid::ParseError for a bad
+/// model or input CSV (with position); std::invalid_argument from the simulator for inputs the
+/// model refuses (a value outside its bounds, an initial state outside its invariant). Writes
+/// --out and --events all or nothing (OutputError when a file cannot be written).
 int RunSimulate(const SimulateArgs& args);
 
 }  // namespace hybrid::cli

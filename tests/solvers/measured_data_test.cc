@@ -163,6 +163,18 @@ TEST(ReadMeasuredData, AcceptsNumberForms) {
   EXPECT_EQ(run.g[7], 254.5);
 }
 
+// One sign is a sign, here as in every option of the command line ("+5" was refused by the
+// data reader while `--input-csv` and `--set` read it).
+TEST(ReadMeasuredData, AcceptsALeadingPlus) {
+  const MeasuredData data =
+      Read(std::string(kHeader) + Rows("1", 5) + "1,+7,+1.5e+1,-2,+.5\n" + Rows("1", 4));
+  const MeasuredRun& run = data.runs.at(0);
+  EXPECT_EQ(run.g[5], 7.0);
+  EXPECT_EQ(run.theta[0][5], 15.0);
+  EXPECT_EQ(run.theta[1][5], -2.0);
+  EXPECT_EQ(run.theta[2][5], 0.5);
+}
+
 TEST(ReadMeasuredData, ColumnOrderDoesNotMatter) {
   std::string reordered = "theta3,g,contact_link,run,theta1,gob,theta2\n";
   std::string ordered(kContactHeader);
@@ -297,7 +309,12 @@ TEST(ReadMeasuredDataErrors, NotANumberQuotesTheCell) {
   EXPECT_TRUE(FailsAt(WithRow("1, x ,10,20,30"), 5, 2, "column 'g': not a number: 'x'"));
   EXPECT_TRUE(FailsAt(WithRow("1,3,10,20,12abc"), 5, 5, "column 'theta3': not a number: '12abc'"));
   EXPECT_TRUE(FailsAt(WithRow("1,3,10,0x10,30"), 5, 4, "not a number: '0x10'"));
-  EXPECT_TRUE(FailsAt(WithRow("1,3,10,+5,30"), 5, 4, "not a number: '+5'"));
+  // The decimal syntax of the command line (automaton/number_syntax.h): one sign at most.
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,+-5,30"), 5, 4, "not a number: '+-5'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,--5,30"), 5, 4, "not a number: '--5'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,0x1p3,30"), 5, 4, "not a number: '0x1p3'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,1e,30"), 5, 4, "not a number: '1e'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,.,30"), 5, 4, "not a number: '.'"));
   EXPECT_TRUE(FailsAt(WithRow("1,3,10,2 0,30"), 5, 4, "not a number: '2 0'"));
   EXPECT_TRUE(
       FailsAt(WithContactRow("1,3,10,20,30,1OO,1"), 5, 6, "column 'gob': not a number: '1OO'"));

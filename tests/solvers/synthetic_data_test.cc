@@ -248,7 +248,7 @@ TEST(WriteMeasuredDataTest, RejectsWhatCannotBeReadBack) {
     write(half_object);
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("WriteMeasuredData: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("cannot write measured data: ", 0), 0u) << e.what();
   }
 }
 
@@ -458,7 +458,7 @@ TEST(SynthesizeTest, RejectsBadDesigns) {
       Synthesize(Predictor(), hidden, design);
       ADD_FAILURE() << what << ": no exception";
     } catch (const std::invalid_argument& e) {
-      EXPECT_EQ(std::string(e.what()).rfind("Synthesize: ", 0), 0u) << what << ": " << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("synthetic data: ", 0), 0u) << what << ": " << e.what();
     }
   };
   const auto with = [](auto change) {
@@ -481,6 +481,19 @@ TEST(SynthesizeTest, RejectsBadDesigns) {
                "missing probability above 1");
   expect_throw(with([](SyntheticDesign& d) { d.free_runs = -1; }), none, "negative free runs");
   expect_throw(with([](SyntheticDesign& d) { d.link2_gob = {300}; }), none, "gob above 255");
+  // Sizes are capped before anything is allocated (2e9 free runs asked for 7.9 GB).
+  expect_throw(with([](SyntheticDesign& d) { d.free_runs = 2000000000; }), none, "2e9 free runs");
+  expect_throw(with([](SyntheticDesign& d) { d.free_runs = kMaxSyntheticFreeRuns + 1; }), none,
+               "one free run more than the cap");
+  expect_throw(with([](SyntheticDesign& d) { d.samples_per_run = 2000000000; }), none,
+               "2e9 samples per run");
+  expect_throw(with([](SyntheticDesign& d) {
+                 d.free_runs = 0;
+                 d.link1_gob.assign(2, 80.0);
+                 d.link2_gob.clear();
+                 d.samples_per_run = static_cast<int>(kMaxSyntheticSamples / 2 + 2);
+               }),
+               none, "one run's rows more than the cap");
   expect_throw(with([](SyntheticDesign& d) {
                  d.free_runs = 0;
                  d.link1_gob.clear();

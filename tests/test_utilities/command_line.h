@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,41 @@ inline Result RunHybrid(const std::string& args, const std::string& stdout_targe
   r.out = ReadAll(out);
   r.err = ReadAll(err);
   return r;
+}
+
+/// The value of `key` in the JSON object `j`. Throws std::out_of_range with a message naming the
+/// key and the keys there are when `j` is not an object or has no such key, so that a test
+/// fails clearly instead of reading a null that indexing would insert.
+inline const nlohmann::json& Field(const nlohmann::json& j, const std::string& key) {
+  if (!j.is_object()) {
+    throw std::out_of_range("JSON: expected an object with key '" + key + "', got " +
+                            std::string(j.type_name()) + ": " + j.dump().substr(0, 200));
+  }
+  const auto it = j.find(key);
+  if (it == j.end()) {
+    std::string keys;
+    for (const auto& [k, v] : j.items()) keys += (keys.empty() ? "" : ", ") + k;
+    throw std::out_of_range("JSON: no key '" + key + "' (keys: " + keys + ")");
+  }
+  return *it;
+}
+
+/// Element `index` of the JSON array `j`; throws std::out_of_range naming the index and the
+/// size when `j` is not an array or is too short.
+inline const nlohmann::json& Field(const nlohmann::json& j, std::size_t index) {
+  if (!j.is_array() || index >= j.size()) {
+    throw std::out_of_range("JSON: no element " + std::to_string(index) + " in " +
+                            std::string(j.type_name()) + " of size " + std::to_string(j.size()));
+  }
+  return j[index];
+}
+
+/// Field(Field(j, k1), k2)...: the value at a path of keys and indices, e.g.
+/// Field(report, "properties", 0, "verdict").
+template <typename K1, typename K2, typename... Rest>
+const nlohmann::json& Field(const nlohmann::json& j, const K1& k1, const K2& k2,
+                            const Rest&... rest) {
+  return Field(Field(j, k1), k2, rest...);
 }
 
 /// Runs `hybrid ARGS --json`, expects exit code `expected_exit`, and parses standard output (an

@@ -3,8 +3,9 @@
 // backlash plus a theta3 sensor bias (cause, parameters, held-out errors, noise floor); the
 // extended model (`--out-model`) accepted by info, simulate, dot and check; the report directory
 // (`--report`); clean data ("none") and an effect outside the diagnosable list ("unexplained"
-// with `where`); bad data (exit 1, FILE:LINE:COL, no output files), bad options (exit 2) and an
-// unwritable output (exit 3, nothing written).
+// with `where`); bad data (exit 1, FILE:LINE:COL, no output files), bad options and outputs
+// naming an input or one another (exit 2), caps on synthetic sizes, and an unwritable output
+// (exit 3, nothing written, no directory left).
 //
 // A diagnosis of the default synthetic design takes a few seconds: the data with backlash and a
 // sensor bias is synthesized and diagnosed once per process (Shared()), with --json, --out-model
@@ -37,6 +38,7 @@ using testing::TempDir;
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 const std::string kThermostat = (kSourceDir / "spec" / "thermostat.ha").string();
 const std::string kHand = (kSourceDir / "spec" / "hand.ha").string();
+const std::string kFinger = (kSourceDir / "spec" / "finger.ha").string();
 
 constexpr const char* kEffects = "--effect backlash=6 --effect theta3_bias=2.5";
 constexpr double kBacklash = 6.0;
@@ -132,7 +134,8 @@ TEST(Synthesize, WritesSyntheticCsvThatDependsOnlyOnTheSeed) {
 }
 
 TEST(Synthesize, BadEffectsExitTwoNamingTheOption) {
-  for (const std::string effect : {"no_such_effect=1", "backlash", "backlash=abc"}) {
+  for (const std::string effect : {"no_such_effect=1", "backlash", "backlash=abc", "backlash=",
+                                   "backlash=0x10", "backlash=+-1", "backlash=inf", "=1"}) {
     SCOPED_TRACE(effect);
     TempDir dir;
     const std::string out = dir.File("out.csv");
@@ -143,6 +146,59 @@ TEST(Synthesize, BadEffectsExitTwoNamingTheOption) {
     EXPECT_TRUE(r.out.empty()) << r.out;
     EXPECT_FALSE(fs::exists(out)) << "written despite the error";
   }
+}
+
+// Numeric options are numbers (no empty value read as 0, no negative seed wrapped around), and
+// the size of the data is capped before anything is allocated: exit 2 naming the option, in
+// plain words, nothing written.
+TEST(Synthesize, BadNumbersAndSizesExitTwoNamingTheOption) {
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--seed -1", "--seed: '-1' is negative"},
+           {"--seed ''", "--seed: empty"},
+           {"--seed 0x10", "--seed: '0x10' is not a decimal number"},
+           {"--seed 18446744073709551616", "--seed: '18446744073709551616' is out of range"},
+           {"--free-runs ''", "--free-runs: empty"},
+           {"--free-runs 1.5", "--free-runs: '1.5' is not an integer"},
+           {"--samples 1e3", "--samples: '1e3' is not an integer"},
+           {"--free-runs -1", "--free-runs must lie in [0, 10000]"},
+           {"--free-runs 2000000000", "--free-runs must lie in [0, 10000]"},
+           {"--samples 1000002", "--samples must be even and lie in [10, 1000000]"},
+           {"--samples 11", "--samples must be even"},
+           {"--free-runs 10000 --samples 1000", "at most 1000000 rows"},
+       }) {
+    SCOPED_TRACE(c.args);
+    TempDir dir;
+    const std::string out = dir.File("out.csv");
+    const Result r = RunHybrid("synthesize " + c.args + " -o " + Quote(out));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("::"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(dir.Files().empty()) << "written despite the error";
+  }
+  // The largest seed is a seed.
+  TempDir dir;
+  const Result r =
+      RunHybrid("synthesize --seed 18446744073709551615 --free-runs 0 --samples 10 -o " +
+                Quote(dir.File("out.csv")));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(ReadAll(dir.File("out.csv")).find("with seed 18446744073709551615"), std::string::npos);
+}
+
+// The output may not overwrite the model it reads.
+TEST(Synthesize, OutputNamingTheModelIsRefused) {
+  TempDir dir;
+  const std::string model = dir.Write("finger.ha", ReadAll(kFinger));
+  const Result r = RunHybrid("synthesize --model " + Quote(model) + " -o " + Quote(model));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--out '" + model + "' names the input --model"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(ReadAll(model), ReadAll(kFinger));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -453,24 +509,91 @@ TEST(Diagnose, HelpNamesTheOutputOptions) {
   }
 }
 
+// A missing directory of --out-model is found before any work; the report directory is not
+// created (the issue's `diagnose --report rep --out-model nodir/m.ha` left `rep/`).
 TEST(Diagnose, UnwritableModelExitsThreeAndWritesNothing) {
   const fs::path missing = "/nonexistent_dir";
   ASSERT_FALSE(fs::exists(missing)) << missing << " exists: the test needs it absent";
   TempDir dir;
   const std::string data = dir.File("clean.csv");
   Synthesize("--seed 5", data);
-  const std::string report = dir.File("report");
-  const Result r = RunHybrid("diagnose " + Quote(data) + " --json --out-model " +
-                             Quote((missing / "x.ha").string()) + " --report " + Quote(report));
-  EXPECT_EQ(r.exit_code, 3) << r.err;
-  EXPECT_NE(r.err.find("/nonexistent_dir/x.ha"), std::string::npos) << r.err;
-  EXPECT_TRUE(r.out.empty()) << "standard output after a failed write:\n" << r.out.substr(0, 300);
-  EXPECT_FALSE(fs::exists(missing));
-  // Nothing of the report is written (the directory itself may have been created).
-  if (fs::exists(report)) {
-    EXPECT_TRUE(fs::is_empty(report)) << "report files written although --out-model failed";
+  for (const std::string& model :
+       std::vector<std::string>{(missing / "x.ha").string(), dir.File("nodir/m.ha")}) {
+    SCOPED_TRACE(model);
+    const std::string report = dir.File("report");
+    const Result r = RunHybrid("diagnose " + Quote(data) + " --json --out-model " + Quote(model) +
+                               " --report " + Quote(report));
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_NE(r.err.find(model), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << "standard output after a failed write:\n" << r.out.substr(0, 300);
+    EXPECT_FALSE(fs::exists(missing));
+    EXPECT_EQ(dir.Files(), std::vector<std::string>{"clean.csv"});
   }
-  EXPECT_EQ(dir.Files().size(), fs::exists(report) ? 2u : 1u);
+}
+
+// An output that fails while being written (here /dev/full, after the diagnosis) leaves nothing:
+// neither the report's files nor the report directory and its parents, which the run created.
+TEST(Diagnose, FailedWriteRemovesTheReportDirectory) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  TempDir dir;
+  const std::string data = dir.File("clean.csv");
+  Synthesize("--seed 5", data);
+  const Result r = RunHybrid("diagnose " + Quote(data) + " --out-model /dev/full --report " +
+                             Quote(dir.File("out/rep")));
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("/dev/full"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out.substr(0, 300);
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"clean.csv"});
+}
+
+// The README's command, `diagnose data/finger_demo.csv --out-model ext.ha --report
+// out/diagnosis`, on a fresh clone where out/ does not exist: --report creates its parents.
+TEST(Diagnose, ReportCreatesItsParentDirectories) {
+  TempDir dir;
+  const std::string report = dir.File("out/diagnosis");
+  const Result r =
+      RunHybrid("diagnose " + Quote(kSourceDir / "data" / "finger_demo.csv") + " --out-model " +
+                Quote(dir.File("ext.ha")) + " --report " + Quote(report));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir.File("ext.ha")));
+  EXPECT_TRUE(fs::is_regular_file(fs::path(report) / "diagnosis.json"));
+  EXPECT_TRUE(fs::is_regular_file(fs::path(report) / "summary.svg"));
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"ext.ha", "out"}));
+  // No temporary file is left next to the outputs.
+  for (const auto& e : fs::directory_iterator(report)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+  }
+}
+
+// Outputs naming an input (DATA, --model) or one another are refused before any work: exit 2
+// naming the options, nothing written or changed.
+TEST(Diagnose, OutputsNamingAnInputOrOneAnotherAreRefused) {
+  TempDir dir;
+  const std::string data = dir.Write("data.csv", ValidCsv()).string();
+  const std::string model = dir.Write("finger.ha", ReadAll(kFinger)).string();
+  const std::string report = dir.File("rep");
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--out-model " + Quote(data), "--out-model '" + data + "' names the input DATA"},
+           {"--model " + Quote(model) + " --out-model " + Quote(model), "names the input --model"},
+           {"--out-model " + Quote(report + "/summary.svg") + " --report " + Quote(report),
+            "--out-model and --report name the same file"},
+           {"--out-model " + Quote(report + "/diagnosis.json") + " --report " + Quote(report),
+            "--out-model and --report name the same file"},
+       }) {
+    SCOPED_TRACE(c.args);
+    const Result r = RunHybrid("diagnose " + Quote(data) + " " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_EQ(ReadAll(data), ValidCsv());
+    EXPECT_EQ(ReadAll(model), ReadAll(kFinger));
+    EXPECT_EQ(dir.Files(), (std::vector<std::string>{"data.csv", "finger.ha"}));
+  }
 }
 
 }  // namespace

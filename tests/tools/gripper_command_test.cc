@@ -2,8 +2,9 @@
 // docs/finger_model.md): the closed form of section 4 through the command line (free-space table
 // 4.1, a link-1 contact given as gob1), objects given by geometry (the analytic contact position
 // of a circle), --simulate agreeing with the closed form, the SVG outputs, the hand's three
-// fingers, and every kind of bad input (exit 2 for bad options, 1 for bad objects, 3 for
-// unwritable outputs; a message on stderr, nothing on stdout, no file left behind).
+// fingers, and every kind of bad input (exit 2 for bad options, malformed numbers and object
+// descriptions and outputs naming one file, 1 for objects the gripper cannot hold, 3 for
+// unwritable outputs; a message on stderr, nothing on stdout, no file left behind or changed).
 
 #include <gtest/gtest.h>
 
@@ -24,6 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using testing::Field;
 using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
@@ -256,6 +258,27 @@ TEST(HybridFinger, FailedRunKeepsExistingFiles) {
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"keep.svg"});  // no temporaries left
 }
 
+// Two outputs naming one file, or an output naming the model --simulate reads, are refused before
+// any work (exit 2 naming both options); the existing file keeps its content.
+TEST(HybridFinger, OutputsNamingOneFileOrTheModelAreRefused) {
+  TempDir dir;
+  const std::string f = dir.Write("f.svg", "OLD");
+  ExpectRejected("finger --g 10 --draw " + Quote(f) + " --plot " + Quote(f), 2,
+                 {"--draw and --plot name the same file"});
+  ExpectRejected("finger --g 10 --draw " + Quote(f) + " --plot " +
+                     Quote((dir.path() / "." / "f.svg").string()),
+                 2, {"--draw and --plot name the same file"});
+  EXPECT_EQ(ReadAll(f), "OLD");
+  const std::string model = dir.Write("finger.ha", ReadAll(HYBRID_SOURCE_DIR "/spec/finger.ha"));
+  ExpectRejected("finger --g 10 --simulate --model " + Quote(model) + " --plot " + Quote(model), 2,
+                 {"--plot", "names the input --model"});
+  EXPECT_EQ(ReadAll(model), ReadAll(HYBRID_SOURCE_DIR "/spec/finger.ha"));
+  ExpectRejected("hand --simulate --model " + Quote(model) + " --draw " + Quote(model), 2,
+                 {"--draw", "names the input --model"});
+  EXPECT_EQ(ReadAll(model), ReadAll(HYBRID_SOURCE_DIR "/spec/finger.ha"));
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"f.svg", "finger.ha"}));
+}
+
 // A given contact position that is never reached (link 1 is at its limit from g = 140) does not
 // take effect and is not listed.
 TEST(HybridFinger, ContactsListOnlyThoseThatTakeEffect) {
@@ -295,13 +318,51 @@ TEST(HybridFinger, BadOptionValuesAreExit2) {
   ExpectRejected("finger --json", 2, {"nothing to do"});
 }
 
-// Malformed objects: exit 1, the message names --object and the column of the fault.
-TEST(HybridFinger, MalformedObjectsAreExit1WithTheColumn) {
-  ExpectRejected("finger --g 100 --object circle:0.05,abc,0.01", 1, {"--object", "column 13"});
-  ExpectRejected("finger --g 100 --object square:1,2,3", 1, {"--object", "column 1:"});
-  ExpectRejected("finger --g 100 --object circle:0.1,0.2", 1, {"--object", "column 15"});
-  ExpectRejected("finger --g 100 --object circle:0.05,0.05,-0.01", 1,
+// Numbers are numbers: an empty value is not 0, hexadecimal, doubled signs, inf, blanks and
+// trailing text are refused naming the option (exit 2), for every numeric option.
+TEST(HybridFinger, MalformedNumbersAreExit2NamingTheOption) {
+  for (const std::string option : {"--g", "--gob1", "--gob2", "--gob3"}) {
+    const std::string rest = option == "--g" ? "" : " --g 10";
+    ExpectRejected("finger " + option + " ''" + rest, 2, {option + ": empty"});
+    ExpectRejected("finger " + option + " 0x10" + rest, 2,
+                   {option + ": '0x10' is not a decimal number"});
+    ExpectRejected("finger " + option + " +-5" + rest, 2, {option + ": '+-5' is not"});
+    ExpectRejected("finger " + option + " 5x" + rest, 2, {option + ": '5x' is not"});
+    ExpectRejected("finger " + option + " ' 5'" + rest, 2, {option + ": ' 5' is not"});
+    ExpectRejected("finger " + option + " inf" + rest, 2, {option + ": 'inf' is not"});
+  }
+  TempDir dir;
+  const std::string draw = "finger --draw " + Quote(dir.File("x.svg"));
+  ExpectRejected(draw + " --at ''", 2, {"--at: empty"});
+  ExpectRejected(draw + " --at 0,,30", 2, {"--at: empty"});
+  ExpectRejected(draw + " --at 0,30,", 2, {"--at: empty"});
+  ExpectRejected(draw + " --at 0,0x1e", 2, {"--at: '0x1e' is not a decimal number"});
+  EXPECT_TRUE(dir.Files().empty());
+  // Signs, fractions and exponents are numbers.
+  const json j = RunJson("finger --g +2.0e2 --gob1 .8E2");
+  EXPECT_EQ(Field(j, "g"), 200.0);
+  EXPECT_EQ(Field(j, "contacts", 0, "g"), 80.0);
+  ASSERT_EQ(RunHybrid(draw + " --at +0,30. --at 1e2").exit_code, 0);
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"x.svg"});
+}
+
+// Malformed objects are bad option values: exit 2, the message names --object and the column of
+// the fault; the numbers of a description follow the same syntax as the options'.
+TEST(HybridFinger, MalformedObjectsAreExit2WithTheColumn) {
+  ExpectRejected("finger --g 100 --object circle:0.05,abc,0.01", 2, {"--object", "column 13"});
+  ExpectRejected("finger --g 100 --object square:1,2,3", 2, {"--object", "column 1:"});
+  ExpectRejected("finger --g 100 --object circle:0.1,0.2", 2, {"--object", "column 15"});
+  ExpectRejected("finger --g 100 --object circle:0.05,0.05,-0.01", 2,
                  {"--object", "column 18", "radius"});
+  // A doubled sign is not a sign: "+-0.06" was read as -0.06.
+  ExpectRejected("finger --g 100 --object circle:+-0.06,0.1,0.01", 2,
+                 {"--object", "column 9", "malformed number '+-0.06'"});
+  ExpectRejected("finger --g 100 --object circle:0x1,0.1,0.01", 2, {"--object", "column 9"});
+  ExpectRejected("finger --g 100 --object circle:inf,0.1,0.01", 2, {"--object", "column 8"});
+  ExpectRejected("finger --g 100 --object circle:,0.1,0.01", 2,
+                 {"--object", "column 8", "expected a number"});
+  // Thinner than 0.1 mm: could be crossed between two samples of the contact search.
+  ExpectRejected("finger --g 100 --object circle:0.03,0.05,0.00005", 2, {"at least 0.0001 m"});
 }
 
 // Objects the finger cannot hold: overlapping the palm (G1) or the open finger, or out of reach.
@@ -312,8 +373,6 @@ TEST(HybridFinger, ObjectsTheFingerCannotHoldAreExit1) {
   // Inside the open finger at the knuckle of joint 2 (0.05715 m up), where contact segments
   // leave a 2 mm gap: still an overlap.
   ExpectRejected("finger --g 100 --object circle:0,0.05815,0.0005", 1, {"overlaps", "open finger"});
-  // Thinner than 0.1 mm: could be crossed between two samples of the contact search.
-  ExpectRejected("finger --g 100 --object circle:0.03,0.05,0.00005", 1, {"at least 0.0001 m"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -424,8 +483,14 @@ TEST(HybridHand, BadInputIsRejected) {
   ExpectRejected("hand --g nan", 2, {"--g"});
   ExpectRejected("hand --spread 300", 2, {"--spread"});
   ExpectRejected("hand --object circle:0,-0.01,0.02", 1, {"overlaps the palm"});
-  ExpectRejected("hand --object circle:0,0.06,abc", 1, {"--object", "column 15"});
+  ExpectRejected("hand --object circle:0,0.06,abc", 2, {"--object", "column 15"});
   ExpectRejected("hand --object circle:0.3,0.5,0.01", 1, {"no finger reaches"});
+  for (const std::string option : {"--spread", "--g", "--g-a", "--g-b", "--g-c"}) {
+    ExpectRejected("hand " + option + " ''", 2, {option + ": empty"});
+    ExpectRejected("hand " + option + " 0x10", 2, {option + ": '0x10' is not a decimal number"});
+    ExpectRejected("hand " + option + " --5", 2, {option});
+  }
+  ExpectRejected("hand --draw x.svg --at ''", 2, {"--at: empty"});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -300,7 +300,9 @@ system s { instance A = a; instance B = a; }
 TEST(HybridCli, UnwritableOutputExitsThreeAndLeavesNoFile) {
   const Result r = RunHybrid("dot " + Quote(kFinger) + " -o /nonexistent_dir/x.dot");
   EXPECT_EQ(r.exit_code, 3);
-  EXPECT_EQ(r.err, "hybrid: cannot write '/nonexistent_dir/x.dot'\n");
+  EXPECT_EQ(r.err,
+            "hybrid: cannot write -o '/nonexistent_dir/x.dot': the directory '/nonexistent_dir' "
+            "does not exist\n");
   EXPECT_EQ(r.out, "");
   EXPECT_FALSE(fs::exists("/nonexistent_dir/x.dot"));
   EXPECT_FALSE(fs::exists("/nonexistent_dir"));
@@ -311,7 +313,8 @@ TEST(HybridCli, OutputOntoADirectoryExitsThreeAndCleansUp) {
   fs::create_directory(dir.path() / "target");
   const Result r = RunHybrid("dot " + Quote(kFinger) + " -o " + Quote(dir.path() / "target"));
   EXPECT_EQ(r.exit_code, 3);
-  EXPECT_EQ(r.err, "hybrid: cannot write '" + (dir.path() / "target").string() + "'\n");
+  EXPECT_EQ(r.err, "hybrid: cannot write -o '" + (dir.path() / "target").string() +
+                       "': it is a directory\n");
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"target"});  // no temporary file left
   EXPECT_TRUE(fs::is_empty(dir.path() / "target"));
 }

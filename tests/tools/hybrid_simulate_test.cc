@@ -1,7 +1,8 @@
 // Tests of `hybrid simulate` (HYBRID_BINARY): the bundled models run to completion, the JSON
 // summary, the trajectory and event CSVs, input overrides from the command line and from a CSV
-// file, every kind of bad input (exit 1, a clear message, no output file), and runs that stop
-// early (exit 5, outputs still written).
+// file, every kind of bad input (exit 2 for a bad option value, 1 for a bad model or file, a clear
+// message, no output file), outputs that name one file or an input, outputs written all or
+// nothing, and runs that stop early (exit 5, outputs still written).
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -25,6 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using testing::Field;
 using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
@@ -164,13 +166,16 @@ TEST(HybridSimulate, SetOverridesAParameter) {
   for (size_t k = 0; k < times.size(); ++k) {
     EXPECT_NEAR(j["events"][k]["time"].get<double>(), times[k], 1e-6) << k;
   }
+  // Bad --set values are option errors (exit 2) naming the option, in plain words.
   const Result unknown = Simulate(Quote(Spec("finger")) + " --set nope=1");
-  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.err.find("--set nope"), std::string::npos) << unknown.err;
+  EXPECT_EQ(unknown.err.find("::"), std::string::npos) << unknown.err;
   const Result bad = Simulate(Quote(Spec("finger")) + " --set gob1=abc");
-  EXPECT_EQ(bad.exit_code, 1);
-  EXPECT_NE(bad.err.find("not a finite number"), std::string::npos) << bad.err;
-  EXPECT_EQ(Simulate(Quote(Spec("finger")) + " --set gob1").exit_code, 1);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--set gob1: 'abc' is not a decimal number"), std::string::npos)
+      << bad.err;
+  EXPECT_EQ(Simulate(Quote(Spec("finger")) + " --set gob1").exit_code, 2);
 }
 
 TEST(HybridSimulate, InputOverridesTheScenario) {
@@ -212,14 +217,15 @@ TEST(HybridSimulate, InputCsvDrivesTheInputs) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Bad input: exit 1, a message naming the problem, no output files.
+// Bad input: exit 2 for a bad option value, 1 for a bad model or input file or an input the
+// model refuses, a message naming the problem, no output files.
 
-void ExpectRefused(const std::string& args, const std::string& needle) {
+void ExpectRefused(const std::string& args, const std::string& needle, int exit_code = 1) {
   TempDir dir;
   const std::string trace = dir.File("trace.csv"), events = dir.File("events.csv");
   const Result r =
       Simulate(args + " --out " + Quote(trace) + " --events " + Quote(events) + " --json");
-  EXPECT_EQ(r.exit_code, 1) << "hybrid simulate " << args << "\n" << r.err;
+  EXPECT_EQ(r.exit_code, exit_code) << "hybrid simulate " << args << "\n" << r.err;
   EXPECT_NE(r.err.find(needle), std::string::npos)
       << "hybrid simulate " << args << "\nstderr: " << r.err;
   EXPECT_EQ(r.out, "") << args;
@@ -228,29 +234,53 @@ void ExpectRefused(const std::string& args, const std::string& needle) {
 
 TEST(HybridSimulate, RefusesBadOptions) {
   const std::string thermostat = Quote(Spec("thermostat"));
-  ExpectRefused(thermostat + " --input v=1", "'v' is not an input of the model (inputs: u)");
-  ExpectRefused(thermostat + " --input u", "expected NAME=SIGNAL");
-  ExpectRefused(thermostat + " --input =1", "expected NAME=SIGNAL");
-  ExpectRefused(thermostat + " --until -1", "horizon must be positive and finite");
-  ExpectRefused(thermostat + " --until 0", "horizon must be positive and finite");
-  ExpectRefused(thermostat + " --until inf", "horizon must be positive and finite");
-  ExpectRefused(thermostat + " --until nan", "horizon must be positive and finite");
+  ExpectRefused(thermostat + " --input v=1", "'v' is not an input of the model (inputs: u)", 2);
+  ExpectRefused(thermostat + " --input u", "expected NAME=SIGNAL", 2);
+  ExpectRefused(thermostat + " --input =1", "expected NAME=SIGNAL", 2);
+  ExpectRefused(thermostat + " --until -1", "--until: the horizon must be positive and finite", 2);
+  ExpectRefused(thermostat + " --until 0", "--until: the horizon must be positive and finite", 2);
+  ExpectRefused(thermostat + " --until inf", "--until: 'inf' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --until nan", "--until: 'nan' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --sample -1", "--sample", 2);
+  ExpectRefused(thermostat + " --input-csv x.csv --csv-shape cubic", "--csv-shape", 2);
+  // Values the model refuses: exit 1.
   ExpectRefused(thermostat + " --input u=50", "outside its bounds [-20, 30]");
   ExpectRefused(thermostat + " --input " + Quote("u=step(0: 1, 5: -21)"), "outside its bounds");
-  ExpectRefused(thermostat + " --sample -1", "--sample");
-  ExpectRefused(thermostat + " --input-csv x.csv --csv-shape cubic", "--csv-shape");
   const std::string x = Quote(Spec("finger"));  // u in [-1, 1]
   ExpectRefused(x + " --input u=5", "outside its bounds [-1, 1]");
+}
+
+// Numbers are numbers: every numeric option and --set value in the one decimal syntax; an empty,
+// hexadecimal, doubled-sign or trailing-garbage value is refused naming the option (exit 2).
+TEST(HybridSimulate, RefusesMalformedNumbersNamingTheOption) {
+  const std::string thermostat = Quote(Spec("thermostat"));
+  ExpectRefused(thermostat + " --until ''", "--until: empty", 2);
+  ExpectRefused(thermostat + " --until 0x10", "--until: '0x10' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --until +-5", "--until: '+-5' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --until 5s", "--until: '5s' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --until 1e999", "--until: '1e999' is out of range", 2);
+  ExpectRefused(thermostat + " --sample ''", "--sample: empty", 2);
+  ExpectRefused(thermostat + " --sample 0x1p-3", "--sample: '0x1p-3' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --set a=", "--set a: empty", 2);
+  ExpectRefused(thermostat + " --set a=0x10", "--set a: '0x10' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --set a=+-0.1", "--set a: '+-0.1' is not a decimal number", 2);
+  ExpectRefused(thermostat + " --set a=inf", "--set a: 'inf' is not a decimal number", 2);
+  // The same syntax accepted everywhere: a sign, digits, a fraction, an exponent.
+  const json j = SimulateJson(thermostat + " --until +1.5e1 --sample 5. --set a=+.1");
+  EXPECT_EQ(Field(j, "until"), 15.0);
 }
 
 TEST(HybridSimulate, RefusesMalformedSignalsWithTheirPosition) {
   const std::string thermostat = Quote(Spec("thermostat"));
   ExpectRefused(thermostat + " --input " + Quote("u=step(1: 0, 0: 1)"),
-                "--input u:1:12: signal times must increase strictly");
-  ExpectRefused(thermostat + " --input " + Quote("u=step(0 1)"), "--input u:1:");
-  ExpectRefused(thermostat + " --input " + Quote("u=ramp(0: 1)"), "--input u:1:");
-  ExpectRefused(thermostat + " --input " + Quote("u="), "--input u:1:");
-  ExpectRefused(thermostat + " --input " + Quote("u=1 2"), "--input u:1:");
+                "--input u:1:12: signal times must increase strictly", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=step(0 1)"), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=ramp(0: 1)"), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u="), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=1 2"), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=0x10"), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=+-1"), "--input u:1:", 2);
+  ExpectRefused(thermostat + " --input " + Quote("u=step(0: +-1)"), "--input u:1:", 2);
 }
 
 TEST(HybridSimulate, RefusesBadCsvFiles) {
@@ -273,6 +303,15 @@ TEST(HybridSimulate, RefusesBadCsvFiles) {
   ExpectRefused(thermostat + " --input-csv " + Quote(empty), "no data rows");
   const std::string bounds = inputs.Write("bounds.csv", "time,u\n0,1\n5,99\n");
   ExpectRefused(thermostat + " --input-csv " + Quote(bounds), "outside its bounds");
+  // CSV cells are numbers in the same decimal syntax as the options (no hexadecimal, no doubled
+  // sign, no inf or nan, nothing empty).
+  for (const std::string bad : {"0x10", "+-1", "inf", "nan", "", "1e999", "1 5"}) {
+    const std::string file = inputs.Write("number.csv", "time,u\n0,1\n5," + bad + "\n");
+    ExpectRefused(thermostat + " --input-csv " + Quote(file), file + ":3:2:");
+  }
+  const std::string signs = inputs.Write("signs.csv", "time,u\n+0,+1\n5.,-1e0\n");
+  const json ok = SimulateJson(thermostat + " --input-csv " + Quote(signs) + " --until 10");
+  EXPECT_EQ(Field(ok, "status"), "completed");
   const std::string missing = (inputs.path() / "missing.csv").string();
   ExpectRefused(thermostat + " --input-csv " + Quote(missing), "cannot open input CSV");
 }
@@ -283,6 +322,71 @@ TEST(HybridSimulate, RefusesAnInitialStateOutsideItsInvariant) {
       dir.Write("cold.ha", testing::ReplaceOnce(testing::SpecText("thermostat"),
                                                 "init off { x = 20; }", "init off { x = 17; }"));
   ExpectRefused(Quote(model), "the initial state violates the invariant 'x >= 18'");
+}
+
+// Outputs are checked before any work: two outputs naming one file, or an output naming the model
+// or the input CSV, exit 2 naming both options, and no file is written or changed.
+TEST(HybridSimulate, RefusesOutputsNamingOneFileOrAnInput) {
+  TempDir dir;
+  const std::string model = dir.Write("m.ha", testing::SpecText("thermostat"));
+  const std::string csv = dir.Write("u.csv", "time,u\n0,1\n");
+  const std::string kept = dir.Write("t.csv", "kept\n");
+  const auto refused = [&](const std::string& args, const std::string& needle) {
+    const Result r = Simulate(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.out, "") << args;
+    EXPECT_EQ(ReadAll(model), testing::SpecText("thermostat")) << args;
+    EXPECT_EQ(ReadAll(csv), "time,u\n0,1\n") << args;
+    EXPECT_EQ(ReadAll(kept), "kept\n") << args;
+    EXPECT_EQ(dir.Files(), (std::vector<std::string>{"m.ha", "t.csv", "u.csv"})) << args;
+  };
+  refused(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(kept),
+          "--out and --events name the same file");
+  // The same file under another name: "./", "..", a symbolic link.
+  const std::string other = (dir.path() / "." / "sub" / ".." / "t.csv").string();
+  std::filesystem::create_directory(dir.path() / "sub");
+  refused(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(other),
+          "--out and --events name the same file");
+  std::filesystem::remove(dir.path() / "sub");
+  std::filesystem::create_symlink(kept, dir.path() / "link.csv");
+  const Result via_link =
+      Simulate(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(dir.File("link.csv")));
+  EXPECT_EQ(via_link.exit_code, 2) << via_link.err;
+  EXPECT_EQ(ReadAll(kept), "kept\n");
+  std::filesystem::remove(dir.path() / "link.csv");
+  // Not yet existing files too.
+  refused(Quote(model) + " --out " + Quote(dir.File("new.csv")) + " --events " +
+              Quote((dir.path() / "." / "new.csv").string()),
+          "--out and --events name the same file");
+  refused(Quote(model) + " --out " + Quote(model), "--out '" + model + "' names the input MODEL");
+  refused(Quote(model) + " --events " + Quote(model), "names the input MODEL");
+  refused(Quote(model) + " --input-csv " + Quote(csv) + " --out " + Quote(csv),
+          "names the input --input-csv");
+  // Devices are not files: both outputs may go to /dev/null.
+  const Result null = Simulate(Quote(model) + " --out /dev/null --events /dev/null");
+  EXPECT_EQ(null.exit_code, 0) << null.err;
+}
+
+// A missing directory is found before the simulation, and nothing is written: the trajectory of
+// a run whose event log cannot be written is not left behind.
+TEST(HybridSimulate, OutputsAreAllOrNothing) {
+  TempDir dir;
+  const std::string trace = dir.File("trace.csv");
+  const Result r = Simulate(Quote(Spec("thermostat")) + " --out " + Quote(trace) + " --events " +
+                            Quote(dir.File("no_such_dir/events.csv")));
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("--events"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_TRUE(dir.Files().empty()) << dir.Files().front();
+  // An existing events file that cannot be replaced (a directory) leaves the trajectory alone.
+  const std::string old_trace = dir.Write("trace.csv", "old\n");
+  std::filesystem::create_directory(dir.path() / "events.csv");
+  const Result d = Simulate(Quote(Spec("thermostat")) + " --out " + Quote(old_trace) +
+                            " --events " + Quote(dir.File("events.csv")));
+  EXPECT_EQ(d.exit_code, 3) << d.err;
+  EXPECT_EQ(ReadAll(old_trace), "old\n");
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"events.csv", "trace.csv"}));
 }
 
 TEST(HybridSimulate, UnwritableOutputExitsThree) {
