@@ -6,10 +6,14 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "automaton/expression.h"
 
 namespace hybrid {
 
@@ -65,32 +69,40 @@ void RecordError(int error_code, const char* module, const char* function, char*
   *static_cast<std::string*>(data) = msg ? msg : "";
 }
 
-// "FLAG_NAME (what CVODE said)" for a failed call.
+// "FLAG_NAME (what CVODE said)" for a failed call. CVodeGetReturnFlagName returns memory from
+// malloc that the caller owns.
 std::string Describe(int flag, const std::string& detail) {
-  std::string out = CVodeGetReturnFlagName(flag);
+  char* name = CVodeGetReturnFlagName(flag);
+  std::string out = name != nullptr ? name : "flag " + std::to_string(flag);
+  std::free(name);
   if (!detail.empty()) out += " (" + detail + ")";
   return out;
 }
 
+// Setup calls fail only on misuse or exhausted memory: an internal error.
 void Check(int flag, const char* call, const std::string& detail) {
   if (flag < 0) {
-    throw std::runtime_error(std::string("CvodeIntegrator: ") + call +
-                             " failed: " + Describe(flag, detail));
+    throw std::runtime_error(std::string("the ODE solver CVODE could not be set up (") + call +
+                             ": " + Describe(flag, detail) + ")");
   }
 }
 
 }  // namespace
 
+double InitialStepTarget(double t, double t_stop) {
+  return std::min(t_stop, t + 1e3 * std::max(std::abs(t), 1.0));
+}
+
 CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options& options)
     : h_(std::make_unique<Handles>()) {
   if (system == nullptr || dimension < 1) {
-    throw std::invalid_argument("CvodeIntegrator: null system or dimension < 1");
+    throw std::invalid_argument("the ODE solver needs a system and at least one state variable");
   }
   h_->system = system;
   h_->dimension = dimension;
   h_->options = options;
   if (SUNContext_Create(nullptr, &h_->context) != 0) {
-    throw std::runtime_error("CvodeIntegrator: SUNContext_Create failed");
+    throw std::runtime_error("the ODE solver CVODE could not create its context");
   }
   h_->y = N_VNew_Serial(dimension, h_->context);
   h_->dky = N_VNew_Serial(dimension, h_->context);
@@ -98,7 +110,7 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options
   h_->solver = SUNLinSol_Dense(h_->y, h_->matrix, h_->context);
   h_->cvode = CVodeCreate(CV_ADAMS, h_->context);
   if (!h_->y || !h_->dky || !h_->matrix || !h_->solver || !h_->cvode) {
-    throw std::runtime_error("CvodeIntegrator: cannot allocate SUNDIALS objects");
+    throw std::runtime_error("the ODE solver CVODE could not allocate its vectors and matrices");
   }
   // The library never prints: CVODE's messages are kept and reported through message(). Handles
   // lives on the heap, so the address of last_error survives moves of the integrator.
@@ -147,7 +159,8 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
   h_->last_error.clear();
   const int stop_flag = CVodeSetStopTime(h_->cvode, t_stop);
   if (stop_flag < 0) {
-    message_ = "CVodeSetStopTime: " + Describe(stop_flag, h_->last_error);
+    message_ = "CVODE refused the stop time " + FormatNumber(t_stop) + ": " +
+               Describe(stop_flag, h_->last_error);
     *t = h_->last_t;
     x->resize(h_->dimension);
     const double* y = N_VGetArrayPointer(h_->y);
@@ -159,8 +172,9 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
     h_->steps_towards_stop = 0;
   }
   if (++h_->steps_towards_stop > h_->options.max_steps) {
-    message_ = "CVode: CV_TOO_MUCH_WORK (more than " + std::to_string(h_->options.max_steps) +
-               " steps towards t = " + std::to_string(t_stop) + ")";
+    message_ = "CVODE failed: CV_TOO_MUCH_WORK (more than " +
+               std::to_string(h_->options.max_steps) +
+               " steps towards t = " + FormatNumber(t_stop) + ")";
     *t = h_->last_t;
     x->resize(h_->dimension);
     const double* y = N_VGetArrayPointer(h_->y);
@@ -168,7 +182,8 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
     return Status::kFailure;
   }
   sunrealtype reached = 0.0;
-  const int flag = CVode(h_->cvode, t_stop, h_->y, &reached, CV_ONE_STEP);
+  const int flag =
+      CVode(h_->cvode, InitialStepTarget(h_->last_t, t_stop), h_->y, &reached, CV_ONE_STEP);
   *t = reached;
   h_->last_t = reached;
   x->resize(h_->dimension);
@@ -179,7 +194,7 @@ CvodeIntegrator::Status CvodeIntegrator::Advance(double t_stop, double* t, Eigen
     return Status::kRoot;
   }
   if (flag < 0) {
-    message_ = "CVode: " + Describe(flag, h_->last_error);
+    message_ = "CVODE failed: " + Describe(flag, h_->last_error);
     return Status::kFailure;
   }
   return flag == CV_TSTOP_RETURN || reached >= t_stop ? Status::kReachedTime : Status::kStep;

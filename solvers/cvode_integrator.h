@@ -17,6 +17,13 @@ class OdeSystem {
   virtual void Roots(double t, const double* x, double* g) = 0;
 };
 
+/// The time towards which CVODE sizes its first step after a restart at `t` with stop time
+/// `t_stop`: min(t_stop, t + 1000 max(|t|, 1)). CVODE bounds that first step from below by
+/// 100 * unit roundoff * max(|t|, |target|); aimed at a far stop time (a horizon of 1e50) the bound
+/// alone would exceed the dynamics' time scale by far, and the first step with it. The stop time
+/// itself is unchanged: steps never pass `t_stop`.
+double InitialStepTarget(double t, double t_stop);
+
 /// The one owner of raw SUNDIALS handles: an RAII wrapper over CVODE (SUNDIALS 6.4) with root
 /// finding. Not copyable; movable.
 ///
@@ -26,7 +33,9 @@ class OdeSystem {
 ///
 /// The integrator never prints: CVODE's error handler is replaced by one that keeps the last
 /// message (errors and warnings), which failures report in message() (and setup errors in the
-/// exception text). CVODE cannot start a step towards a stop time within about 2 * unit roundoff
+/// exception text). The first step after every restart is sized towards InitialStepTarget, not
+/// towards the stop time, so that the run does not depend on how far away the stop time is. CVODE
+/// cannot start a step towards a stop time within about 2 * unit roundoff
 /// * |t| of the restart time: Advance then reports kFailure (CV_TOO_CLOSE, "tout too close to t0
 /// to start integration"); the Simulator steps over such short gaps without CVODE.
 class CvodeIntegrator {
@@ -72,7 +81,7 @@ class CvodeIntegrator {
   /// CVodeGetRootInfo.
   const std::vector<int>& root_info() const { return root_info_; }
   /// The last failure: the return flag and, in parentheses, what CVODE said, e.g.
-  /// "CVode: CV_TOO_CLOSE (tout too close to t0 to start integration.)".
+  /// "CVODE failed: CV_TOO_CLOSE (tout too close to t0 to start integration.)".
   const std::string& message() const { return message_; }
   /// Number of internal steps taken since construction.
   long steps() const;

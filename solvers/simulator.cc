@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -23,6 +24,10 @@ std::string_view StatusName(SimulationStatus status) {
       return "solver_failure";
     case SimulationStatus::kEventLimit:
       return "event_limit";
+    case SimulationStatus::kStepLimit:
+      return "step_limit";
+    case SimulationStatus::kUnresolved:
+      return "unresolved";
   }
   return "?";
 }
@@ -42,6 +47,12 @@ struct CompiledComparison {
   Relation relation;
   std::string text;
   Linearity linearity;
+  // The two sides, for the scale of the resolution tolerance.
+  CompiledExpression lhs;
+  CompiledExpression rhs;
+  // The residual may jump (sign, tan, atan2, a division by a non-constant): exempt from the
+  // resolution check, since a located crossing of a jump is not on its boundary.
+  bool may_jump = false;
 };
 
 struct CompiledTransition {
@@ -88,6 +99,34 @@ bool Holds(Relation relation, double r, double tol, bool closure) {
       return r >= -tol;
     case Relation::kEqual:
       return std::abs(r) <= tol;
+  }
+  return false;
+}
+
+// Whether `e` contains an operation whose value may jump as the state moves continuously: sign,
+// tan, atan2, or a division by something that reads a slot for which `varies` holds. Shared
+// subexpressions are visited once.
+bool MayJump(const Expression& e, const std::function<bool(int)>& varies) {
+  std::vector<Expression> stack = {e};
+  std::set<const void*> seen;
+  while (!stack.empty()) {
+    const Expression node = stack.back();
+    stack.pop_back();
+    if (!seen.insert(node.node_id()).second) continue;
+    switch (node.op()) {
+      case Op::kSign:
+      case Op::kTan:
+      case Op::kAtan2:
+        return true;
+      case Op::kDiv: {
+        const std::vector<int> slots = node.args()[1].Slots();
+        if (std::any_of(slots.begin(), slots.end(), varies)) return true;
+        break;
+      }
+      default:
+        break;
+    }
+    for (const Expression& arg : node.args()) stack.push_back(arg);
   }
   return false;
 }
@@ -162,8 +201,16 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
     };
     auto comparison = [&](const Comparison& c) {
       const Expression residual = global(c.Residual());
-      return CompiledComparison{CompiledExpression(residual), c.relation, c.ToString(),
-                                linearity(residual)};
+      return CompiledComparison{CompiledExpression(residual),
+                                c.relation,
+                                c.ToString(),
+                                linearity(residual),
+                                CompiledExpression(global(c.lhs)),
+                                CompiledExpression(global(c.rhs)),
+                                MayJump(residual, [&](int slot) {
+                                  return symbols[slot].kind == SymbolKind::kVariable ||
+                                         symbols[slot].kind == SymbolKind::kInput;
+                                })};
     };
     CompiledComponent cc;
     cc.instance = comp.instance;
@@ -203,7 +250,8 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
       cc.transitions.push_back(std::move(ct));
     }
     if (a.initial_states().empty()) {
-      throw std::invalid_argument("Simulator: component '" + a.name() + "' has no initial state");
+      throw std::invalid_argument("component '" + a.name() +
+                                  "' has no initial state: it cannot be simulated");
     }
     const InitialState& init = a.initial_states().front();
     cc.initial_mode = init.mode.value();
@@ -360,13 +408,59 @@ class Run final : public OdeSystem {
     return true;
   }
 
+  // The first comparison of component c's current invariant violated beyond event_tolerance.
+  std::optional<std::string> ViolatedInvariantOf(size_t c) const {
+    for (const CompiledComparison& cmp : components_[c].modes[modes_[c]].invariant) {
+      if (!Holds(cmp.relation, cmp.residual.Evaluate(env_.data()), options_.event_tolerance,
+                 true)) {
+        return cmp.text;
+      }
+    }
+    return std::nullopt;
+  }
   // The first comparison of the current modes' invariants violated beyond tolerance, as text.
   std::optional<std::string> ViolatedInvariant() const {
     for (size_t c = 0; c < components_.size(); ++c) {
-      for (const CompiledComparison& cmp : components_[c].modes[modes_[c]].invariant) {
-        if (!Holds(cmp.relation, cmp.residual.Evaluate(env_.data()), options_.event_tolerance,
-                   true)) {
-          return cmp.text;
+      if (auto violated = ViolatedInvariantOf(c)) return violated;
+    }
+    return std::nullopt;
+  }
+
+  // How far from its boundary a located event may leave comparison `c` at the current state
+  // (SimulationOptions::resolution_tolerance).
+  double ResolutionTolerance(const CompiledComparison& c) const {
+    return options_.event_tolerance +
+           options_.resolution_tolerance *
+               (std::abs(c.lhs.Evaluate(env_.data())) + std::abs(c.rhs.Evaluate(env_.data())));
+  }
+  // Root function i at the current state, if it is off its boundary by more than its resolution
+  // tolerance: (residual, tolerance).
+  std::optional<std::pair<double, double>> OffBoundary(int i) const {
+    const CompiledComparison& c = ComparisonOf(roots_[i]);
+    if (c.may_jump) return std::nullopt;
+    const double residual = c.residual.Evaluate(env_.data());
+    const double tolerance = ResolutionTolerance(c);
+    if (std::abs(residual) <= tolerance) return std::nullopt;
+    return std::make_pair(residual, tolerance);
+  }
+
+  // Loads a recorded state (its modes' discrete values, its variables and the inputs at its time)
+  // and returns the first invariant comparison it violates beyond the resolution tolerance, with
+  // its residual, or nullopt. Leaves the environment at that state: for after the run.
+  std::optional<std::pair<std::string, double>> OutsideInvariant(const StateSample& s) {
+    for (size_t c = 0; c < components_.size(); ++c) {
+      for (const auto& [slot, value] : components_[c].modes[s.modes[c]].discrete) {
+        env_[slot] = value;
+      }
+    }
+    for (size_t i = 0; i < variable_slots_.size(); ++i) env_[variable_slots_[i]] = s.x[i];
+    for (const InputSignal& signal : signals_) env_[signal.slot] = signal.ValueAt(s.time);
+    for (size_t c = 0; c < components_.size(); ++c) {
+      for (const CompiledComparison& cmp : components_[c].modes[s.modes[c]].invariant) {
+        if (cmp.may_jump) continue;
+        const double residual = cmp.residual.Evaluate(env_.data());
+        if (!Holds(cmp.relation, residual, ResolutionTolerance(cmp), true)) {
+          return std::make_pair(cmp.text, residual);
         }
       }
     }
@@ -396,16 +490,98 @@ class Run final : public OdeSystem {
 // A candidate jump: the participating (component, transition) pairs.
 using Jump = std::vector<std::pair<int, int>>;
 
+// The scenario's signals overridden by `signals`. Throws std::invalid_argument for a signal that
+// drives something other than an input.
+std::vector<InputSignal> MergedInputs(const System& system, std::span<const InputSignal> signals) {
+  const SymbolTable& symbols = system.symbols();
+  std::vector<InputSignal> inputs;
+  if (system.scenario()) inputs = system.scenario()->inputs;
+  for (const InputSignal& s : signals) {
+    if (s.slot < 0 || s.slot >= symbols.size() || symbols[s.slot].kind != SymbolKind::kInput) {
+      throw std::invalid_argument("a signal drives something that is not an input");
+    }
+    std::erase_if(inputs, [&](const InputSignal& x) { return x.slot == s.slot; });
+    inputs.push_back(s);
+  }
+  return inputs;
+}
+
+// The first recorded state outside its modes' invariants (beyond the resolution tolerance), as
+// a message, or nullopt. A state left by a jump at its own instant (a kBeforeEvent sample at the
+// same time in the same modes follows) is exempt: an urgent transition may leave at once a mode
+// entered outside its invariant.
+std::optional<std::string> StateOutsideInvariant(Run& run, const std::vector<StateSample>& samples,
+                                                 const Simulator& simulator) {
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const StateSample& s = samples[i];
+    const auto outside = run.OutsideInvariant(s);
+    if (!outside) continue;
+    bool left = false;
+    for (size_t j = i + 1; j < samples.size() && samples[j].time == s.time && !left; ++j) {
+      left = samples[j].kind == StateSample::Kind::kBeforeEvent && samples[j].modes == s.modes;
+    }
+    if (left) continue;
+    return "the state recorded at t = " + FormatNumber(s.time) + " lies outside the invariant '" +
+           outside->first + "' of mode " + simulator.ModeLabel(s.modes) + " (residual " +
+           FormatNumber(outside->second) + "): the run is not resolved there";
+  }
+  return std::nullopt;
+}
+
+// Throws std::invalid_argument for a setting out of its range, or for a run that would record
+// more than options.max_samples samples at sample times (until > 0 and finite).
+void CheckOptions(const SimulationOptions& o, double until) {
+  auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  auto positive = [&](double v, const char* what) {
+    if (!(v > 0.0) || !std::isfinite(v)) {
+      fail(std::string("the ") + what + " must be positive and finite, got " + FormatNumber(v));
+    }
+  };
+  auto non_negative = [&](double v, const char* what) {
+    if (!(v >= 0.0) || !std::isfinite(v)) {
+      fail(std::string("the ") + what + " must be finite and >= 0, got " + FormatNumber(v));
+    }
+  };
+  positive(o.relative_tolerance, "relative tolerance");
+  positive(o.absolute_tolerance, "absolute tolerance");
+  non_negative(o.event_tolerance, "event tolerance");
+  non_negative(o.resolution_tolerance, "resolution tolerance");
+  non_negative(o.sample_step, "sample step (--sample)");
+  non_negative(o.max_step, "largest step");
+  non_negative(o.zeno_window, "Zeno window");
+  non_negative(o.zeno_horizon, "Zeno horizon");
+  if (o.dense_checks < 0 || o.dense_checks > 1000) fail("dense checks must lie in [0, 1000]");
+  if (o.max_event_iterations < 1) fail("the event iteration bound must be at least 1");
+  if (o.zeno_events < 0) fail("the Zeno event count must be >= 0");
+  if (o.max_events < 0) fail("the event limit must be >= 0");
+  if (o.max_samples < 0) fail("the sample limit must be >= 0");
+  if (o.max_steps < 1) fail("the step limit must be at least 1");
+  // Samples at sample times: refused before the run rather than grown without bound.
+  const double uniform = o.sample_step > 0.0 ? std::floor(until / o.sample_step) : 0.0;
+  const double planned = uniform + static_cast<double>(o.sample_times.size());
+  if (planned > static_cast<double>(o.max_samples)) {
+    std::string what;
+    if (uniform > 0.0) {
+      what = "recording the state every " + FormatNumber(o.sample_step) +
+             " (--sample) up to t = " + FormatNumber(until) + " (--until)";
+    }
+    if (!o.sample_times.empty()) {
+      what += (what.empty() ? "recording the state at " : " and at ") +
+              std::to_string(o.sample_times.size()) + " listed times";
+    }
+    fail(what + " would record " + FormatNumber(planned) + " samples, more than the limit of " +
+         std::to_string(o.max_samples) +
+         (uniform > 0.0 ? ": give a larger sample step or a shorter horizon" : ""));
+  }
+}
+
 }  // namespace
 
 SimulationResult Simulator::Run(const SimulationOptions& options,
                                 std::span<const InputSignal> signals) const {
-  constexpr std::string_view kApi = "Simulator::Run: ";
   const System& system = *c_->system;
   const SymbolTable& symbols = system.symbols();
-  auto fail = [&](const std::string& message) {
-    throw std::invalid_argument(std::string(kApi) + message);
-  };
+  auto fail = [&](const std::string& message) { throw std::invalid_argument(message); };
 
   // Horizon and inputs.
   double until = 0.0;
@@ -419,6 +595,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   if (!std::isfinite(until) || !(until > 0.0)) {
     fail("the horizon must be positive and finite, got " + FormatNumber(until));
   }
+  CheckOptions(options, until);
   for (size_t i = 0; i < options.sample_times.size(); ++i) {
     const double ts = options.sample_times[i];
     if (!std::isfinite(ts) || ts < 0.0 || ts > until) {
@@ -426,15 +603,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     }
     if (i > 0 && ts < options.sample_times[i - 1]) fail("sample times must not decrease");
   }
-  std::vector<InputSignal> inputs;
-  if (system.scenario()) inputs = system.scenario()->inputs;
-  for (const InputSignal& s : signals) {
-    if (s.slot < 0 || s.slot >= symbols.size() || symbols[s.slot].kind != SymbolKind::kInput) {
-      fail("a signal drives something that is not an input");
-    }
-    std::erase_if(inputs, [&](const InputSignal& x) { return x.slot == s.slot; });
-    inputs.push_back(s);
-  }
+  const std::vector<InputSignal> inputs = MergedInputs(system, signals);
   for (const InputSignal& s : inputs) {
     const std::string& name = symbols[s.slot].name;
     if (s.points.empty()) fail("signal for '" + name + "' has no points");
@@ -713,6 +882,51 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     return true;
   };
 
+  // A located event must sit on its boundary: the root functions that crossed are within their
+  // resolution tolerance of zero at the state reached. Otherwise time, rounded to doubles, no
+  // longer resolves the dynamics there (or the solver's root location failed): a message.
+  auto unresolved_crossing = [&](const std::vector<int>& crossed) -> std::optional<std::string> {
+    for (int i : crossed) {
+      const auto off = run.OffBoundary(i);
+      if (!off) continue;
+      const RootRef& ref = run.roots()[i];
+      const double resolution = std::nextafter(t, std::numeric_limits<double>::infinity()) - t;
+      return "at t = " + FormatNumber(t) + " the event on '" + run.ComparisonOf(ref).text +
+             "' in mode " + ModeLabel(run.modes()) + " cannot be located: the state reached is " +
+             FormatNumber(std::abs(off->first)) + " from its boundary, beyond the tolerance " +
+             FormatNumber(off->second) + "; time is resolved only to " + FormatNumber(resolution) +
+             " there (a shorter horizon, or larger tolerances)";
+    }
+    return std::nullopt;
+  };
+
+  // A step input jumped at t: an urgent guard may hold now, and a component the jump leaves
+  // outside its invariant has reached its boundary at this instant (its lazy transitions may
+  // fire; if none does, the invariant is violated). Returns false when the run must stop.
+  auto input_jump = [&]() {
+    for (size_t c = 0; c < reached_invariant.size(); ++c) {
+      if (auto violated = run.ViolatedInvariantOf(c)) reached_invariant[c] = *violated;
+    }
+    std::vector<Jump> jumps = candidates();
+    EventRecord::Cause cause = EventRecord::Cause::kEnabled;
+    if (!jumps.empty()) {
+      const auto [c0, t0] = jumps.front().front();
+      if (c_->components[c0].transitions[t0].urgency == Urgency::kLazy) {
+        cause = EventRecord::Cause::kInvariant;
+      }
+    }
+    if (!jump_and_iterate(std::move(jumps), cause)) return false;
+    for (size_t c = 0; c < reached_invariant.size(); ++c) {
+      if (reached_invariant[c].empty()) continue;
+      result.status = SimulationStatus::kInvariantViolated;
+      result.message = "at t = " + FormatNumber(t) + " the input jump leaves the state outside " +
+                       "the invariant '" + reached_invariant[c] + "' of mode " +
+                       ModeLabel(run.modes()) + " and no transition is enabled";
+      return false;
+    }
+    return !zeno_check();
+  };
+
   CvodeIntegrator::Options io;
   io.relative_tolerance = options.relative_tolerance;
   io.absolute_tolerance = options.absolute_tolerance;
@@ -769,8 +983,17 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   // A segment after a restart shorter than this times |t| is not given to CVODE (see its use).
   constexpr double kShortGap = 100 * std::numeric_limits<double>::epsilon();
   int stalled = 0;
+  long passes = 0;  // SimulationOptions::max_steps
 
   while (running && t < until) {
+    if (++passes > options.max_steps) {
+      result.status = SimulationStatus::kStepLimit;
+      result.message =
+          "more than " + std::to_string(options.max_steps) +
+          " integration steps (solver steps and exact segments) before t = " + FormatNumber(t) +
+          " (step limit)";
+      break;
+    }
     while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
     const double t_stop = std::min(
         {until, next_sample, next_break < breakpoints.size() ? breakpoints[next_break] : until});
@@ -940,6 +1163,11 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
 
     forget_reached();  // a new instant
     if (status == CvodeIntegrator::Status::kRoot || interior) {
+      if (auto off = unresolved_crossing(crossed)) {
+        result.status = SimulationStatus::kUnresolved;
+        result.message = *off;
+        break;
+      }
       note_reached(crossed);
       std::vector<Jump> jumps = candidates();
       const bool jumped = !jumps.empty();
@@ -988,8 +1216,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       run.SetStepInputs(t);
       run.Load(t, x.data());
       settled_time = std::numeric_limits<double>::quiet_NaN();  // the inputs changed
-      running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
-      if (running && zeno_check()) running = false;
+      running = input_jump();
       restart = true;
     }
     if (!running) break;
@@ -1021,7 +1248,31 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     result.message = "stopped before the horizon";
   }
   record(StateSample::Kind::kEnd);
+  if (result.status == SimulationStatus::kCompleted) {
+    if (auto outside = StateOutsideInvariant(run, result.samples, *this)) {
+      result.status = SimulationStatus::kUnresolved;
+      result.message = *outside;
+    }
+  }
   return result;
+}
+
+std::optional<std::string> Simulator::FirstStateOutsideInvariant(
+    const SimulationResult& result, const SimulationOptions& options,
+    std::span<const InputSignal> signals) const {
+  const size_t n = c_->variable_slots.size();
+  for (const StateSample& s : result.samples) {
+    bool modes_ok = s.modes.size() == c_->components.size();
+    for (size_t c = 0; c < s.modes.size() && modes_ok; ++c) {
+      modes_ok = s.modes[c] >= 0 && s.modes[c] < static_cast<int>(c_->components[c].modes.size());
+    }
+    if (!modes_ok || static_cast<size_t>(s.x.size()) != n) {
+      throw std::invalid_argument("a recorded state does not fit the model (modes or variables)");
+    }
+  }
+  hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env,
+                  MergedInputs(*c_->system, signals), options);
+  return StateOutsideInvariant(run, result.samples, *this);
 }
 
 }  // namespace hybrid

@@ -14,12 +14,21 @@
 namespace hybrid {
 
 /// Settings of one simulation run. Defaults suit models whose time scale is between 1e-3 and
-/// 1e4 (seconds, or any unit).
+/// 1e4 (seconds, or any unit). Run throws std::invalid_argument for a setting out of its range.
+///
+/// Bounds. Every run ends after a bounded amount of work and memory, each bound a count (never a
+/// time, so that outcomes do not depend on the machine's load): at most `max_steps` passes of the
+/// integration loop (kStepLimit), `max_events` events in all (kEventLimit) and
+/// `max_event_iterations` at one instant (kZeno), at most CvodeIntegrator::Options::max_steps
+/// solver steps towards one stop time (kSolverFailure), and at most `max_samples` samples
+/// recorded at sample times (refused before the run). So a run records at most
+/// max_samples + 2 max_events + 2 states; with the defaults its result stays below about 350 MB
+/// for a model of a few variables.
 struct SimulationOptions {
   /// Horizon; nullopt uses the model's scenario (Run throws if there is none).
   std::optional<double> until;
   /// > 0: also record the state every `sample_step` (from the start); 0: only the start, the end
-  /// and both sides of every event.
+  /// and both sides of every event. Finite and >= 0.
   double sample_step = 0.0;
   /// Further times at which to record the state (StateSample::Kind::kSample), e.g. the instants
   /// of measured samples. Non-decreasing, finite, within [0, until]; a repeated time is recorded
@@ -32,9 +41,17 @@ struct SimulationOptions {
   /// A residual within this of 0 counts as on the boundary (non-strict guards hold, invariants
   /// are not violated).
   double event_tolerance = 1e-9;
+  /// Resolution check. A located event (a root function that crossed) must leave its comparison
+  /// within event_tolerance + resolution_tolerance * (|lhs| + |rhs|) of its boundary, and every
+  /// state a completed run records must satisfy its modes' invariants within the same tolerance;
+  /// otherwise the run ends as kUnresolved (time, rounded to doubles, no longer resolves the
+  /// dynamics: a horizon so far that one unit of time resolution moves the state past the
+  /// tolerance). Comparisons that may jump (sign, tan, atan2, a division by a non-constant) are
+  /// exempt.
+  double resolution_tolerance = 1e-6;
   /// Interior points of every integration step at which the root functions are also evaluated on
   /// the step's interpolating polynomial, to find a guard that crosses twice inside one step (CVODE
-  /// looks only at step ends). 0 disables the check.
+  /// looks only at step ends). 0 disables the check. At most 1000.
   int dense_checks = 4;
   /// Largest internal step (0: unlimited).
   double max_step = 0.0;
@@ -49,11 +66,18 @@ struct SimulationOptions {
   int zeno_events = 10;
   double zeno_window = 1e-6;
   double zeno_horizon = 1e-4;
-  /// Total number of events allowed.
-  long max_events = 1000000;
+  /// Total number of events allowed (kEventLimit beyond). Each event records two states.
+  long max_events = 500000;
+  /// Most states recorded at sample times: the uniform samples (about until / sample_step) plus
+  /// `sample_times`. A run that would record more is refused before it starts.
+  long max_samples = 1000000;
+  /// Most passes of the integration loop in one run: CVODE steps, exact (constant-rate) segments
+  /// and steps over short gaps, each a pass (kStepLimit beyond).
+  long max_steps = 10000000;
 };
 
-/// How a run ended. Only kCompleted reaches the horizon.
+/// How a run ended. Only kCompleted reaches the horizon, and a kCompleted run has every recorded
+/// state inside its modes' invariants (within the resolution tolerance) and every event located.
 enum class SimulationStatus {
   kCompleted,
   /// Events accumulate (or iterate at one instant): see SimulationResult::zeno.
@@ -66,9 +90,17 @@ enum class SimulationStatus {
   kSolverFailure,
   /// More than SimulationOptions::max_events events.
   kEventLimit,
+  /// More than SimulationOptions::max_steps passes of the integration loop.
+  kStepLimit,
+  /// Time, rounded to doubles, no longer resolves the run: a located event is off its boundary,
+  /// or a recorded state lies outside its mode's invariant, by more than the resolution tolerance
+  /// (SimulationOptions::resolution_tolerance). No recorded state after the message's time is
+  /// trustworthy.
+  kUnresolved,
 };
 
-/// "completed", "zeno", "invariant_violated", "solver_failure", "event_limit".
+/// "completed", "zeno", "invariant_violated", "solver_failure", "event_limit", "step_limit",
+/// "unresolved".
 std::string_view StatusName(SimulationStatus status);
 
 /// One recorded state.
@@ -174,20 +206,33 @@ struct SimulationResult {
 class Simulator {
  public:
   /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument
-  /// ("Simulator: ...") if some component has no initial state.
+  /// if some component has no initial state.
   explicit Simulator(const System& system);
   ~Simulator();
   Simulator(Simulator&&) noexcept;
 
   /// Runs from the first initial state of each component (interval initial values start at
   /// their midpoint). Inputs: `signals` (System input slots) override the scenario's signals;
-  /// inputs with neither are 0. Throws std::invalid_argument ("Simulator::Run: ...") for misuse:
-  /// a non-positive or non-finite horizon, no horizon and no scenario, a signal for a
-  /// non-input, a signal value outside the input's bounds, non-finite signal points, an initial
-  /// state that violates its mode's invariant or is not finite. Run-time outcomes (Zeno, invariant
-  /// violation, solver failure) are statuses in the result.
+  /// inputs with neither are 0. Throws std::invalid_argument, with a message for the user, for
+  /// misuse: a non-positive or non-finite horizon, no horizon and no scenario, an option out of
+  /// its range, more samples than SimulationOptions::max_samples, a signal for a non-input, a
+  /// signal value outside the input's bounds, non-finite signal points, an initial state that
+  /// violates its mode's invariant or is not finite. Run-time outcomes (Zeno, invariant
+  /// violation, solver failure, limits, lost resolution) are statuses in the result.
   SimulationResult Run(const SimulationOptions& options,
                        std::span<const InputSignal> signals = {}) const;
+
+  /// The general guard of every run: the first state of `result.samples` that lies outside its
+  /// modes' invariants by more than the resolution tolerance (SimulationOptions), as a message
+  /// naming its time, the invariant and the mode; nullopt if none. The inputs are those of a run
+  /// with `signals`. A state followed, at the same time and in the same modes, by a kBeforeEvent
+  /// sample is exempt (a jump leaves it at once). Run applies it to every run that reached its
+  /// horizon, and reports kUnresolved instead of kCompleted when it finds a state; callers that
+  /// replay or doctor a result may apply it too. Throws std::invalid_argument if a state does
+  /// not fit the model (mode indices, number of variables) or a signal drives a non-input.
+  std::optional<std::string> FirstStateOutsideInvariant(
+      const SimulationResult& result, const SimulationOptions& options,
+      std::span<const InputSignal> signals = {}) const;
 
   /// Names of the continuous variables, the order of StateSample::x.
   const std::vector<std::string>& variable_names() const;
