@@ -72,6 +72,21 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+/// Whether this program is built with AddressSanitizer (which cannot run under a limit on
+/// virtual memory: it reserves terabytes of address space for its shadow memory).
+inline constexpr bool kAddressSanitizer =
+#if defined(__SANITIZE_ADDRESS__)
+    true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    true;
+#else
+    false;
+#endif
+#else
+    false;
+#endif
+
 /// Exit code and captured output of one run.
 struct Result {
   int exit_code = -1;
@@ -81,10 +96,12 @@ struct Result {
 
 /// Runs `hybrid ARGS` through the shell (arguments as written: quote them), with standard output
 /// redirected to `stdout_target` when given. A run that does not exit normally is a test failure.
-inline Result RunHybrid(const std::string& args, const std::string& stdout_target = "") {
+/// `shell_prefix` (e.g. "ulimit -v 100000; ") runs before the command in the same shell.
+inline Result RunHybrid(const std::string& args, const std::string& stdout_target = "",
+                        const std::string& shell_prefix = "") {
   TempDir dir;
   const std::filesystem::path out = dir.path() / "stdout", err = dir.path() / "stderr";
-  const std::string command = Quote(HYBRID_BINARY) + " " + args + " >" +
+  const std::string command = shell_prefix + Quote(HYBRID_BINARY) + " " + args + " >" +
                               (stdout_target.empty() ? Quote(out.string()) : stdout_target) +
                               " 2>" + Quote(err.string()) + " </dev/null";
   const int status = std::system(command.c_str());

@@ -24,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using testing::Field;
 using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
@@ -90,7 +91,7 @@ std::string Number(double x) {
 // every input as a step signal, every parameter set.
 std::string ReplayArguments(const json& trace, double until) {
   std::string args;
-  for (const auto& [name, points] : trace["inputs"].items()) {
+  for (const auto& [name, points] : Field(trace, "inputs").items()) {
     std::string signal = name + "=step(";
     for (std::size_t i = 0; i < points.size(); ++i) {
       signal += (i ? ", " : "") + Number(points[i][0].get<double>()) + ": " +
@@ -98,7 +99,7 @@ std::string ReplayArguments(const json& trace, double until) {
     }
     args += " --input " + Quote(signal + ")");
   }
-  for (const auto& [name, value] : trace["parameters"].items()) {
+  for (const auto& [name, value] : Field(trace, "parameters").items()) {
     args += " --set " + Quote(name + "=" + Number(value.get<double>()));
   }
   return args + " --until " + Number(until);
@@ -127,12 +128,12 @@ TEST(CheckCommand, ProvesEveryInvariantOfTheFingerAndReachesFullClosure) {
   const json report = RunHybridJson("check " + Quote(kFinger), 0);
   EXPECT_EQ(report.value("model", ""), kFinger);
   EXPECT_EQ(report.value("method", ""), "prove");
-  EXPECT_TRUE(report.contains("seconds") && report["seconds"].is_number());
+  EXPECT_TRUE(report.contains("seconds") && Field(report, "seconds").is_number());
   EXPECT_FALSE(report.contains("modes"));
   ASSERT_TRUE(report.contains("properties"));
-  ASSERT_EQ(report["properties"].size(), 13u) << report.dump(2);
+  ASSERT_EQ(Field(report, "properties").size(), 13u) << report.dump(2);
   int invariants = 0;
-  for (const json& p : report["properties"]) {
+  for (const json& p : Field(report, "properties")) {
     const std::string kind = p.value("kind", "");
     EXPECT_FALSE(p.value("predicate", "").empty()) << p;
     EXPECT_FALSE(p.value("reason", "").empty()) << p;
@@ -151,16 +152,17 @@ TEST(CheckCommand, ProvesEveryInvariantOfTheFingerAndReachesFullClosure) {
   EXPECT_EQ(close.value("kind", ""), "reach");
   EXPECT_EQ(close.value("verdict", ""), "reachable") << close.dump(2);
   ASSERT_TRUE(close.contains("trace")) << close.dump(2);
-  const json& trace = close["trace"];
+  const json& trace = Field(close, "trace");
   EXPECT_EQ(trace.value("replay_status", ""), "completed");
   ASSERT_TRUE(trace.contains("state")) << trace.dump(2);
-  const json& values = trace["state"]["values"];
+  const json& values = Field(trace, "state", "values");
   EXPECT_NEAR(values.value("theta1", -1.0), 70.0, 1e-6) << trace.dump(2);
   EXPECT_NEAR(values.value("theta2", -1.0), 90.0, 1e-6) << trace.dump(2);
   // The witness closes the finger: links 1 and 2 hit their limits in turn.
-  ASSERT_FALSE(trace["events"].empty());
-  EXPECT_EQ(trace["events"].back().value("mode_after", ""), trace["state"].value("mode", ""));
-  EXPECT_LE(trace["state"].value("time", 1e9), trace.value("until", 0.0));
+  ASSERT_FALSE(Field(trace, "events").empty());
+  EXPECT_EQ(Field(trace, "events").back().value("mode_after", ""),
+            Field(trace, "state").value("mode", ""));
+  EXPECT_LE(Field(trace, "state").value("time", 1e9), trace.value("until", 0.0));
 }
 
 TEST(CheckCommand, TextOutputNamesTheModelAndTheVerdicts) {
@@ -199,16 +201,16 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   EXPECT_EQ(p.value("verdict", ""), "violated") << p.dump(2);
   EXPECT_EQ(p.value("method", ""), "prove");
   ASSERT_TRUE(p.contains("trace")) << p.dump(2);
-  const json& trace = p["trace"];
+  const json& trace = Field(p, "trace");
   ASSERT_TRUE(trace.contains("state")) << trace.dump(2);
-  ASSERT_TRUE(trace["inputs"].contains("u")) << trace.dump(2);
-  ASSERT_TRUE(trace["initial_values"].empty())
+  ASSERT_TRUE(Field(trace, "inputs").contains("u")) << trace.dump(2);
+  ASSERT_TRUE(Field(trace, "initial_values").empty())
       << "hybrid simulate cannot replay free initial values: " << trace.dump(2);
-  const double state_time = trace["state"].value("time", -1.0);
+  const double state_time = Field(trace, "state").value("time", -1.0);
   const double until = trace.value("until", -1.0);
   ASSERT_GT(state_time, 0.0);
   ASSERT_GE(until, state_time);
-  EXPECT_GT(trace["state"]["values"].value("theta1", 0.0), 70.0) << trace.dump(2);
+  EXPECT_GT(Field(trace, "state", "values").value("theta1", 0.0), 70.0) << trace.dump(2);
 
   // Replayed by `hybrid simulate` to the trace's horizon, theta1 is past its limit...
   // The run may go on to stop at the motor's range (exit 5, invariant_violated) after the
@@ -218,20 +220,22 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   ASSERT_TRUE(replay.exit_code == 0 || replay.exit_code == 5) << replay.err;
   const json run = json::parse(replay.out);
   ASSERT_TRUE(run.contains("final")) << run.dump(2);
-  EXPECT_GT(run["final"]["state"].value("theta1", 0.0), 70.0) << run.dump(2);
+  EXPECT_GT(Field(run, "final", "state").value("theta1", 0.0), 70.0) << run.dump(2);
 
   // ... and at the violating state's time it is in the same mode with the same values, after
   // the same events.
   const json at = RunHybridJson("simulate " + Quote(model) + ReplayArguments(trace, state_time), 0);
   ASSERT_TRUE(at.contains("final")) << at.dump(2);
-  EXPECT_EQ(at["final"].value("mode", ""), trace["state"].value("mode", "?"));
-  for (const auto& [name, value] : trace["state"]["values"].items()) {
-    EXPECT_NEAR(at["final"]["state"].value(name, 1e300), value.get<double>(), 1e-6) << name;
+  EXPECT_EQ(Field(at, "final").value("mode", ""), Field(trace, "state").value("mode", "?"));
+  for (const auto& [name, value] : Field(trace, "state", "values").items()) {
+    EXPECT_NEAR(Field(at, "final", "state").value(name, 1e300), value.get<double>(), 1e-6) << name;
   }
-  ASSERT_EQ(at.value("events", json::array()).size(), trace["events"].size()) << at.dump(2);
-  for (std::size_t i = 0; i < trace["events"].size(); ++i) {
-    EXPECT_NEAR(at["events"][i].value("time", -1.0), trace["events"][i].value("time", 1.0), 1e-6);
-    EXPECT_EQ(at["events"][i].value("mode_after", ""), trace["events"][i].value("mode_after", "?"));
+  ASSERT_EQ(at.value("events", json::array()).size(), Field(trace, "events").size()) << at.dump(2);
+  for (std::size_t i = 0; i < Field(trace, "events").size(); ++i) {
+    EXPECT_NEAR(Field(at, "events", i).value("time", -1.0),
+                Field(trace, "events", i).value("time", 1.0), 1e-6);
+    EXPECT_EQ(Field(at, "events", i).value("mode_after", ""),
+              Field(trace, "events", i).value("mode_after", "?"));
   }
 }
 
@@ -252,7 +256,8 @@ TEST(CheckCommand, SamplingFindsTheMutationButNeverProves) {
   EXPECT_EQ(violated.value("verdict", ""), "violated") << violated.dump(2);
   EXPECT_EQ(violated.value("method", ""), "sample");
   ASSERT_TRUE(violated.contains("trace")) << violated.dump(2);
-  EXPECT_GT(violated["trace"]["state"]["values"].value("theta1", 0.0), 70.0) << violated.dump(2);
+  EXPECT_GT(Field(violated, "trace", "state", "values").value("theta1", 0.0), 70.0)
+      << violated.dump(2);
 
   // The text output says so too, with the same exit codes.
   const Result text = RunHybrid("check " + Quote(kFinger) + options);
@@ -278,12 +283,12 @@ TEST(CheckCommand, ExitCodesFollowTheVerdicts) {
   const json low = Property(all, "low");
   EXPECT_EQ(low.value("verdict", ""), "violated");
   ASSERT_TRUE(low.contains("trace")) << low.dump(2);
-  EXPECT_GT(low["trace"]["state"]["values"].value("x", 0.0), 0.5) << low.dump(2);
+  EXPECT_GT(Field(low, "trace", "state", "values").value("x", 0.0), 0.5) << low.dump(2);
   const json never_b = Property(all, "never_b");
   EXPECT_EQ(never_b.value("kind", ""), "never");
   EXPECT_EQ(never_b.value("verdict", ""), "violated");
   ASSERT_TRUE(never_b.contains("trace")) << never_b.dump(2);
-  EXPECT_EQ(never_b["trace"]["state"].value("mode", ""), "b") << never_b.dump(2);
+  EXPECT_EQ(Field(never_b, "trace", "state").value("mode", ""), "b") << never_b.dump(2);
   EXPECT_EQ(Property(all, "to_c").value("verdict", ""), "unreachable");
   EXPECT_FALSE(Property(all, "to_c").contains("trace"));
   EXPECT_EQ(Property(all, "to_one").value("verdict", ""), "reachable");
@@ -303,10 +308,10 @@ TEST(CheckCommand, ExitCodesFollowTheVerdicts) {
   // Properties come out in the order asked, each with its own predicate.
   const json some = RunHybridJson("check " + model + " --property to_one --property low", 6);
   ASSERT_EQ(some.value("properties", json::array()).size(), 2u) << some.dump(2);
-  EXPECT_EQ(some["properties"][0].value("name", ""), "to_one");
-  EXPECT_EQ(some["properties"][0].value("predicate", ""), "x >= 1");
-  EXPECT_EQ(some["properties"][1].value("name", ""), "low");
-  EXPECT_EQ(some["properties"][1].value("predicate", ""), "x <= 0.5");
+  EXPECT_EQ(Field(some, "properties", 0).value("name", ""), "to_one");
+  EXPECT_EQ(Field(some, "properties", 0).value("predicate", ""), "x >= 1");
+  EXPECT_EQ(Field(some, "properties", 1).value("name", ""), "low");
+  EXPECT_EQ(Field(some, "properties", 1).value("predicate", ""), "x <= 0.5");
 }
 
 TEST(CheckCommand, ModesListsEveryModeWithAVerdict) {
@@ -315,14 +320,14 @@ TEST(CheckCommand, ModesListsEveryModeWithAVerdict) {
       Quote(dir.Write("two.ha", SmallModel("  property safe: always x >= 0;")).string());
   const json report = RunHybridJson("check " + model + " --modes", 0);
   ASSERT_TRUE(report.contains("modes")) << report.dump(2);
-  ASSERT_EQ(report["modes"].size(), 3u) << report.dump(2);
+  ASSERT_EQ(Field(report, "modes").size(), 3u) << report.dump(2);
   for (const std::string name : {"a", "b"}) {
-    const json m = Find(report["modes"], "mode", name);
+    const json m = Find(Field(report, "modes"), "mode", name);
     EXPECT_EQ(m.value("verdict", ""), "reachable") << m.dump(2);
     ASSERT_TRUE(m.contains("trace")) << m.dump(2);
-    EXPECT_EQ(m["trace"]["state"].value("mode", ""), name) << m.dump(2);
+    EXPECT_EQ(Field(m, "trace", "state").value("mode", ""), name) << m.dump(2);
   }
-  const json c = Find(report["modes"], "mode", "c");
+  const json c = Find(Field(report, "modes"), "mode", "c");
   EXPECT_EQ(c.value("verdict", ""), "unreachable") << c.dump(2);
   EXPECT_FALSE(c.contains("trace"));
   // The properties are still checked.

@@ -28,6 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+using testing::Field;
 using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
@@ -212,36 +213,39 @@ TEST(Diagnose, FindsBacklashAndSensorBias) {
 
   EXPECT_EQ(d.value("cause", json()), json({"backlash", "sensor_bias"})) << d.dump(2);
 
-  ASSERT_TRUE(d.contains("parameters") && d["parameters"].is_object()) << d.dump(2);
-  const json& p = d["parameters"];
-  ASSERT_TRUE(p.contains("backlash") && p["backlash"].is_number()) << p.dump();
-  ASSERT_TRUE(p.contains("theta3_bias") && p["theta3_bias"].is_number()) << p.dump();
-  EXPECT_NEAR(p["backlash"].get<double>(), kBacklash, 0.15 * kBacklash) << p.dump();
-  EXPECT_NEAR(p["theta3_bias"].get<double>(), kTheta3Bias, 0.15 * kTheta3Bias) << p.dump();
+  ASSERT_TRUE(d.contains("parameters") && Field(d, "parameters").is_object()) << d.dump(2);
+  const json& p = Field(d, "parameters");
+  ASSERT_TRUE(p.contains("backlash") && Field(p, "backlash").is_number()) << p.dump();
+  ASSERT_TRUE(p.contains("theta3_bias") && Field(p, "theta3_bias").is_number()) << p.dump();
+  EXPECT_NEAR(Field(p, "backlash").get<double>(), kBacklash, 0.15 * kBacklash) << p.dump();
+  EXPECT_NEAR(Field(p, "theta3_bias").get<double>(), kTheta3Bias, 0.15 * kTheta3Bias) << p.dump();
 
   ASSERT_TRUE(d.contains("baseline_mse")) << d.dump(2);
   ASSERT_TRUE(d.contains("extended_mse")) << d.dump(2);
-  ExpectPerJoint(d["baseline_mse"], "baseline_mse");
-  ExpectPerJoint(d["extended_mse"], "extended_mse");
+  ExpectPerJoint(Field(d, "baseline_mse"), "baseline_mse");
+  ExpectPerJoint(Field(d, "extended_mse"), "extended_mse");
   for (const char* joint : kJoints) {
-    EXPECT_LT(d["extended_mse"].value(joint, 1e300), d["baseline_mse"].value(joint, -1e300))
+    EXPECT_LT(Field(d, "extended_mse").value(joint, 1e300),
+              Field(d, "baseline_mse").value(joint, -1e300))
         << joint << ": the extended model is not better than the baseline\n"
-        << d["baseline_mse"].dump() << "\n"
-        << d["extended_mse"].dump();
+        << Field(d, "baseline_mse").dump() << "\n"
+        << Field(d, "extended_mse").dump();
   }
 
   ASSERT_TRUE(d.contains("noise_floor")) << d.dump(2);
-  ExpectPerJoint(d["noise_floor"], "noise_floor");
-  EXPECT_TRUE(d["noise_floor"].contains("method") && d["noise_floor"]["method"].is_string() &&
-              !d["noise_floor"]["method"].get<std::string>().empty())
-      << d["noise_floor"].dump();
+  ExpectPerJoint(Field(d, "noise_floor"), "noise_floor");
+  EXPECT_TRUE(Field(d, "noise_floor").contains("method") &&
+              Field(d, "noise_floor", "method").is_string() &&
+              !Field(d, "noise_floor", "method").get<std::string>().empty())
+      << Field(d, "noise_floor").dump();
 
   ASSERT_TRUE(d.contains("where")) << d.dump(2);
-  EXPECT_TRUE(d["where"].is_null()) << d["where"].dump();
+  EXPECT_TRUE(Field(d, "where").is_null()) << Field(d, "where").dump();
   ASSERT_TRUE(d.contains("candidates")) << d.dump(2);
-  EXPECT_TRUE(d["candidates"].is_array() && !d["candidates"].empty()) << d["candidates"].dump();
+  EXPECT_TRUE(Field(d, "candidates").is_array() && !Field(d, "candidates").empty())
+      << Field(d, "candidates").dump();
   ASSERT_TRUE(d.contains("residuals")) << d.dump(2);
-  EXPECT_TRUE(d["residuals"].is_array()) << d["residuals"].dump();
+  EXPECT_TRUE(Field(d, "residuals").is_array()) << Field(d, "residuals").dump();
 }
 
 TEST(Diagnose, WritesTheExtendedModelAndTheReport) {
@@ -307,12 +311,13 @@ TEST(Diagnose, ExtendedModelKeepsItsInvariants) {
   EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
   json report;
   ASSERT_NO_THROW(report = json::parse(r.out)) << r.out << r.err;
-  ASSERT_TRUE(report.contains("properties") && report["properties"].is_array()) << r.out;
-  EXPECT_EQ(report["properties"].size(), 2u) << report.dump(2);
+  ASSERT_TRUE(report.contains("properties") && Field(report, "properties").is_array()) << r.out;
+  EXPECT_EQ(Field(report, "properties").size(), 2u) << report.dump(2);
   for (const std::string name : {"theta1_range", "never_contact_at_limit_1"}) {
-    const auto it = std::find_if(report["properties"].begin(), report["properties"].end(),
-                                 [&](const json& p) { return p.value("name", "") == name; });
-    ASSERT_NE(it, report["properties"].end()) << name << " missing:\n" << report.dump(2);
+    const auto it =
+        std::find_if(Field(report, "properties").begin(), Field(report, "properties").end(),
+                     [&](const json& p) { return p.value("name", "") == name; });
+    ASSERT_NE(it, Field(report, "properties").end()) << name << " missing:\n" << report.dump(2);
     EXPECT_EQ(it->value("verdict", ""), "proved") << it->dump(2);
   }
 }
@@ -342,20 +347,22 @@ TEST(Diagnose, RippleIsUnexplainedAndLocated) {
   EXPECT_EQ(d.value("parameters", json()), json::object()) << d.dump(2);
   EXPECT_EQ(d.value("extended_mse", json()), d.value("baseline_mse", json())) << d.dump(2);
   ASSERT_TRUE(d.contains("where")) << d.dump(2);
-  const json& where = d["where"];
+  const json& where = Field(d, "where");
   ASSERT_TRUE(where.is_object()) << where.dump();
   const std::string joint = where.value("joint", "");
   EXPECT_TRUE(joint == "theta1" || joint == "theta2" || joint == "theta3") << where.dump();
-  EXPECT_TRUE(where.contains("mode") && where["mode"].is_string() &&
-              !where["mode"].get<std::string>().empty())
+  EXPECT_TRUE(where.contains("mode") && Field(where, "mode").is_string() &&
+              !Field(where, "mode").get<std::string>().empty())
       << where.dump();
   const std::string direction = where.value("direction", "");
   EXPECT_TRUE(direction == "closing" || direction == "opening") << where.dump();
-  ASSERT_TRUE(where.contains("g_range") && where["g_range"].is_array() &&
-              where["g_range"].size() == 2)
+  ASSERT_TRUE(where.contains("g_range") && Field(where, "g_range").is_array() &&
+              Field(where, "g_range").size() == 2)
       << where.dump();
-  ASSERT_TRUE(where["g_range"][0].is_number() && where["g_range"][1].is_number()) << where.dump();
-  EXPECT_LE(where["g_range"][0].get<double>(), where["g_range"][1].get<double>()) << where.dump();
+  ASSERT_TRUE(Field(where, "g_range", 0).is_number() && Field(where, "g_range", 1).is_number())
+      << where.dump();
+  EXPECT_LE(Field(where, "g_range", 0).get<double>(), Field(where, "g_range", 1).get<double>())
+      << where.dump();
 }
 
 // ---------------------------------------------------------------------------------------------

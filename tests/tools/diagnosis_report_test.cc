@@ -216,7 +216,9 @@ TEST(DiagnosisReport, LabelsAndCausesAreEscaped) {
 
 TEST(DiagnosisReport, ResidualsHaveOneDotPerFiniteResidualAndNoiseLines) {
   const Diagnosis d = Sample();
-  const std::string& svg = DiagnosisReportFiles(d, "dir")[2].second;
+  const Files files = DiagnosisReportFiles(d, "dir");  // owns the text `svg` refers to
+  ASSERT_EQ(files.size(), 4u);
+  const std::string& svg = files[2].second;
   const auto baseline = Groups(svg, "class=\"baseline\"");
   const auto extended = Groups(svg, "class=\"extended\"");
   const auto noise = Groups(svg, "class=\"noise\"");
@@ -247,7 +249,9 @@ TEST(DiagnosisReport, ResidualsHaveOneDotPerFiniteResidualAndNoiseLines) {
 }
 
 TEST(DiagnosisReport, SummaryHasBarsAndNoiseTicks) {
-  const std::string& svg = DiagnosisReportFiles(Sample(), "dir")[3].second;
+  const Files files = DiagnosisReportFiles(Sample(), "dir");  // owns the text `svg` refers to
+  ASSERT_EQ(files.size(), 4u);
+  const std::string& svg = files[3].second;
   const auto joints = Groups(svg, "class=\"joint\"");
   ASSERT_EQ(joints.size(), 3u);
   EXPECT_EQ(Count(joints[0], "<rect"), 2);

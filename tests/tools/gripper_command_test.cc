@@ -107,16 +107,17 @@ TEST(HybridFinger, TextAtG120IsPhase1Prime) {
 // The JSON report's keys: angles in degrees, the motor, phase, automaton state, contacts, stop.
 TEST(HybridFinger, JsonAtG120HasEveryKey) {
   const json j = RunJson("finger --g 120");
-  EXPECT_EQ(j["theta1"], 60.0);
-  EXPECT_EQ(j["theta2"], 0.0);
-  EXPECT_EQ(j["theta3"], -55.0);
-  EXPECT_EQ(j["motor"], 120.0);
-  EXPECT_EQ(j["phase"], "1'");
-  EXPECT_EQ(j["mode"], "c000_l00n");
-  EXPECT_EQ(j["state"], (json{{"c1", 0}, {"c2", 0}, {"c3", 0}, {"l1", 0}, {"l2", 0}, {"l3", -1}}));
-  ASSERT_TRUE(j["contacts"].is_array());
-  EXPECT_TRUE(j["contacts"].empty());
-  EXPECT_EQ(j["stop"], 240.0);
+  EXPECT_EQ(Field(j, "theta1"), 60.0);
+  EXPECT_EQ(Field(j, "theta2"), 0.0);
+  EXPECT_EQ(Field(j, "theta3"), -55.0);
+  EXPECT_EQ(Field(j, "motor"), 120.0);
+  EXPECT_EQ(Field(j, "phase"), "1'");
+  EXPECT_EQ(Field(j, "mode"), "c000_l00n");
+  EXPECT_EQ(Field(j, "state"),
+            (json{{"c1", 0}, {"c2", 0}, {"c3", 0}, {"l1", 0}, {"l2", 0}, {"l3", -1}}));
+  ASSERT_TRUE(Field(j, "contacts").is_array());
+  EXPECT_TRUE(Field(j, "contacts").empty());
+  EXPECT_EQ(Field(j, "stop"), 240.0);
 }
 
 // Table 4.1 (free space): theta1 = min(0.5 g, 70), theta2 = clamp(0.9 (g - 140), 0, 90),
@@ -125,11 +126,11 @@ TEST(HybridFinger, FreeSpaceTableOfSection41) {
   for (double g : {0.0, 55.0, 110.0, 125.0, 140.0, 190.0, 240.0, 250.0}) {
     const json j = RunJson("finger --g " + std::to_string(g));
     SCOPED_TRACE("g = " + std::to_string(g));
-    EXPECT_NEAR(j["theta1"].get<double>(), std::min(0.5 * g, 70.0), 1e-9);
-    EXPECT_NEAR(j["theta2"].get<double>(), std::clamp(0.9 * (g - 140.0), 0.0, 90.0), 1e-9);
-    EXPECT_NEAR(j["theta3"].get<double>(), std::max(-0.5 * g, -55.0), 1e-9);
-    EXPECT_NEAR(j["motor"].get<double>(), std::min(g, 240.0), 1e-9);
-    EXPECT_TRUE(j["contacts"].empty());
+    EXPECT_NEAR(Field(j, "theta1").get<double>(), std::min(0.5 * g, 70.0), 1e-9);
+    EXPECT_NEAR(Field(j, "theta2").get<double>(), std::clamp(0.9 * (g - 140.0), 0.0, 90.0), 1e-9);
+    EXPECT_NEAR(Field(j, "theta3").get<double>(), std::max(-0.5 * g, -55.0), 1e-9);
+    EXPECT_NEAR(Field(j, "motor").get<double>(), std::min(g, 240.0), 1e-9);
+    EXPECT_TRUE(Field(j, "contacts").empty());
   }
 }
 
@@ -138,17 +139,18 @@ TEST(HybridFinger, FreeSpaceTableOfSection41) {
 // stopping) half way between 180 and 255 (C3).
 TEST(HybridFinger, Link1ContactFollowsTheContactTable) {
   const json j = RunJson("finger --gob1 80 --g 200");
-  EXPECT_NEAR(j["theta1"].get<double>(), 40.0, 1e-9);
-  EXPECT_NEAR(j["theta2"].get<double>(), 90.0, 1e-9);
-  EXPECT_NEAR(j["theta3"].get<double>(), -55.0 + 98.0 * (200.0 - 180.0) / (255.0 - 200.0), 1e-9);
-  EXPECT_EQ(j["phase"], "3");
-  EXPECT_EQ(j["state"]["c1"], 1);
-  EXPECT_EQ(j["state"]["l2"], 1);
-  EXPECT_NEAR(j["stop"].get<double>(), 217.5, 1e-9);
-  ASSERT_EQ(j["contacts"].size(), 1u) << j.dump(2);
-  EXPECT_EQ(j["contacts"][0]["link"], 1);
-  EXPECT_EQ(j["contacts"][0]["g"], 80.0);
-  EXPECT_EQ(j["contacts"][0]["by"], "given");
+  EXPECT_NEAR(Field(j, "theta1").get<double>(), 40.0, 1e-9);
+  EXPECT_NEAR(Field(j, "theta2").get<double>(), 90.0, 1e-9);
+  EXPECT_NEAR(Field(j, "theta3").get<double>(), -55.0 + 98.0 * (200.0 - 180.0) / (255.0 - 200.0),
+              1e-9);
+  EXPECT_EQ(Field(j, "phase"), "3");
+  EXPECT_EQ(Field(j, "state", "c1"), 1);
+  EXPECT_EQ(Field(j, "state", "l2"), 1);
+  EXPECT_NEAR(Field(j, "stop").get<double>(), 217.5, 1e-9);
+  ASSERT_EQ(Field(j, "contacts").size(), 1u) << j.dump(2);
+  EXPECT_EQ(Field(j, "contacts", 0, "link"), 1);
+  EXPECT_EQ(Field(j, "contacts", 0, "g"), 80.0);
+  EXPECT_EQ(Field(j, "contacts", 0, "by"), "given");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -158,16 +160,16 @@ TEST(HybridFinger, Link1ContactFollowsTheContactTable) {
 // counts; GeometricFinger bisects to 1e-10) and attributed to the object.
 TEST(HybridFinger, CircleBlocksLink1AtTheAnalyticPosition) {
   const json j = RunJson("finger --g 255 --object " + Link1Circle());
-  ASSERT_EQ(j["contacts"].size(), 1u) << j.dump(2);
-  const json& c = j["contacts"][0];
-  EXPECT_EQ(c["link"], 1);
-  EXPECT_EQ(c["by"], "object 1");
-  EXPECT_NEAR(c["g"].get<double>(), Link1CircleGob1(), 1e-6);
-  EXPECT_NEAR(j["theta1"].get<double>(), 0.5 * Link1CircleGob1(), 1e-6);
-  EXPECT_EQ(j["state"]["c1"], 1);
-  ASSERT_EQ(j["objects"].size(), 1u);
+  ASSERT_EQ(Field(j, "contacts").size(), 1u) << j.dump(2);
+  const json& c = Field(j, "contacts", 0);
+  EXPECT_EQ(Field(c, "link"), 1);
+  EXPECT_EQ(Field(c, "by"), "object 1");
+  EXPECT_NEAR(Field(c, "g").get<double>(), Link1CircleGob1(), 1e-6);
+  EXPECT_NEAR(Field(j, "theta1").get<double>(), 0.5 * Link1CircleGob1(), 1e-6);
+  EXPECT_EQ(Field(j, "state", "c1"), 1);
+  ASSERT_EQ(Field(j, "objects").size(), 1u);
   // Link 2 then reaches its limit 100 counts later and phase 3 ends half way to 255 (C3).
-  EXPECT_NEAR(j["stop"].get<double>(), (Link1CircleGob1() + 100.0 + 255.0) / 2.0, 1e-6);
+  EXPECT_NEAR(Field(j, "stop").get<double>(), (Link1CircleGob1() + 100.0 + 255.0) / 2.0, 1e-6);
   // The text form names the object too.
   const Result r = RunHybrid("finger --g 255 --object " + Link1Circle());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -185,12 +187,12 @@ TEST(HybridFinger, SimulationAgreesWithAGivenContact) {
   EXPECT_TRUE(Contains(r.out, "agrees")) << r.out;
   EXPECT_FALSE(Contains(r.out, "DISAGREES")) << r.out;
   const json j = RunJson("finger --gob1 80 --g 200 --simulate");
-  EXPECT_EQ(j["simulation"]["status"], "completed");
-  EXPECT_EQ(j["simulation"]["agrees"], true);
-  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
-  ASSERT_EQ(j["simulation"]["contacts"].size(), 1u) << j.dump(2);
-  EXPECT_EQ(j["simulation"]["contacts"][0]["link"], 1);
-  EXPECT_NEAR(j["simulation"]["contacts"][0]["g"].get<double>(), 80.0, 1e-6);
+  EXPECT_EQ(Field(j, "simulation", "status"), "completed");
+  EXPECT_EQ(Field(j, "simulation", "agrees"), true);
+  EXPECT_LE(Field(j, "simulation", "max_angle_difference_deg").get<double>(), 1e-6);
+  ASSERT_EQ(Field(j, "simulation", "contacts").size(), 1u) << j.dump(2);
+  EXPECT_EQ(Field(j, "simulation", "contacts", 0, "link"), 1);
+  EXPECT_NEAR(Field(j, "simulation", "contacts", 0, "g").get<double>(), 80.0, 1e-6);
 }
 
 TEST(HybridFinger, SimulationAgreesWithAnObject) {
@@ -199,11 +201,11 @@ TEST(HybridFinger, SimulationAgreesWithAnObject) {
   EXPECT_TRUE(Contains(r.out, "agrees")) << r.out;
   EXPECT_FALSE(Contains(r.out, "DISAGREES")) << r.out;
   const json j = RunJson("finger --g 255 --object " + Link1Circle() + " --simulate");
-  EXPECT_EQ(j["simulation"]["status"], "completed");
-  EXPECT_EQ(j["simulation"]["agrees"], true);
-  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
-  ASSERT_EQ(j["simulation"]["contacts"].size(), 1u) << j.dump(2);
-  EXPECT_NEAR(j["simulation"]["contacts"][0]["g"].get<double>(), Link1CircleGob1(), 1e-6);
+  EXPECT_EQ(Field(j, "simulation", "status"), "completed");
+  EXPECT_EQ(Field(j, "simulation", "agrees"), true);
+  EXPECT_LE(Field(j, "simulation", "max_angle_difference_deg").get<double>(), 1e-6);
+  ASSERT_EQ(Field(j, "simulation", "contacts").size(), 1u) << j.dump(2);
+  EXPECT_NEAR(Field(j, "simulation", "contacts", 0, "g").get<double>(), Link1CircleGob1(), 1e-6);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -283,9 +285,9 @@ TEST(HybridFinger, OutputsNamingOneFileOrTheModelAreRefused) {
 // take effect and is not listed.
 TEST(HybridFinger, ContactsListOnlyThoseThatTakeEffect) {
   const json j = RunJson("finger --g 255 --gob1 200");
-  EXPECT_TRUE(j["contacts"].empty()) << j.dump(2);
-  EXPECT_EQ(j["mode"], "c000_l11n");
-  EXPECT_EQ(RunJson("finger --g 255 --gob1 100")["contacts"].size(), 1u);
+  EXPECT_TRUE(Field(j, "contacts").empty()) << j.dump(2);
+  EXPECT_EQ(Field(j, "mode"), "c000_l11n");
+  EXPECT_EQ(Field(RunJson("finger --g 255 --gob1 100"), "contacts").size(), 1u);
 }
 
 // --simulate with a model that is not a finger automaton: exit 1, naming the file.
@@ -386,34 +388,34 @@ TEST(HybridHand, EveryFingerTouchesACentredCylinderWithLink2) {
     EXPECT_TRUE(Contains(r.out, f)) << r.out;
   }
   const json j = RunJson("hand --object " + kHandObject);
-  EXPECT_EQ(j["mode"], "basic");
-  EXPECT_EQ(j["spread"], 137.0);
-  ASSERT_EQ(j["fingers"].size(), 3u) << j.dump(2);
+  EXPECT_EQ(Field(j, "mode"), "basic");
+  EXPECT_EQ(Field(j, "spread"), 137.0);
+  ASSERT_EQ(Field(j, "fingers").size(), 3u) << j.dump(2);
   for (int f = 0; f < 3; ++f) {
-    const json& finger = j["fingers"][f];
+    const json& finger = Field(j, "fingers", f);
     SCOPED_TRACE(std::string("finger ") + "ABC"[f]);
-    EXPECT_EQ(finger["finger"], std::string(1, "ABC"[f]));
+    EXPECT_EQ(Field(finger, "finger"), std::string(1, "ABC"[f]));
     for (const char* k : {"theta1", "theta2", "theta3", "motor", "command", "state", "stop"}) {
       EXPECT_TRUE(finger.contains(k)) << k;
     }
-    ASSERT_EQ(finger["contacts"].size(), 1u) << finger.dump(2);
-    EXPECT_EQ(finger["contacts"][0]["link"], 2);
-    EXPECT_EQ(finger["contacts"][0]["by"], "object 1");
-    EXPECT_EQ(finger["state"]["c2"], 1);
+    ASSERT_EQ(Field(finger, "contacts").size(), 1u) << finger.dump(2);
+    EXPECT_EQ(Field(finger, "contacts", 0, "link"), 2);
+    EXPECT_EQ(Field(finger, "contacts", 0, "by"), "object 1");
+    EXPECT_EQ(Field(finger, "state", "c2"), 1);
   }
-  ASSERT_TRUE(j["finger_touches"].is_array());
-  EXPECT_TRUE(j["finger_touches"].empty());
+  ASSERT_TRUE(Field(j, "finger_touches").is_array());
+  EXPECT_TRUE(Field(j, "finger_touches").empty());
 }
 
 // The composed automata (spec/hand.ha, one shared u) agree with the quasistatic hand on every
 // finger.
 TEST(HybridHand, SimulationAgreesWithTheClosedForm) {
   const json j = RunJson("hand --object " + kHandObject + " --simulate");
-  EXPECT_EQ(j["simulation"]["status"], "completed");
-  EXPECT_EQ(j["simulation"]["agrees"], true);
-  EXPECT_LE(j["simulation"]["max_angle_difference_deg"].get<double>(), 1e-6);
-  EXPECT_LE(j["simulation"]["max_motor_difference"].get<double>(), 1e-6);
-  EXPECT_EQ(j["simulation"]["contacts"].size(), 3u) << j.dump(2);
+  EXPECT_EQ(Field(j, "simulation", "status"), "completed");
+  EXPECT_EQ(Field(j, "simulation", "agrees"), true);
+  EXPECT_LE(Field(j, "simulation", "max_angle_difference_deg").get<double>(), 1e-6);
+  EXPECT_LE(Field(j, "simulation", "max_motor_difference").get<double>(), 1e-6);
+  EXPECT_EQ(Field(j, "simulation", "contacts").size(), 3u) << j.dump(2);
 }
 
 // Pinch mode: the fingers touch each other, and the composed automata, whose contact guards also
@@ -421,31 +423,31 @@ TEST(HybridHand, SimulationAgreesWithTheClosedForm) {
 // and each finger's link-3 contact in the simulation is at the touch's motor position.
 TEST(HybridHand, PinchSimulationFindsTheFingerTouches) {
   const json j = RunJson("hand --mode pinch --object " + kHandObject + " --simulate");
-  ASSERT_FALSE(j["finger_touches"].empty()) << j.dump(2);
-  EXPECT_EQ(j["simulation"]["status"], "completed");
-  EXPECT_EQ(j["simulation"]["agrees"], true) << j["simulation"].dump(2);
-  const double touch = j["finger_touches"][0]["g"].get<double>();
+  ASSERT_FALSE(Field(j, "finger_touches").empty()) << j.dump(2);
+  EXPECT_EQ(Field(j, "simulation", "status"), "completed");
+  EXPECT_EQ(Field(j, "simulation", "agrees"), true) << Field(j, "simulation").dump(2);
+  const double touch = Field(j, "finger_touches", 0, "g").get<double>();
   int at_touch = 0;
-  for (const json& c : j["simulation"]["contacts"]) {
-    if (std::abs(c["g"].get<double>() - touch) <= 1e-6) ++at_touch;
+  for (const json& c : Field(j, "simulation", "contacts")) {
+    if (std::abs(Field(c, "g").get<double>() - touch) <= 1e-6) ++at_touch;
   }
-  EXPECT_GE(at_touch, 2) << j["simulation"].dump(2);  // both fingers of the first touch
+  EXPECT_GE(at_touch, 2) << Field(j, "simulation").dump(2);  // both fingers of the first touch
 }
 
 // Pinch mode (spread 255) with finger A commanded to 100: the fingers touch each other (H3), and
 // finger A's motor never passes its command.
 TEST(HybridHand, PinchWithPerFingerCommandReportsFingerTouches) {
   const json j = RunJson("hand --mode pinch --g-a 100 --object " + kHandObject);
-  EXPECT_EQ(j["mode"], "pinch");
-  EXPECT_EQ(j["spread"], 255.0);
-  ASSERT_EQ(j["fingers"].size(), 3u);
-  EXPECT_EQ(j["fingers"][0]["command"], 100.0);
-  EXPECT_LE(j["fingers"][0]["motor"].get<double>(), 100.0);
-  ASSERT_TRUE(j["finger_touches"].is_array());
-  EXPECT_FALSE(j["finger_touches"].empty()) << j.dump(2);
-  for (const json& t : j["finger_touches"]) {
-    EXPECT_EQ(t["fingers"].get<std::string>().size(), 2u);
-    EXPECT_EQ(t["links"].size(), 2u);
+  EXPECT_EQ(Field(j, "mode"), "pinch");
+  EXPECT_EQ(Field(j, "spread"), 255.0);
+  ASSERT_EQ(Field(j, "fingers").size(), 3u);
+  EXPECT_EQ(Field(j, "fingers", 0, "command"), 100.0);
+  EXPECT_LE(Field(j, "fingers", 0, "motor").get<double>(), 100.0);
+  ASSERT_TRUE(Field(j, "finger_touches").is_array());
+  EXPECT_FALSE(Field(j, "finger_touches").empty()) << j.dump(2);
+  for (const json& t : Field(j, "finger_touches")) {
+    EXPECT_EQ(Field(t, "fingers").get<std::string>().size(), 2u);
+    EXPECT_EQ(Field(t, "links").size(), 2u);
   }
 }
 
@@ -453,17 +455,17 @@ TEST(HybridHand, PinchWithPerFingerCommandReportsFingerTouches) {
 // 4.1, D3).
 TEST(HybridHand, NoObjectClosesFreely) {
   const json j = RunJson("hand");
-  EXPECT_EQ(j["mode"], "basic");
-  ASSERT_EQ(j["fingers"].size(), 3u);
-  for (const json& finger : j["fingers"]) {
-    SCOPED_TRACE(finger["finger"].dump());
-    EXPECT_NEAR(finger["theta1"].get<double>(), 70.0, 1e-9);
-    EXPECT_NEAR(finger["theta2"].get<double>(), 90.0, 1e-9);
-    EXPECT_NEAR(finger["theta3"].get<double>(), -55.0, 1e-9);
-    EXPECT_NEAR(finger["motor"].get<double>(), 240.0, 1e-9);
-    EXPECT_TRUE(finger["contacts"].empty());
+  EXPECT_EQ(Field(j, "mode"), "basic");
+  ASSERT_EQ(Field(j, "fingers").size(), 3u);
+  for (const json& finger : Field(j, "fingers")) {
+    SCOPED_TRACE(Field(finger, "finger").dump());
+    EXPECT_NEAR(Field(finger, "theta1").get<double>(), 70.0, 1e-9);
+    EXPECT_NEAR(Field(finger, "theta2").get<double>(), 90.0, 1e-9);
+    EXPECT_NEAR(Field(finger, "theta3").get<double>(), -55.0, 1e-9);
+    EXPECT_NEAR(Field(finger, "motor").get<double>(), 240.0, 1e-9);
+    EXPECT_TRUE(Field(finger, "contacts").empty());
   }
-  EXPECT_TRUE(j["finger_touches"].empty());
+  EXPECT_TRUE(Field(j, "finger_touches").empty());
 }
 
 // Bad options (exit 2) and an object overlapping the palm (exit 1).
@@ -472,9 +474,9 @@ TEST(HybridHand, NoObjectClosesFreely) {
 TEST(HybridHand, ContactsBeyondTheCommandDoNotCount) {
   ExpectRejected("hand --g 10 --object " + kHandObject, 1, {"no finger reaches"});
   const json j = RunJson("hand --g-a 30 --object " + kHandObject);
-  EXPECT_TRUE(j["fingers"][0]["contacts"].empty()) << j["fingers"][0].dump(2);
-  EXPECT_TRUE(j["fingers"][0]["stop"].is_null());
-  EXPECT_EQ(j["fingers"][1]["contacts"].size(), 1u);
+  EXPECT_TRUE(Field(j, "fingers", 0, "contacts").empty()) << Field(j, "fingers", 0).dump(2);
+  EXPECT_TRUE(Field(j, "fingers", 0, "stop").is_null());
+  EXPECT_EQ(Field(j, "fingers", 1, "contacts").size(), 1u);
 }
 
 TEST(HybridHand, BadInputIsRejected) {

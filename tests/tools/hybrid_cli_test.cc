@@ -25,6 +25,7 @@ namespace hybrid {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Field;
 using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
@@ -82,32 +83,32 @@ TEST(HybridCli, InfoJsonOfTheFinger) {
   EXPECT_EQ(r.err, "");
   nlohmann::json info;
   ASSERT_NO_THROW(info = nlohmann::json::parse(r.out)) << r.out;
-  EXPECT_EQ(info["file"], kFinger.string());
-  EXPECT_EQ(info["name"], "finger");
-  ASSERT_EQ(info["components"].size(), 1u);
-  const auto& c = info["components"][0];
-  EXPECT_EQ(c["automaton"], "finger");
-  EXPECT_EQ(c["instance"], "");
-  EXPECT_EQ(c["modes"].size(), 31u);
-  EXPECT_EQ(c["reachable_modes"].size(), 31u);
-  EXPECT_TRUE(c["unreachable_modes"].empty());
-  EXPECT_EQ(c["variables"].size(), 6u);
-  EXPECT_EQ(c["variables"][0]["name"], "theta1");
-  EXPECT_EQ(c["variables"][0]["unit"], "deg");
-  EXPECT_EQ(c["variables"][0]["domain"], nlohmann::json::array({0.0, 70.0}));
-  EXPECT_EQ(c["discrete_variables"].size(), 6u);
-  EXPECT_EQ(c["inputs"][0]["bounds"], nlohmann::json::array({-1.0, 1.0}));
-  EXPECT_EQ(c["initial_states"][0]["mode"], "c000_l000");
-  EXPECT_EQ(c["properties"].size(), 13u);
-  EXPECT_TRUE(info["warnings"].empty());
-  EXPECT_EQ(info["scenario"]["until"], 530.0);
-  EXPECT_EQ(info["scenario"]["inputs"][0]["shape"], "step");
+  EXPECT_EQ(Field(info, "file"), kFinger.string());
+  EXPECT_EQ(Field(info, "name"), "finger");
+  ASSERT_EQ(Field(info, "components").size(), 1u);
+  const auto& c = Field(info, "components", 0);
+  EXPECT_EQ(Field(c, "automaton"), "finger");
+  EXPECT_EQ(Field(c, "instance"), "");
+  EXPECT_EQ(Field(c, "modes").size(), 31u);
+  EXPECT_EQ(Field(c, "reachable_modes").size(), 31u);
+  EXPECT_TRUE(Field(c, "unreachable_modes").empty());
+  EXPECT_EQ(Field(c, "variables").size(), 6u);
+  EXPECT_EQ(Field(c, "variables", 0, "name"), "theta1");
+  EXPECT_EQ(Field(c, "variables", 0, "unit"), "deg");
+  EXPECT_EQ(Field(c, "variables", 0, "domain"), nlohmann::json::array({0.0, 70.0}));
+  EXPECT_EQ(Field(c, "discrete_variables").size(), 6u);
+  EXPECT_EQ(Field(c, "inputs", 0, "bounds"), nlohmann::json::array({-1.0, 1.0}));
+  EXPECT_EQ(Field(c, "initial_states", 0, "mode"), "c000_l000");
+  EXPECT_EQ(Field(c, "properties").size(), 13u);
+  EXPECT_TRUE(Field(info, "warnings").empty());
+  EXPECT_EQ(Field(info, "scenario", "until"), 530.0);
+  EXPECT_EQ(Field(info, "scenario", "inputs", 0, "shape"), "step");
   // Every transition names existing modes.
   std::set<std::string> modes;
-  for (const auto& m : c["modes"]) modes.insert(m["name"].get<std::string>());
-  for (const auto& t : c["transitions"]) {
-    EXPECT_TRUE(modes.count(t["source"].get<std::string>())) << t;
-    EXPECT_TRUE(modes.count(t["target"].get<std::string>())) << t;
+  for (const auto& m : Field(c, "modes")) modes.insert(Field(m, "name").get<std::string>());
+  for (const auto& t : Field(c, "transitions")) {
+    EXPECT_TRUE(modes.count(Field(t, "source").get<std::string>())) << t;
+    EXPECT_TRUE(modes.count(Field(t, "target").get<std::string>())) << t;
   }
 }
 
@@ -139,14 +140,14 @@ system s {
   const Result r = RunHybrid("info " + Quote(model) + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json info = nlohmann::json::parse(r.out);
-  EXPECT_EQ(info["name"], "s");
-  ASSERT_EQ(info["components"].size(), 2u);
-  EXPECT_EQ(info["components"][1]["instance"], "B");
-  EXPECT_EQ(info["components"][1]["unreachable_modes"], nlohmann::json::array({"B.orphan"}));
-  EXPECT_EQ(info["warnings"],
+  EXPECT_EQ(Field(info, "name"), "s");
+  ASSERT_EQ(Field(info, "components").size(), 2u);
+  EXPECT_EQ(Field(info, "components", 1, "instance"), "B");
+  EXPECT_EQ(Field(info, "components", 1, "unreachable_modes"), nlohmann::json::array({"B.orphan"}));
+  EXPECT_EQ(Field(info, "warnings"),
             nlohmann::json::array({"A: mode 'orphan' is unreachable from the initial modes",
                                    "B: mode 'orphan' is unreachable from the initial modes"}));
-  EXPECT_EQ(info["properties"][0]["predicate"], "in A.orphan");
+  EXPECT_EQ(Field(info, "properties", 0, "predicate"), "in A.orphan");
   // With --json the warnings also go to stderr, prefixed by the file.
   EXPECT_EQ(r.err, model.string() +
                        ": warning: A: mode 'orphan' is unreachable from the initial "
@@ -163,7 +164,7 @@ TEST(HybridCli, InfoJsonOfAFileWhoseNameIsNotUtf8) {
   nlohmann::json info;
   ASSERT_NO_THROW(info = nlohmann::json::parse(r.out));
   // Invalid bytes become U+FFFD.
-  EXPECT_EQ(info["file"], (dir.path() / "\xef\xbf\xbd\xef\xbf\xbd.ha").string());
+  EXPECT_EQ(Field(info, "file"), (dir.path() / "\xef\xbf\xbd\xef\xbf\xbd.ha").string());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -317,6 +318,42 @@ TEST(HybridCli, OutputOntoADirectoryExitsThreeAndCleansUp) {
                        "': it is a directory\n");
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"target"});  // no temporary file left
   EXPECT_TRUE(fs::is_empty(dir.path() / "target"));
+}
+
+// Out of memory is a resource error in plain words (it was "internal error: std::bad_alloc"):
+// exit 4, no C++ type name. The limit on virtual memory makes a million-row synthesis fail.
+TEST(HybridCli, OutOfMemoryIsReportedInPlainWords) {
+  if (testing::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer cannot run under ulimit -v";
+  const Result r =
+      RunHybrid("synthesize --free-runs 0 --samples 166666 -o /dev/null", "", "ulimit -v 150000; ");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_TRUE(r.err.starts_with("hybrid: out of memory: ")) << r.err;
+  EXPECT_EQ(r.err.find("std::"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+}
+
+// An output naming the input model is refused before any work (it was overwritten, exit 0),
+// whatever the spelling of the path: exit 2 naming both, the model unchanged.
+TEST(HybridCli, DotOutputNamingTheModelIsRefused) {
+  TempDir dir;
+  const std::string text = ReadAll(kFinger);
+  const fs::path model = dir.Write("m.ha", text);
+  for (const std::string& out :
+       std::vector<std::string>{model.string(), (dir.path() / "." / "m.ha").string(),
+                                (dir.path() / "x" / ".." / "m.ha").string()}) {
+    if (out.find("/x/") != std::string::npos) fs::create_directory(dir.path() / "x");
+    const Result r = RunHybrid("dot " + Quote(model) + " -o " + Quote(out));
+    EXPECT_EQ(r.exit_code, 2) << out << "\n" << r.err;
+    EXPECT_EQ(r.err, "hybrid: -o '" + out + "' names the input MODEL '" + model.string() +
+                         "'; an output may not overwrite an input\n");
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(ReadAll(model), text);
+  }
+  // A hard link is the same file too.
+  fs::create_hard_link(model, dir.path() / "hard.ha");
+  EXPECT_EQ(RunHybrid("dot " + Quote(model) + " -o " + Quote(dir.File("hard.ha"))).exit_code, 2);
+  EXPECT_EQ(ReadAll(model), text);
 }
 
 TEST(HybridCli, FullStdoutExitsThree) {

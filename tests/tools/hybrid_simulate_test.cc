@@ -75,33 +75,33 @@ TEST(HybridSimulate, BundledModelsComplete) {
 
 TEST(HybridSimulate, JsonHasStatusEventsAndStatesByName) {
   const json j = SimulateJson(Quote(Spec("finger")));
-  EXPECT_EQ(j["status"], "completed");
-  EXPECT_EQ(j["message"], "");
-  EXPECT_EQ(j["until"], 530.0);
-  ASSERT_EQ(j["events"].size(), 6u) << j.dump(2);
-  const json& first = j["events"][0];
-  EXPECT_NEAR(first["time"].get<double>(), 110.0, 1e-9);
-  EXPECT_EQ(first["cause"], "crossing");
-  EXPECT_EQ(first["transitions"], json::array({"t5_c000_l000_to_c000_l00n"}));
-  EXPECT_EQ(first["mode_before"], "c000_l000");
-  EXPECT_EQ(first["mode_after"], "c000_l00n");
+  EXPECT_EQ(Field(j, "status"), "completed");
+  EXPECT_EQ(Field(j, "message"), "");
+  EXPECT_EQ(Field(j, "until"), 530.0);
+  ASSERT_EQ(Field(j, "events").size(), 6u) << j.dump(2);
+  const json& first = Field(j, "events", 0);
+  EXPECT_NEAR(Field(first, "time").get<double>(), 110.0, 1e-9);
+  EXPECT_EQ(Field(first, "cause"), "crossing");
+  EXPECT_EQ(Field(first, "transitions"), json::array({"t5_c000_l000_to_c000_l00n"}));
+  EXPECT_EQ(Field(first, "mode_before"), "c000_l000");
+  EXPECT_EQ(Field(first, "mode_after"), "c000_l00n");
   for (const char* v : {"theta1", "theta2", "theta3", "g"}) {
-    EXPECT_TRUE(first["before"].contains(v)) << v;
-    EXPECT_TRUE(first["after"].contains(v)) << v;
+    EXPECT_TRUE(Field(first, "before").contains(v)) << v;
+    EXPECT_TRUE(Field(first, "after").contains(v)) << v;
   }
-  EXPECT_NEAR(first["before"]["theta3"].get<double>(), -55.0, 1e-8);
-  EXPECT_NEAR(first["before"]["g"].get<double>(), 110.0, 1e-8);
-  EXPECT_EQ(j["events"][3]["cause"], "enabled");  // u reverses at t = 265
-  EXPECT_EQ(j["final"]["time"], 530.0);
-  EXPECT_EQ(j["final"]["mode"], "c000_l000");
-  EXPECT_NEAR(j["final"]["state"]["g"].get<double>(), 0.0, 1e-8);
-  EXPECT_GE(j["steps"].get<long>(), 0);  // CVODE steps: none for constant-rate modes
+  EXPECT_NEAR(Field(first, "before", "theta3").get<double>(), -55.0, 1e-8);
+  EXPECT_NEAR(Field(first, "before", "g").get<double>(), 110.0, 1e-8);
+  EXPECT_EQ(Field(j, "events", 3, "cause"), "enabled");  // u reverses at t = 265
+  EXPECT_EQ(Field(j, "final", "time"), 530.0);
+  EXPECT_EQ(Field(j, "final", "mode"), "c000_l000");
+  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 0.0, 1e-8);
+  EXPECT_GE(Field(j, "steps").get<long>(), 0);  // CVODE steps: none for constant-rate modes
   EXPECT_FALSE(j.contains("zeno"));
   // A composed model: qualified variable and mode names.
   const json hand = SimulateJson(Quote(Spec("hand")));
-  EXPECT_EQ(hand["status"], "completed");
-  EXPECT_TRUE(hand["final"]["state"].contains("B.theta2"));
-  EXPECT_EQ(hand["events"][0]["transitions"], json::array({"A.t5_c000_l000_to_c000_l00n"}));
+  EXPECT_EQ(Field(hand, "status"), "completed");
+  EXPECT_TRUE(Field(hand, "final", "state").contains("B.theta2"));
+  EXPECT_EQ(Field(hand, "events", 0, "transitions"), json::array({"A.t5_c000_l000_to_c000_l00n"}));
 }
 
 TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
@@ -109,7 +109,7 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   const std::string trace = dir.File("trace.csv"), events = dir.File("events.csv");
   const json j = SimulateJson(Quote(Spec("thermostat")) + " --sample 2.5 --out " + Quote(trace) +
                               " --events " + Quote(events));
-  ASSERT_EQ(j["status"], "completed");
+  ASSERT_EQ(Field(j, "status"), "completed");
   const auto rows = ReadCsv(trace);
   ASSERT_GT(rows.size(), 2u);
   EXPECT_EQ(rows[0], (std::vector<std::string>{"time", "kind", "mode", "x"}));
@@ -132,10 +132,10 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   EXPECT_EQ(rows.back()[1], "end");
   EXPECT_EQ(rows.back()[0], "120");
   // Both sides of every event, at the event's time (printed with 17 digits).
-  ASSERT_EQ(before.size(), j["events"].size());
-  ASSERT_EQ(after.size(), j["events"].size());
+  ASSERT_EQ(before.size(), Field(j, "events").size());
+  ASSERT_EQ(after.size(), Field(j, "events").size());
   for (size_t k = 0; k < before.size(); ++k) {
-    EXPECT_EQ(before[k], j["events"][k]["time"].get<double>());
+    EXPECT_EQ(before[k], Field(j, "events", k, "time").get<double>());
     EXPECT_EQ(after[k], before[k]);
   }
   // Samples at 2.5, 5, ..., 117.5.
@@ -143,7 +143,7 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   for (size_t k = 0; k < samples.size(); ++k) EXPECT_NEAR(samples[k], 2.5 * (k + 1), 1e-12);
 
   const auto log = ReadCsv(events);
-  ASSERT_EQ(log.size(), j["events"].size() + 1);
+  ASSERT_EQ(log.size(), Field(j, "events").size() + 1);
   EXPECT_EQ(log[0], (std::vector<std::string>{"time", "cause", "transitions", "label",
                                               "mode_before", "mode_after", "x_before", "x_after"}));
   EXPECT_EQ(log[1][1], "invariant");
@@ -152,7 +152,7 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   EXPECT_EQ(log[1][4], "off");
   EXPECT_EQ(log[1][5], "on");
   EXPECT_NEAR(std::stod(log[1][6]), 18.0, 1e-9);
-  EXPECT_EQ(std::stod(log[1][0]), j["events"][0]["time"].get<double>());
+  EXPECT_EQ(std::stod(log[1][0]), Field(j, "events", 0, "time").get<double>());
 }
 
 // --set overrides a parameter: an object blocking link 1 at g = 80 (the finger's gob1) gives the
@@ -160,11 +160,11 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
 // its limit at 180, theta3 at its maximum half way to 255 (217.5).
 TEST(HybridSimulate, SetOverridesAParameter) {
   const json j = SimulateJson(Quote(Spec("finger")) + " --set gob1=80 --until 255");
-  EXPECT_EQ(j["status"], "completed");
-  ASSERT_EQ(j["events"].size(), 4u) << j.dump(2);
+  EXPECT_EQ(Field(j, "status"), "completed");
+  ASSERT_EQ(Field(j, "events").size(), 4u) << j.dump(2);
   const std::vector<double> times = {80.0, 80.0 + 15.0 / 0.9, 180.0, 217.5};
   for (size_t k = 0; k < times.size(); ++k) {
-    EXPECT_NEAR(j["events"][k]["time"].get<double>(), times[k], 1e-6) << k;
+    EXPECT_NEAR(Field(j, "events", k, "time").get<double>(), times[k], 1e-6) << k;
   }
   // Bad --set values are option errors (exit 2) naming the option, in plain words.
   const Result unknown = Simulate(Quote(Spec("finger")) + " --set nope=1");
@@ -182,21 +182,21 @@ TEST(HybridSimulate, InputOverridesTheScenario) {
   // Close for 10 s only: no joint reaches a limit.
   const json j = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=step(0: 1, 10: 0)") +
                               " --until 50");
-  ASSERT_EQ(j["status"], "completed");
-  EXPECT_TRUE(j["events"].empty());
-  EXPECT_EQ(j["until"], 50.0);
-  EXPECT_NEAR(j["final"]["state"]["g"].get<double>(), 10.0, 1e-9);
-  EXPECT_NEAR(j["final"]["state"]["theta1"].get<double>(), 5.0, 1e-9);
-  EXPECT_NEAR(j["final"]["state"]["theta3"].get<double>(), -5.0, 1e-9);
+  ASSERT_EQ(Field(j, "status"), "completed");
+  EXPECT_TRUE(Field(j, "events").empty());
+  EXPECT_EQ(Field(j, "until"), 50.0);
+  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "state", "theta1").get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "state", "theta3").get<double>(), -5.0, 1e-9);
   // A constant and a linear signal.
   const json c = SimulateJson(Quote(Spec("finger")) + " --input u=0.5 --until 20");
-  EXPECT_NEAR(c["final"]["state"]["g"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(c, "final", "state", "g").get<double>(), 10.0, 1e-9);
   const json l = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=linear(0: 0, 10: 1)") +
                               " --until 20");
-  EXPECT_NEAR(l["final"]["state"]["g"].get<double>(), 5.0 + 10.0, 1e-9);  // t^2/20, then t
+  EXPECT_NEAR(Field(l, "final", "state", "g").get<double>(), 5.0 + 10.0, 1e-9);  // t^2/20, then t
   // The last --input for a name wins.
   const json last = SimulateJson(Quote(Spec("finger")) + " --input u=1 --input u=0.25 --until 20");
-  EXPECT_NEAR(last["final"]["state"]["g"].get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(Field(last, "final", "state", "g").get<double>(), 5.0, 1e-9);
 }
 
 TEST(HybridSimulate, InputCsvDrivesTheInputs) {
@@ -204,16 +204,16 @@ TEST(HybridSimulate, InputCsvDrivesTheInputs) {
   const std::string steps = dir.Write("steps.csv", "# close, then hold\ntime,u\n0,1\n10,0\n");
   const json j =
       SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) + " --until 50");
-  ASSERT_EQ(j["status"], "completed");
-  EXPECT_NEAR(j["final"]["state"]["g"].get<double>(), 10.0, 1e-9);
+  ASSERT_EQ(Field(j, "status"), "completed");
+  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 10.0, 1e-9);
   const std::string ramp = dir.Write("ramp.csv", "time, u\n0, 0\n10, 1\n");
   const json l = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(ramp) +
                               " --csv-shape linear --until 20");
-  EXPECT_NEAR(l["final"]["state"]["g"].get<double>(), 15.0, 1e-9);
+  EXPECT_NEAR(Field(l, "final", "state", "g").get<double>(), 15.0, 1e-9);
   // --input overrides the CSV.
   const json o = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) +
                               " --input u=0.5 --until 20");
-  EXPECT_NEAR(o["final"]["state"]["g"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(o, "final", "state", "g").get<double>(), 10.0, 1e-9);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -331,6 +331,7 @@ TEST(HybridSimulate, RefusesOutputsNamingOneFileOrAnInput) {
   const std::string model = dir.Write("m.ha", testing::SpecText("thermostat"));
   const std::string csv = dir.Write("u.csv", "time,u\n0,1\n");
   const std::string kept = dir.Write("t.csv", "kept\n");
+  std::filesystem::create_directory(dir.path() / "sub");
   const auto refused = [&](const std::string& args, const std::string& needle) {
     const Result r = Simulate(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
@@ -339,16 +340,14 @@ TEST(HybridSimulate, RefusesOutputsNamingOneFileOrAnInput) {
     EXPECT_EQ(ReadAll(model), testing::SpecText("thermostat")) << args;
     EXPECT_EQ(ReadAll(csv), "time,u\n0,1\n") << args;
     EXPECT_EQ(ReadAll(kept), "kept\n") << args;
-    EXPECT_EQ(dir.Files(), (std::vector<std::string>{"m.ha", "t.csv", "u.csv"})) << args;
+    EXPECT_EQ(dir.Files(), (std::vector<std::string>{"m.ha", "sub", "t.csv", "u.csv"})) << args;
   };
   refused(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(kept),
           "--out and --events name the same file");
   // The same file under another name: "./", "..", a symbolic link.
   const std::string other = (dir.path() / "." / "sub" / ".." / "t.csv").string();
-  std::filesystem::create_directory(dir.path() / "sub");
   refused(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(other),
           "--out and --events name the same file");
-  std::filesystem::remove(dir.path() / "sub");
   std::filesystem::create_symlink(kept, dir.path() / "link.csv");
   const Result via_link =
       Simulate(Quote(model) + " --out " + Quote(kept) + " --events " + Quote(dir.File("link.csv")));
@@ -407,17 +406,17 @@ TEST(HybridSimulate, ZenoRunExitsFiveAndWritesItsOutputs) {
   const std::string trace = dir.File("trace.csv"), events = dir.File("events.csv");
   const json j =
       SimulateJson(Quote(model) + " --out " + Quote(trace) + " --events " + Quote(events), 5);
-  EXPECT_EQ(j["status"], "zeno");
-  EXPECT_NE(j["message"].get<std::string>().find("accumulate"), std::string::npos);
+  EXPECT_EQ(Field(j, "status"), "zeno");
+  EXPECT_NE(Field(j, "message").get<std::string>().find("accumulate"), std::string::npos);
   ASSERT_TRUE(j.contains("zeno"));
   const double tz = std::sqrt(2.0 * 10.0 / 9.81) * 1.8 / 0.2;
-  EXPECT_NEAR(j["zeno"]["accumulation_time"].get<double>(), tz, 1e-9 * tz);
-  EXPECT_EQ(j["zeno"]["cycle"], json::array({"bounce"}));
+  EXPECT_NEAR(Field(j, "zeno", "accumulation_time").get<double>(), tz, 1e-9 * tz);
+  EXPECT_EQ(Field(j, "zeno", "cycle"), json::array({"bounce"}));
   const auto rows = ReadCsv(trace);
   ASSERT_GT(rows.size(), 2u);
   EXPECT_EQ(rows.back()[1], "end");
   EXPECT_LT(std::stod(rows.back()[0]), tz);
-  EXPECT_EQ(ReadCsv(events).size(), j["events"].size() + 1);
+  EXPECT_EQ(ReadCsv(events).size(), Field(j, "events").size() + 1);
   // The text summary says so too.
   const Result text = Simulate(Quote(model));
   EXPECT_EQ(text.exit_code, 5);
@@ -430,9 +429,10 @@ TEST(HybridSimulate, InvariantViolationExitsFiveAndWritesItsOutputs) {
   const std::string model = dir.Write("stuck.ha", std::string(testing::kInvariantViolationModel));
   const std::string trace = dir.File("trace.csv");
   const json j = SimulateJson(Quote(model) + " --sample 0.25 --out " + Quote(trace), 5);
-  EXPECT_EQ(j["status"], "invariant_violated");
-  EXPECT_NE(j["message"].get<std::string>().find("x <= 1"), std::string::npos) << j["message"];
-  EXPECT_NEAR(j["final"]["time"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(Field(j, "status"), "invariant_violated");
+  EXPECT_NE(Field(j, "message").get<std::string>().find("x <= 1"), std::string::npos)
+      << Field(j, "message");
+  EXPECT_NEAR(Field(j, "final", "time").get<double>(), 1.0, 1e-12);
   const auto rows = ReadCsv(trace);
   // Header, start, samples 0.25 .. 0.75, end: x' = 1 is a constant rate, so the boundary x = 1
   // is found exactly at t = 1, where the run stops before recording a sample there.
@@ -441,8 +441,8 @@ TEST(HybridSimulate, InvariantViolationExitsFiveAndWritesItsOutputs) {
   // Endless event iteration is Zeno too.
   const std::string ping = dir.Write("ping.ha", std::string(testing::kPingPongModel));
   const json z = SimulateJson(Quote(ping), 5);
-  EXPECT_EQ(z["status"], "zeno");
-  EXPECT_EQ(z["events"].size(), 100u);
+  EXPECT_EQ(Field(z, "status"), "zeno");
+  EXPECT_EQ(Field(z, "events").size(), 100u);
 }
 
 }  // namespace
