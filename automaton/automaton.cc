@@ -8,13 +8,24 @@
 namespace hybrid {
 namespace {
 
-[[noreturn]] void Fail(std::string_view api, const std::string& message) {
-  throw std::invalid_argument(std::string(api) + ": " + message);
+// Messages speak of the model (names, modes, values), never of this API: they reach users as
+// they are (the parser reports them at the offending declaration).
+[[noreturn]] void Fail(const std::string& message) { throw std::invalid_argument(message); }
+
+// `context` names what is wrong ("flow of 'x' in mode 'm'").
+[[noreturn]] void Fail(std::string_view context, const std::string& message) {
+  throw std::invalid_argument(std::string(context) + ": " + message);
 }
 
 // "[lo, hi]" in shortest round-trip form.
 std::string RangeText(double lo, double hi) {
   return "[" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+}
+
+// The message for an expression or predicate of `depth` levels, beyond kMaxExpressionDepth.
+std::string TooDeep(int depth) {
+  return "expression too long or nested too deeply (" + std::to_string(depth) +
+         " levels, more than " + std::to_string(kMaxExpressionDepth) + ")";
 }
 
 template <class T, class Key>
@@ -28,11 +39,12 @@ bool SortedUnique(const std::vector<T>& items, Key key) {
 }  // namespace
 
 Automaton::Automaton(std::string name) : name_(std::move(name)) {
-  if (name_.empty()) Fail("Automaton", "empty name");
+  if (name_.empty()) Fail("an automaton needs a name");
 }
 
 void Automaton::CheckSlots(const Expression& e, std::string_view context, bool allow_inputs,
                            bool allow_state) const {
+  if (e.depth() > kMaxExpressionDepth) Fail(context, TooDeep(e.depth()));
   for (int slot : e.Slots()) {
     if (slot >= symbols_.size()) {
       Fail(context,
@@ -57,15 +69,15 @@ double Automaton::EvaluateConstant(const Expression& e, std::string_view context
 
 int Automaton::AddVariable(std::string name, std::string unit, std::optional<Range> domain) {
   if (domain) {
-    const double lo = EvaluateConstant(domain->lo, "Automaton::AddVariable: domain of " + name);
-    const double hi = EvaluateConstant(domain->hi, "Automaton::AddVariable: domain of " + name);
-    if (lo > hi) Fail("Automaton::AddVariable", "empty domain for '" + name + "'");
+    const double lo = EvaluateConstant(domain->lo, "domain of " + name);
+    const double hi = EvaluateConstant(domain->hi, "domain of " + name);
+    if (lo > hi) Fail("empty domain for '" + name + "'");
   }
   int slot;
   try {
     slot = symbols_.Add({std::move(name), SymbolKind::kVariable, std::move(unit)});
   } catch (const std::invalid_argument& e) {
-    Fail("Automaton::AddVariable", e.what());
+    Fail(e.what());
   }
   variables_.push_back({slot, std::move(domain)});
   return slot;
@@ -73,27 +85,27 @@ int Automaton::AddVariable(std::string name, std::string unit, std::optional<Ran
 
 int Automaton::AddDiscreteVariable(std::string name) {
   if (!modes_.empty()) {
-    Fail("Automaton::AddDiscreteVariable", "'" + name + "' declared after the first mode");
+    Fail("'" + name + "' declared after the first mode");
   }
   int slot;
   try {
     slot = symbols_.Add({std::move(name), SymbolKind::kDiscrete, ""});
   } catch (const std::invalid_argument& e) {
-    Fail("Automaton::AddDiscreteVariable", e.what());
+    Fail(e.what());
   }
   discrete_.push_back(slot);
   return slot;
 }
 
 int Automaton::AddInput(std::string name, Range bounds, std::string unit) {
-  const double lo = EvaluateConstant(bounds.lo, "Automaton::AddInput: bounds of " + name);
-  const double hi = EvaluateConstant(bounds.hi, "Automaton::AddInput: bounds of " + name);
-  if (lo > hi) Fail("Automaton::AddInput", "empty bounds for '" + name + "'");
+  const double lo = EvaluateConstant(bounds.lo, "bounds of " + name);
+  const double hi = EvaluateConstant(bounds.hi, "bounds of " + name);
+  if (lo > hi) Fail("empty bounds for '" + name + "'");
   int slot;
   try {
     slot = symbols_.Add({std::move(name), SymbolKind::kInput, std::move(unit)});
   } catch (const std::invalid_argument& e) {
-    Fail("Automaton::AddInput", e.what());
+    Fail(e.what());
   }
   inputs_.push_back({slot, std::move(bounds)});
   return slot;
@@ -101,23 +113,22 @@ int Automaton::AddInput(std::string name, Range bounds, std::string unit) {
 
 int Automaton::AddParameter(std::string name, Expression value, std::string unit,
                             std::optional<Range> range) {
-  constexpr std::string_view kApi = "Automaton::AddParameter";
-  const double v = EvaluateConstant(value, std::string(kApi) + ": value of " + name);
+  const double v = EvaluateConstant(value, "value of " + name);
   if (range) {
-    const std::string context = std::string(kApi) + ": range of '" + name + "'";
+    const std::string context = "range of '" + name + "'";
     const double lo = EvaluateConstant(range->lo, context);
     const double hi = EvaluateConstant(range->hi, context);
-    if (lo > hi) Fail(kApi, "empty range " + RangeText(lo, hi) + " for parameter '" + name + "'");
+    if (lo > hi) Fail("empty range " + RangeText(lo, hi) + " for parameter '" + name + "'");
     if (v < lo || v > hi) {
-      Fail(kApi, "value " + FormatNumber(v) + " of parameter '" + name + "' is outside its range " +
-                     RangeText(lo, hi));
+      Fail("value " + FormatNumber(v) + " of parameter '" + name + "' is outside its range " +
+           RangeText(lo, hi));
     }
   }
   int slot;
   try {
     slot = symbols_.Add({std::move(name), SymbolKind::kParameter, std::move(unit)});
   } catch (const std::invalid_argument& e) {
-    Fail(kApi, e.what());
+    Fail(e.what());
   }
   parameters_.emplace_back(slot, std::move(value));
   parameter_ranges_.push_back(std::move(range));
@@ -132,19 +143,18 @@ std::optional<Range> Automaton::ParameterRange(int slot) const {
 }
 
 void Automaton::SetParameter(std::string_view name, double value) {
-  constexpr std::string_view kApi = "Automaton::SetParameter";
   const std::optional<int> slot = symbols_.Find(name);
   if (!slot || symbols_[*slot].kind != SymbolKind::kParameter) {
-    Fail(kApi, "'" + std::string(name) + "' is not a parameter of automaton '" + name_ + "'");
+    Fail("'" + std::string(name) + "' is not a parameter of automaton '" + name_ + "'");
   }
-  if (!std::isfinite(value)) Fail(kApi, "value of '" + std::string(name) + "' is not finite");
+  if (!std::isfinite(value)) Fail("value of '" + std::string(name) + "' is not finite");
   auto it = std::find_if(parameters_.begin(), parameters_.end(),
                          [&](const auto& p) { return p.first == *slot; });
   const Expression old = it->second;
   it->second = Expression::Constant(value);
   auto fail = [&](const std::string& message) {
     it->second = old;
-    Fail(kApi, message);
+    Fail(message);
   };
   const std::string setting = "setting '" + std::string(name) + "' to " + FormatNumber(value);
   // Every parameter and range bound is evaluated in the new environment; ranges read only
@@ -176,44 +186,39 @@ void Automaton::SetParameter(std::string_view name, double value) {
 }
 
 ModeId Automaton::AddMode(Mode mode) {
-  constexpr std::string_view kApi = "Automaton::AddMode";
-  if (mode.name.empty()) Fail(kApi, "empty mode name");
-  if (FindMode(mode.name)) Fail(kApi, "duplicate mode '" + mode.name + "'");
+  if (mode.name.empty()) Fail("empty mode name");
+  if (FindMode(mode.name)) Fail("duplicate mode '" + mode.name + "'");
   if (!SortedUnique(mode.flows, [](const auto& f) { return f.first; })) {
-    Fail(kApi, "flows of mode '" + mode.name + "' are not sorted by slot or repeat a variable");
+    Fail("flows of mode '" + mode.name + "' are not sorted by slot or repeat a variable");
   }
   for (const auto& [slot, rhs] : mode.flows) {
     if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kVariable) {
-      Fail(kApi, "mode '" + mode.name +
-                     "' has a flow for something that is not a continuous "
-                     "variable (slot " +
-                     std::to_string(slot) + ")");
+      Fail("mode '" + mode.name +
+           "' has a flow for something that is not a continuous "
+           "variable (slot " +
+           std::to_string(slot) + ")");
     }
-    CheckSlots(
-        rhs,
-        std::string(kApi) + ": flow of '" + symbols_[slot].name + "' in mode '" + mode.name + "'",
-        true, true);
-  }
-  for (const Comparison& c : mode.invariant.comparisons) {
-    CheckSlots(c.Residual(), std::string(kApi) + ": invariant of mode '" + mode.name + "'", true,
+    CheckSlots(rhs, "flow of '" + symbols_[slot].name + "' in mode '" + mode.name + "'", true,
                true);
   }
+  for (const Comparison& c : mode.invariant.comparisons) {
+    CheckSlots(c.Residual(), "invariant of mode '" + mode.name + "'", true, true);
+  }
   if (!SortedUnique(mode.discrete_values, [](const auto& d) { return d.first; })) {
-    Fail(kApi, "discrete values of mode '" + mode.name + "' are not sorted or repeat a variable");
+    Fail("discrete values of mode '" + mode.name + "' are not sorted or repeat a variable");
   }
   for (const auto& [slot, value] : mode.discrete_values) {
     if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kDiscrete) {
-      Fail(kApi, "mode '" + mode.name +
-                     "' sets a value for something that is not a discrete "
-                     "variable (slot " +
-                     std::to_string(slot) + ")");
+      Fail("mode '" + mode.name +
+           "' sets a value for something that is not a discrete "
+           "variable (slot " +
+           std::to_string(slot) + ")");
     }
   }
   if (mode.discrete_values.size() != discrete_.size()) {
     for (int d : discrete_) {
       if (!mode.DiscreteValueOf(d)) {
-        Fail(kApi,
-             "mode '" + mode.name + "' does not set discrete variable '" + symbols_[d].name + "'");
+        Fail("mode '" + mode.name + "' does not set discrete variable '" + symbols_[d].name + "'");
       }
     }
   }
@@ -229,28 +234,25 @@ std::optional<ModeId> Automaton::FindMode(std::string_view name) const {
 }
 
 TransitionId Automaton::AddTransition(Transition t) {
-  constexpr std::string_view kApi = "Automaton::AddTransition";
-  if (t.name.empty()) Fail(kApi, "empty transition name");
-  if (transition_index_.count(t.name)) Fail(kApi, "duplicate transition '" + t.name + "'");
+  if (t.name.empty()) Fail("empty transition name");
+  if (transition_index_.count(t.name)) Fail("duplicate transition '" + t.name + "'");
   if (!t.source.is_valid() || t.source.value() >= num_modes()) {
-    Fail(kApi, "transition '" + t.name + "' has an unknown source mode");
+    Fail("transition '" + t.name + "' has an unknown source mode");
   }
   if (!t.target.is_valid() || t.target.value() >= num_modes()) {
-    Fail(kApi, "transition '" + t.name + "' has an unknown target mode");
+    Fail("transition '" + t.name + "' has an unknown target mode");
   }
   for (const Comparison& c : t.guard.comparisons) {
-    CheckSlots(c.Residual(), std::string(kApi) + ": guard of '" + t.name + "'", true, true);
+    CheckSlots(c.Residual(), "guard of '" + t.name + "'", true, true);
   }
   if (!SortedUnique(t.resets, [](const Reset& r) { return r.slot; })) {
-    Fail(kApi, "transition '" + t.name + "' resets a variable twice");
+    Fail("transition '" + t.name + "' resets a variable twice");
   }
   for (const Reset& r : t.resets) {
     if (r.slot < 0 || r.slot >= symbols_.size() || symbols_[r.slot].kind != SymbolKind::kVariable) {
-      Fail(kApi, "transition '" + t.name + "' resets something that is not a continuous variable");
+      Fail("transition '" + t.name + "' resets something that is not a continuous variable");
     }
-    CheckSlots(r.value,
-               std::string(kApi) + ": reset of '" + symbols_[r.slot].name + "' in '" + t.name + "'",
-               true, true);
+    CheckSlots(r.value, "reset of '" + symbols_[r.slot].name + "' in '" + t.name + "'", true, true);
   }
   transition_index_.emplace(t.name, num_transitions());
   transitions_.push_back(std::move(t));
@@ -258,24 +260,25 @@ TransitionId Automaton::AddTransition(Transition t) {
 }
 
 void Automaton::SetGuard(TransitionId id, Constraint guard) {
-  constexpr std::string_view kApi = "Automaton::SetGuard";
-  if (!id.is_valid() || id.value() >= num_transitions()) Fail(kApi, "unknown transition");
+  if (!id.is_valid() || id.value() >= num_transitions()) {
+    Fail("guard for a transition that automaton '" + name_ + "' does not have");
+  }
   Transition& t = transitions_[id.value()];
   for (const Comparison& c : guard.comparisons) {
-    CheckSlots(c.Residual(), std::string(kApi) + ": guard of '" + t.name + "'", true, true);
+    CheckSlots(c.Residual(), "guard of '" + t.name + "'", true, true);
   }
   t.guard = std::move(guard);
 }
 
 void Automaton::SetInitialValue(int slot, const InitialValue& value) {
-  constexpr std::string_view kApi = "Automaton::SetInitialValue";
   if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kVariable ||
       value.slot != slot) {
-    Fail(kApi, "not a continuous variable, or the value is for another slot");
+    Fail("initial value for something that is not a continuous variable of automaton '" + name_ +
+         "'");
   }
-  const std::string context = std::string(kApi) + ": value of '" + symbols_[slot].name + "'";
+  const std::string context = "value of '" + symbols_[slot].name + "'";
   if (EvaluateConstant(value.range.lo, context) > EvaluateConstant(value.range.hi, context)) {
-    Fail(kApi, "empty initial range for '" + symbols_[slot].name + "'");
+    Fail("empty initial range for '" + symbols_[slot].name + "'");
   }
   for (InitialState& state : initial_states_) {
     auto it = std::lower_bound(state.values.begin(), state.values.end(), slot,
@@ -289,42 +292,44 @@ void Automaton::SetInitialValue(int slot, const InitialValue& value) {
 }
 
 void Automaton::AddInitialState(InitialState state) {
-  constexpr std::string_view kApi = "Automaton::AddInitialState";
-  if (!state.mode.is_valid() || state.mode.value() >= num_modes()) Fail(kApi, "unknown mode");
+  if (!state.mode.is_valid() || state.mode.value() >= num_modes()) {
+    Fail("initial state in a mode that automaton '" + name_ + "' does not have");
+  }
   const std::string& mode_name = modes_[state.mode.value()].name;
   if (!SortedUnique(state.values, [](const InitialValue& v) { return v.slot; })) {
-    Fail(kApi, "initial state in '" + mode_name + "' gives a variable twice");
+    Fail("initial state in '" + mode_name + "' gives a variable twice");
   }
   for (const InitialValue& v : state.values) {
     if (v.slot < 0 || v.slot >= symbols_.size() || symbols_[v.slot].kind != SymbolKind::kVariable) {
-      Fail(kApi, "initial state in '" + mode_name +
-                     "' sets something that is not a continuous "
-                     "variable");
+      Fail("initial state in '" + mode_name +
+           "' sets something that is not a continuous "
+           "variable");
     }
-    const std::string context =
-        std::string(kApi) + ": initial value of '" + symbols_[v.slot].name + "'";
+    const std::string context = "initial value of '" + symbols_[v.slot].name + "'";
     const double lo = EvaluateConstant(v.range.lo, context);
     const double hi = EvaluateConstant(v.range.hi, context);
-    if (lo > hi) Fail(kApi, "empty initial range for '" + symbols_[v.slot].name + "'");
+    if (lo > hi) Fail("empty initial range for '" + symbols_[v.slot].name + "'");
   }
   for (const VariableInfo& var : variables_) {
     const bool given = std::any_of(state.values.begin(), state.values.end(),
                                    [&](const InitialValue& v) { return v.slot == var.slot; });
     if (!given) {
-      Fail(kApi, "initial state in '" + mode_name + "' gives no value for '" +
-                     symbols_[var.slot].name + "'");
+      Fail("initial state in '" + mode_name + "' gives no value for '" + symbols_[var.slot].name +
+           "'");
     }
   }
   initial_states_.push_back(std::move(state));
 }
 
 void Automaton::AddProperty(Property property) {
-  constexpr std::string_view kApi = "Automaton::AddProperty";
-  if (property.name.empty()) Fail(kApi, "empty property name");
+  if (property.name.empty()) Fail("empty property name");
   for (const Property& p : properties_) {
-    if (p.name == property.name) Fail(kApi, "duplicate property '" + property.name + "'");
+    if (p.name == property.name) Fail("duplicate property '" + property.name + "'");
   }
-  const std::string context = std::string(kApi) + ": property '" + property.name + "'";
+  const std::string context = "property '" + property.name + "'";
+  if (property.predicate.depth() > kMaxExpressionDepth) {
+    Fail(context, TooDeep(property.predicate.depth()));
+  }
   property.predicate.ForEachComparison(
       [&](const Comparison& c) { CheckSlots(c.Residual(), context, false, true); });
   property.predicate.ForEachMode([&](const std::string& m) {
@@ -337,35 +342,34 @@ void Automaton::AddProperty(Property property) {
 }
 
 void Automaton::SetScenario(Scenario scenario) {
-  constexpr std::string_view kApi = "Automaton::SetScenario";
   if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {
-    Fail(kApi, "'until' must be positive and finite");
+    Fail("'until' must be positive and finite");
   }
   std::set<int> seen;
   for (const InputSignal& s : scenario.inputs) {
     if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
-      Fail(kApi, "signal for something that is not an input");
+      Fail("signal for something that is not an input");
     }
     const std::string& name = symbols_[s.slot].name;
-    if (!seen.insert(s.slot).second) Fail(kApi, "input '" + name + "' driven twice");
-    if (s.points.empty()) Fail(kApi, "signal for '" + name + "' has no points");
+    if (!seen.insert(s.slot).second) Fail("input '" + name + "' driven twice");
+    if (s.points.empty()) Fail("signal for '" + name + "' has no points");
     for (size_t i = 0; i < s.points.size(); ++i) {
       if (!std::isfinite(s.points[i].first) || !std::isfinite(s.points[i].second)) {
-        Fail(kApi, "signal for '" + name + "' has a non-finite point");
+        Fail("signal for '" + name + "' has a non-finite point");
       }
       if (i > 0 && !(s.points[i - 1].first < s.points[i].first)) {
-        Fail(kApi, "signal for '" + name + "': times must increase strictly");
+        Fail("signal for '" + name + "': times must increase strictly");
       }
     }
     const auto& bounds = std::find_if(inputs_.begin(), inputs_.end(), [&](const InputInfo& in) {
                            return in.slot == s.slot;
                          })->bounds;
-    const double lo = EvaluateConstant(bounds.lo, kApi);
-    const double hi = EvaluateConstant(bounds.hi, kApi);
+    const double lo = EvaluateConstant(bounds.lo, "bounds of input '" + name + "'");
+    const double hi = EvaluateConstant(bounds.hi, "bounds of input '" + name + "'");
     for (const auto& [t, v] : s.points) {
       if (v < lo || v > hi) {
-        Fail(kApi, "signal for '" + name + "' takes value " + FormatNumber(v) +
-                       " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+        Fail("signal for '" + name + "' takes value " + FormatNumber(v) + " outside its bounds [" +
+             FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
       }
     }
   }

@@ -127,95 +127,118 @@ CompiledExpression::CompiledExpression(const Expression& expression) {
   for (const auto& [id, count] : parents) {
     if (count > 1) registers_.emplace(id, -1);
   }
-  Emit(expression, 1);
+  Emit(expression);
   code_.push_back({Code::kEnd, 0, 0.0});
   num_registers_ = next_register_;
   registers_.clear();
 }
 
-// Emits code that leaves the value of `e` in the accumulator; `depth` counts the stack entries
-// in use (accumulator included) once it is there.
-void CompiledExpression::Emit(const Expression& e, int depth) {
-  max_depth_ = std::max(max_depth_, depth);
-  switch (e.op()) {
-    case Op::kConstant:
+// Emits code that leaves the value of `root` in the accumulator. The work is kept on a heap
+// stack of tasks (no recursion, whatever the depth): emitting a subexpression with `depth` stack
+// entries in use (accumulator included) once its value is there, appending an instruction, or
+// storing a shared subexpression's value into its register. Tasks run in the reverse of the
+// order they are pushed.
+void CompiledExpression::Emit(const Expression& root) {
+  struct Task {
+    enum Kind { kEmit, kAppend, kStore } kind;
+    const Expression* e;
+    int depth;
+    Instruction instruction;
+  };
+  std::vector<Task> todo = {{Task::kEmit, &root, 1, {}}};
+  auto emit = [&](const Expression& e, int depth) { todo.push_back({Task::kEmit, &e, depth, {}}); };
+  auto append = [&](Code code, std::int32_t slot, double value) {
+    todo.push_back({Task::kAppend, nullptr, 0, {code, slot, value}});
+  };
+  // The operation of the non-leaf `e`, its arguments first.
+  auto operation = [&](const Expression& e, int depth) {
+    const Expression& lhs = e.args()[0];
+    if (Arity(e.op()) == 1) {
+      append(UnaryCode(e.op()), 0, 0.0);
+      emit(lhs, depth);
+      return;
+    }
+    const Expression& rhs = e.args()[1];
+    if (e.op() == Op::kPow && rhs.is_constant() &&
+        std::nearbyint(rhs.constant()) == rhs.constant() && std::abs(rhs.constant()) <= 4) {
+      const int n = static_cast<int>(rhs.constant());
+      if (n == 2 || n == 3) {
+        append(n == 2 ? Code::kSquare : Code::kCube, 0, 0.0);
+      } else {
+        append(Code::kPowInt, n, 0.0);
+      }
+      emit(lhs, depth);
+      return;
+    }
+    const bool leaf_left = lhs.is_constant() || lhs.is_symbol();
+    if (leaf_left && !rhs.is_constant() && !rhs.is_symbol() &&
+        (e.op() == Op::kAdd || e.op() == Op::kMul || e.op() == Op::kSub || e.op() == Op::kDiv)) {
+      // A leaf on the left of a compound right operand: evaluate the right operand first and
+      // apply the operation with the leaf taken from the instruction (exact: + and * commute in
+      // IEEE arithmetic, and the reversed forms compute leaf - acc and leaf / acc).
+      Code code;
+      switch (e.op()) {
+        case Op::kAdd:
+          code = lhs.is_constant() ? Code::kAddC : Code::kAddV;
+          break;
+        case Op::kMul:
+          code = lhs.is_constant() ? Code::kMulC : Code::kMulV;
+          break;
+        case Op::kSub:
+          code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV;
+          break;
+        default:
+          code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV;
+          break;
+      }
+      append(code, lhs.is_symbol() ? lhs.slot() : 0, lhs.is_constant() ? lhs.constant() : 0.0);
+      emit(rhs, depth);
+      return;
+    }
+    const Code base = BinaryCode(e.op());
+    if (rhs.is_constant()) {
+      append(Offset(base, 1), 0, rhs.constant());
+    } else if (rhs.is_symbol()) {
+      append(Offset(base, 2), rhs.slot(), 0.0);
+    } else {
+      append(base, 0, 0.0);
+      emit(rhs, depth + 1);
+    }
+    emit(lhs, depth);
+  };
+  while (!todo.empty()) {
+    const Task task = todo.back();
+    todo.pop_back();
+    if (task.kind == Task::kAppend) {
+      code_.push_back(task.instruction);
+      continue;
+    }
+    if (task.kind == Task::kStore) {
+      const int r = next_register_++;
+      registers_.at(task.e->node_id()) = r;
+      code_.push_back({Code::kStoreR, r, 0.0});
+      continue;
+    }
+    const Expression& e = *task.e;
+    max_depth_ = std::max(max_depth_, task.depth);
+    if (e.is_constant()) {
       code_.push_back({Code::kPushC, 0, e.constant()});
-      return;
-    case Op::kSymbol:
+      continue;
+    }
+    if (e.is_symbol()) {
       code_.push_back({Code::kPushV, e.slot(), 0.0});
-      return;
-    default:
-      break;
-  }
-  // A shared subexpression: computed the first time, then read from its register.
-  auto shared = registers_.find(e.node_id());
-  if (shared != registers_.end()) {
-    if (shared->second >= 0) {
-      code_.push_back({Code::kLoadR, shared->second, 0.0});
-      return;
+      continue;
     }
-    EmitOperation(e, depth);
-    shared->second = next_register_++;
-    code_.push_back({Code::kStoreR, shared->second, 0.0});
-    return;
-  }
-  EmitOperation(e, depth);
-}
-
-// Emits the operation of the non-leaf `e` (its arguments through Emit).
-void CompiledExpression::EmitOperation(const Expression& e, int depth) {
-  Emit(e.args()[0], depth);
-  if (Arity(e.op()) == 1) {
-    code_.push_back({UnaryCode(e.op()), 0, 0.0});
-    return;
-  }
-  const Expression& rhs = e.args()[1];
-  if (e.op() == Op::kPow && rhs.is_constant() && std::nearbyint(rhs.constant()) == rhs.constant() &&
-      std::abs(rhs.constant()) <= 4) {
-    const int n = static_cast<int>(rhs.constant());
-    if (n == 2)
-      code_.push_back({Code::kSquare, 0, 0.0});
-    else if (n == 3)
-      code_.push_back({Code::kCube, 0, 0.0});
-    else
-      code_.push_back({Code::kPowInt, n, 0.0});
-    return;
-  }
-  const Code base = BinaryCode(e.op());
-  const Expression& lhs = e.args()[0];
-  if ((lhs.is_constant() || lhs.is_symbol()) && !rhs.is_constant() && !rhs.is_symbol() &&
-      (e.op() == Op::kAdd || e.op() == Op::kMul || e.op() == Op::kSub || e.op() == Op::kDiv)) {
-    // A leaf on the left of a compound right operand: evaluate the right operand first and apply
-    // the operation with the leaf taken from the instruction (exact: + and * commute in IEEE
-    // arithmetic, and the reversed forms compute leaf - acc and leaf / acc).
-    code_.pop_back();  // the push of the leaf emitted above
-    Emit(rhs, depth);
-    Code code;
-    switch (e.op()) {
-      case Op::kAdd:
-        code = lhs.is_constant() ? Code::kAddC : Code::kAddV;
-        break;
-      case Op::kMul:
-        code = lhs.is_constant() ? Code::kMulC : Code::kMulV;
-        break;
-      case Op::kSub:
-        code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV;
-        break;
-      default:
-        code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV;
-        break;
+    // A shared subexpression: computed the first time, then read from its register.
+    auto shared = registers_.find(e.node_id());
+    if (shared != registers_.end()) {
+      if (shared->second >= 0) {
+        code_.push_back({Code::kLoadR, shared->second, 0.0});
+        continue;
+      }
+      todo.push_back({Task::kStore, &e, task.depth, {}});
     }
-    code_.push_back(
-        {code, lhs.is_symbol() ? lhs.slot() : 0, lhs.is_constant() ? lhs.constant() : 0.0});
-    return;
-  }
-  if (rhs.is_constant()) {
-    code_.push_back({Offset(base, 1), 0, rhs.constant()});
-  } else if (rhs.is_symbol()) {
-    code_.push_back({Offset(base, 2), rhs.slot(), 0.0});
-  } else {
-    Emit(rhs, depth + 1);
-    code_.push_back({base, 0, 0.0});
+    operation(e, task.depth);
   }
 }
 

@@ -49,8 +49,7 @@ class CompiledExpression {
     std::int32_t slot;
     double value;
   };
-  void Emit(const Expression& e, int depth);
-  void EmitOperation(const Expression& e, int depth);
+  void Emit(const Expression& root);
   double Run(const double* env, double* stack, double* registers) const;
 
   std::vector<Instruction> code_;

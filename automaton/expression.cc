@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <initializer_list>
+#include <iterator>
 #include <map>
 #include <stdexcept>
 #include <unordered_map>
+
+#include "automaton/tree_walk.h"
 
 namespace hybrid {
 
@@ -14,8 +18,31 @@ struct Expression::Node {
   double value = 0.0;
   std::string name;
   int slot = -1;
+  int depth = 1;  // levels of the tree below and including this node
   std::vector<Expression> args;
+
+  Node() = default;
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+  ~Node();
 };
+
+Expression::Node::~Node() {
+  // Destroying the arguments would destroy their nodes in turn, recursively, on a stack as deep as
+  // the tree: the nodes this one owns alone are taken apart here, one at a time, instead.
+  std::vector<std::shared_ptr<const Node>> orphans;
+  auto adopt = [&](std::vector<Expression>& children) {
+    for (Expression& c : children) {
+      if (c.node_ && c.node_.use_count() == 1) orphans.push_back(std::move(c.node_));
+    }
+  };
+  adopt(args);
+  while (!orphans.empty()) {
+    std::shared_ptr<const Node> n = std::move(orphans.back());
+    orphans.pop_back();
+    adopt(const_cast<Node&>(*n).args);  // nodes are created mutable (make_shared<Node>)
+  }
+}
 
 namespace {
 
@@ -53,7 +80,7 @@ double ApplyUnary(Op op, double a) {
     case Op::kSign:
       return SignOf(a);
     default:
-      throw std::logic_error("ApplyUnary: not a unary op");
+      throw std::logic_error("not a unary operation");
   }
 }
 
@@ -76,7 +103,7 @@ double ApplyBinary(Op op, double a, double b) {
     case Op::kAtan2:
       return std::atan2(a, b);
     default:
-      throw std::logic_error("ApplyBinary: not a binary op");
+      throw std::logic_error("not a binary operation");
   }
 }
 
@@ -117,54 +144,76 @@ std::string_view InfixSpelling(Op op) {
   }
 }
 
-void Print(const Expression& e, std::string* out);
-
-void PrintWrapped(const Expression& e, bool wrap, std::string* out) {
-  if (wrap) out->push_back('(');
-  Print(e, out);
-  if (wrap) out->push_back(')');
-}
-
-void Print(const Expression& e, std::string* out) {
-  switch (e.op()) {
-    case Op::kConstant:
-      out->append(FormatNumber(e.constant()));
-      return;
-    case Op::kSymbol:
-      out->append(e.symbol_name());
-      return;
-    case Op::kNeg:
-      out->push_back('-');
-      PrintWrapped(e.args()[0], Precedence(e.args()[0]) < 3, out);
-      return;
-    case Op::kAdd:
-    case Op::kSub:
-    case Op::kMul:
-    case Op::kDiv: {
-      const int p = Precedence(e);
-      PrintWrapped(e.args()[0], Precedence(e.args()[0]) < p, out);
-      out->append(InfixSpelling(e.op()));
-      // Left-associative: an equal-precedence right operand needs parentheses.
-      PrintWrapped(e.args()[1], Precedence(e.args()[1]) <= p, out);
-      return;
+// Appends the model-language text of `root` to `out` (see Expression::ToString), keeping the
+// pending pieces on a heap stack: a piece is either text or a subexpression, wrapped in
+// parentheses or not.
+void Print(const Expression& root, std::string* out) {
+  struct Piece {
+    const Expression* e;    // nullptr for text
+    std::string_view text;  // static text when e is nullptr
+    bool wrap = false;
+  };
+  std::vector<Piece> todo = {{&root, {}, false}};
+  // Pieces of one node are pushed in reverse, so that they pop in order.
+  auto then = [&](std::initializer_list<Piece> pieces) {
+    for (auto it = std::rbegin(pieces); it != std::rend(pieces); ++it) todo.push_back(*it);
+  };
+  auto sub = [](const Expression& e, bool wrap) { return Piece{&e, {}, wrap}; };
+  auto text = [](std::string_view t) { return Piece{nullptr, t, false}; };
+  while (!todo.empty()) {
+    const Piece piece = todo.back();
+    todo.pop_back();
+    if (piece.e == nullptr) {
+      out->append(piece.text);
+      continue;
     }
-    case Op::kPow:
-      // Right-associative and binding tighter than prefix minus: -x^2 is -(x^2).
-      PrintWrapped(e.args()[0], Precedence(e.args()[0]) <= 4, out);
-      out->push_back('^');
-      PrintWrapped(e.args()[1], Precedence(e.args()[1]) < 3, out);
-      return;
-    default: {
-      out->append(*FunctionName(e.op()));
+    const Expression& e = *piece.e;
+    if (piece.wrap) {
       out->push_back('(');
-      for (size_t i = 0; i < e.args().size(); ++i) {
-        if (i > 0) out->append(", ");
-        Print(e.args()[i], out);
+      todo.push_back(text(")"));
+    }
+    const auto args = e.args();
+    switch (e.op()) {
+      case Op::kConstant:
+        out->append(FormatNumber(e.constant()));
+        break;
+      case Op::kSymbol:
+        out->append(e.symbol_name());
+        break;
+      case Op::kNeg:
+        out->push_back('-');
+        todo.push_back(sub(args[0], Precedence(args[0]) < 3));
+        break;
+      case Op::kAdd:
+      case Op::kSub:
+      case Op::kMul:
+      case Op::kDiv: {
+        const int p = Precedence(e);
+        // Left-associative: an equal-precedence right operand needs parentheses.
+        then({sub(args[0], Precedence(args[0]) < p), text(InfixSpelling(e.op())),
+              sub(args[1], Precedence(args[1]) <= p)});
+        break;
       }
-      out->push_back(')');
+      case Op::kPow:
+        // Right-associative and binding tighter than prefix minus: -x^2 is -(x^2).
+        then({sub(args[0], Precedence(args[0]) <= 4), text("^"),
+              sub(args[1], Precedence(args[1]) < 3)});
+        break;
+      default:
+        out->append(*FunctionName(e.op()));
+        out->push_back('(');
+        if (args.size() == 1) {
+          then({sub(args[0], false), text(")")});
+        } else {
+          then({sub(args[0], false), text(", "), sub(args[1], false), text(")")});
+        }
+        break;
     }
   }
 }
+
+// The children of an expression, for the walks of tree_walk.h.
+std::span<const Expression> Args(const Expression& e) { return e.args(); }
 
 // Simplifying constructors used by Derivative(): fold 0 and 1 and constant operands.
 Expression SAdd(const Expression& a, const Expression& b) {
@@ -203,14 +252,6 @@ Expression Call(Op op, const Expression& a, const Expression& b) {
   return Expression::Binary(op, a, b);
 }
 
-void CollectSlots(const Expression& e, std::vector<int>* slots) {
-  if (e.is_symbol()) {
-    slots->push_back(e.slot());
-    return;
-  }
-  for (const Expression& a : e.args()) CollectSlots(a, slots);
-}
-
 AffineForm Scale(AffineForm f, double k) {
   f.constant *= k;
   for (auto& [slot, c] : f.terms) c *= k;
@@ -229,62 +270,22 @@ AffineForm Combine(const AffineForm& a, const AffineForm& b, double sign) {
   return r;
 }
 
-/// FoldConstants() of `e`, with the value of `e` when it reads no symbol. A symbol-free subtree
-/// whose value is not finite stays unfolded but still passes its value up, so that a finite
-/// result above it (`sign(log(0))`, `min(1 / 0, 2)`) folds like any other symbol-free subtree.
-using FoldMemo = std::unordered_map<const void*, std::pair<Expression, std::optional<double>>>;
+// The value of `e` when it reads no symbol, next to FoldConstants() of `e`.
+using Folded = std::pair<Expression, std::optional<double>>;
 
-std::pair<Expression, std::optional<double>> FoldWithValue(const Expression& e, FoldMemo& memo) {
-  switch (e.op()) {
-    case Op::kConstant:
-      return {e, e.constant()};
-    case Op::kSymbol:
-      return {e, std::nullopt};
-    default:
-      break;
-  }
-  if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
-  std::vector<Expression> args;
-  std::vector<double> values;
-  for (const Expression& a : e.args()) {
-    auto [folded, value] = FoldWithValue(a, memo);
-    args.push_back(std::move(folded));
-    if (value) values.push_back(*value);
-  }
-  const bool unary = Arity(e.op()) == 1;
-  std::optional<double> value;
-  std::pair<Expression, std::optional<double>> out;
-  if (values.size() == args.size()) {
-    value = unary ? ApplyUnary(e.op(), values[0]) : ApplyBinary(e.op(), values[0], values[1]);
-  }
-  if (value && std::isfinite(*value)) {
-    out = {Expression::Constant(*value), value};
-  } else {
-    out = {
-        unary ? Expression::Unary(e.op(), args[0]) : Expression::Binary(e.op(), args[0], args[1]),
-        value};
-  }
-  memo.emplace(e.node_id(), out);
-  return out;
+// Expression `op` (unary or binary) over `args`.
+Expression Rebuild(Op op, std::span<const Expression> args) {
+  return args.size() == 1 ? Expression::Unary(op, args[0])
+                          : Expression::Binary(op, args[0], args[1]);
 }
 
-using SubstituteMemo = std::unordered_map<const void*, Expression>;
-
-Expression SubstituteShared(
-    const Expression& e, const std::function<std::optional<Expression>(const std::string&, int)>& f,
-    SubstituteMemo& memo) {
-  if (e.op() == Op::kConstant) return e;
-  if (e.op() == Op::kSymbol) {
-    auto replacement = f(e.symbol_name(), e.slot());
-    return replacement ? *replacement : e;
+// `depth` if a tree may be that deep (kMaxTreeDepth); throws std::invalid_argument otherwise.
+int CheckedDepth(int depth) {
+  if (depth > kMaxTreeDepth) {
+    throw std::invalid_argument("expression too long or nested too deeply (more than " +
+                                std::to_string(kMaxTreeDepth) + " levels)");
   }
-  if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
-  Expression out = Arity(e.op()) == 1
-                       ? Expression::Unary(e.op(), SubstituteShared(e.args()[0], f, memo))
-                       : Expression::Binary(e.op(), SubstituteShared(e.args()[0], f, memo),
-                                            SubstituteShared(e.args()[1], f, memo));
-  memo.emplace(e.node_id(), out);
-  return out;
+  return depth;
 }
 
 }  // namespace
@@ -326,7 +327,7 @@ std::optional<Op> FunctionByName(std::string_view name, int arity) {
 std::string FormatNumber(double value) {
   char buffer[64];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  if (ec != std::errc()) throw std::logic_error("FormatNumber: cannot format");
+  if (ec != std::errc()) throw std::logic_error("cannot format a number");
   return std::string(buffer, end);
 }
 
@@ -336,7 +337,7 @@ Expression::Expression(std::shared_ptr<const Node> node) : node_(std::move(node)
 
 Expression Expression::Constant(double value) {
   if (!std::isfinite(value)) {
-    throw std::invalid_argument("Expression::Constant: value is not finite");
+    throw std::invalid_argument("constant " + FormatNumber(value) + " is not finite");
   }
   auto node = std::make_shared<Node>();
   node->op = Op::kConstant;
@@ -346,7 +347,8 @@ Expression Expression::Constant(double value) {
 
 Expression Expression::Symbol(std::string name, int slot) {
   if (name.empty() || slot < 0) {
-    throw std::invalid_argument("Expression::Symbol: empty name or negative slot");
+    throw std::invalid_argument(name.empty() ? "a name in an expression is empty"
+                                             : "name '" + name + "' has no slot");
   }
   auto node = std::make_shared<Node>();
   node->op = Op::kSymbol;
@@ -356,18 +358,20 @@ Expression Expression::Symbol(std::string name, int slot) {
 }
 
 Expression Expression::Unary(Op op, Expression arg) {
-  if (Arity(op) != 1) throw std::invalid_argument("Expression::Unary: operation is not unary");
+  if (Arity(op) != 1) throw std::invalid_argument("operation does not take one argument");
   if (op == Op::kNeg && arg.is_constant()) return Constant(-arg.constant());
   auto node = std::make_shared<Node>();
   node->op = op;
+  node->depth = CheckedDepth(arg.depth() + 1);
   node->args.push_back(std::move(arg));
   return Expression(std::move(node));
 }
 
 Expression Expression::Binary(Op op, Expression lhs, Expression rhs) {
-  if (Arity(op) != 2) throw std::invalid_argument("Expression::Binary: operation is not binary");
+  if (Arity(op) != 2) throw std::invalid_argument("operation does not take two arguments");
   auto node = std::make_shared<Node>();
   node->op = op;
+  node->depth = CheckedDepth(std::max(lhs.depth(), rhs.depth()) + 1);
   node->args.push_back(std::move(lhs));
   node->args.push_back(std::move(rhs));
   return Expression(std::move(node));
@@ -378,31 +382,25 @@ double Expression::constant() const { return node_->value; }
 const std::string& Expression::symbol_name() const { return node_->name; }
 int Expression::slot() const { return node_->slot; }
 std::span<const Expression> Expression::args() const { return node_->args; }
+int Expression::depth() const { return node_->depth; }
 
 double Expression::Evaluate(std::span<const double> env) const {
-  const Node& n = *node_;
-  switch (Arity(n.op)) {
-    case 0:
-      return n.op == Op::kConstant ? n.value : env[n.slot];
-    case 1:
-      return ApplyUnary(n.op, n.args[0].Evaluate(env));
-    default:
-      return ApplyBinary(n.op, n.args[0].Evaluate(env), n.args[1].Evaluate(env));
-  }
+  return internal::PostOrder<double>(
+      *this, Args,
+      [&](const Expression& e) -> std::optional<double> {
+        if (e.is_constant()) return e.constant();
+        if (e.is_symbol()) return env[e.slot()];
+        return std::nullopt;
+      },
+      [](const Expression& e, std::span<double> v) {
+        return v.size() == 1 ? ApplyUnary(e.op(), v[0]) : ApplyBinary(e.op(), v[0], v[1]);
+      });
 }
 
-Interval Expression::EvaluateInterval(std::span<const Interval> env) const {
-  const Node& n = *node_;
-  switch (n.op) {
-    case Op::kConstant:
-      return Interval(n.value);
-    case Op::kSymbol:
-      return env[n.slot];
-    default:
-      break;
-  }
-  const Interval a = n.args[0].EvaluateInterval(env);
-  switch (n.op) {
+namespace {
+
+Interval ApplyUnary(Op op, const Interval& a) {
+  switch (op) {
     case Op::kNeg:
       return -a;
     case Op::kSin:
@@ -423,10 +421,12 @@ Interval Expression::EvaluateInterval(std::span<const Interval> env) const {
       return Interval(a.lo() > 0.0 ? 1.0 : (a.lo() < 0.0 ? -1.0 : 0.0),
                       a.hi() > 0.0 ? 1.0 : (a.hi() < 0.0 ? -1.0 : 0.0));
     default:
-      break;
+      throw std::logic_error("interval evaluation: not a unary operation");
   }
-  const Interval b = n.args[1].EvaluateInterval(env);
-  switch (n.op) {
+}
+
+Interval ApplyBinary(Op op, const Interval& a, const Interval& b) {
+  switch (op) {
     case Op::kAdd:
       return a + b;
     case Op::kSub:
@@ -444,18 +444,17 @@ Interval Expression::EvaluateInterval(std::span<const Interval> env) const {
     case Op::kAtan2:
       return Atan2(a, b);
     default:
-      throw std::logic_error("Expression::EvaluateInterval: unknown op");
+      throw std::logic_error("interval evaluation: not a binary operation");
   }
 }
 
-Expression Expression::Derivative(int slot) const {
-  const Node& n = *node_;
-  if (n.op == Op::kConstant) return Constant(0.0);
-  if (n.op == Op::kSymbol) return Constant(n.slot == slot ? 1.0 : 0.0);
-  const Expression& a = n.args[0];
-  const Expression da = a.Derivative(slot);
-  const auto half = Constant(0.5);
-  switch (n.op) {
+// The derivative of operation `e` given the derivatives `d` of its arguments (Derivative()).
+Expression DerivativeOf(const Expression& e, std::span<const Expression> d) {
+  const Expression& a = e.args()[0];
+  const Expression& da = d[0];
+  const auto half = Expression::Constant(0.5);
+  const auto two = Expression::Constant(2.0);
+  switch (e.op()) {
     case Op::kNeg:
       return SNeg(da);
     case Op::kSin:
@@ -463,23 +462,23 @@ Expression Expression::Derivative(int slot) const {
     case Op::kCos:
       return SNeg(SMul(Call(Op::kSin, a), da));
     case Op::kTan:
-      return SDiv(da, Binary(Op::kPow, Call(Op::kCos, a), Constant(2.0)));
+      return SDiv(da, Expression::Binary(Op::kPow, Call(Op::kCos, a), two));
     case Op::kExp:
-      return SMul(*this, da);
+      return SMul(e, da);
     case Op::kLog:
       return SDiv(da, a);
     case Op::kSqrt:
-      return SDiv(da, SMul(Constant(2.0), *this));
+      return SDiv(da, SMul(two, e));
     case Op::kAbs:
       return SMul(Call(Op::kSign, a), da);
     case Op::kSign:
-      return Constant(0.0);
+      return Expression::Constant(0.0);
     default:
       break;
   }
-  const Expression& b = n.args[1];
-  const Expression db = b.Derivative(slot);
-  switch (n.op) {
+  const Expression& b = e.args()[1];
+  const Expression& db = d[1];
+  switch (e.op()) {
     case Op::kAdd:
       return SAdd(da, db);
     case Op::kSub:
@@ -487,85 +486,170 @@ Expression Expression::Derivative(int slot) const {
     case Op::kMul:
       return SAdd(SMul(da, b), SMul(a, db));
     case Op::kDiv:
-      return SDiv(SSub(SMul(da, b), SMul(a, db)), Binary(Op::kPow, b, Constant(2.0)));
+      return SDiv(SSub(SMul(da, b), SMul(a, db)), Expression::Binary(Op::kPow, b, two));
     case Op::kPow:
       if (b.is_constant()) {
-        return SMul(SMul(b, Binary(Op::kPow, a, Constant(b.constant() - 1.0))), da);
+        return SMul(
+            SMul(b, Expression::Binary(Op::kPow, a, Expression::Constant(b.constant() - 1.0))), da);
       }
-      return SMul(*this, SAdd(SMul(db, Call(Op::kLog, a)), SDiv(SMul(b, da), a)));
+      return SMul(e, SAdd(SMul(db, Call(Op::kLog, a)), SDiv(SMul(b, da), a)));
     case Op::kMin:
     case Op::kMax: {
       const Expression mean = SMul(half, SAdd(da, db));
       const Expression jump = SMul(SMul(half, Call(Op::kSign, a - b)), SSub(da, db));
-      return n.op == Op::kMin ? SSub(mean, jump) : SAdd(mean, jump);
+      return e.op() == Op::kMin ? SSub(mean, jump) : SAdd(mean, jump);
     }
     case Op::kAtan2:  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
       return SDiv(SSub(SMul(b, da), SMul(a, db)),
-                  Binary(Op::kPow, a, Constant(2.0)) + Binary(Op::kPow, b, Constant(2.0)));
+                  Expression::Binary(Op::kPow, a, two) + Expression::Binary(Op::kPow, b, two));
     default:
-      throw std::logic_error("Expression::Derivative: unknown op");
+      throw std::logic_error("derivative: unknown operation");
   }
+}
+
+// The affine form of operation `e` given those of its arguments (AsAffine()).
+std::optional<AffineForm> AffineOf(const Expression& e,
+                                   std::span<std::optional<AffineForm>> parts) {
+  for (const auto& p : parts) {
+    if (!p) return std::nullopt;
+  }
+  const bool all_constant =
+      std::all_of(parts.begin(), parts.end(), [](const auto& f) { return f->terms.empty(); });
+  if (all_constant) {
+    const double v = parts.size() == 1
+                         ? ApplyUnary(e.op(), parts[0]->constant)
+                         : ApplyBinary(e.op(), parts[0]->constant, parts[1]->constant);
+    if (!std::isfinite(v)) return std::nullopt;
+    return AffineForm{v, {}};
+  }
+  switch (e.op()) {
+    case Op::kNeg:
+      return Scale(*parts[0], -1.0);
+    case Op::kAdd:
+      return Combine(*parts[0], *parts[1], 1.0);
+    case Op::kSub:
+      return Combine(*parts[0], *parts[1], -1.0);
+    case Op::kMul:
+      if (parts[0]->terms.empty()) return Scale(*parts[1], parts[0]->constant);
+      if (parts[1]->terms.empty()) return Scale(*parts[0], parts[1]->constant);
+      return std::nullopt;
+    case Op::kDiv:
+      if (parts[1]->terms.empty() && parts[1]->constant != 0.0) {
+        return Scale(*parts[0], 1.0 / parts[1]->constant);
+      }
+      return std::nullopt;
+    case Op::kPow:
+      if (parts[1]->terms.empty() && parts[1]->constant == 1.0) return *parts[0];
+      return std::nullopt;
+    default:
+      return std::nullopt;
+  }
+}
+
+}  // namespace
+
+Interval Expression::EvaluateInterval(std::span<const Interval> env) const {
+  return internal::PostOrder<Interval>(
+      *this, Args,
+      [&](const Expression& e) -> std::optional<Interval> {
+        if (e.is_constant()) return Interval(e.constant());
+        if (e.is_symbol()) return env[e.slot()];
+        return std::nullopt;
+      },
+      [](const Expression& e, std::span<Interval> v) {
+        return v.size() == 1 ? ApplyUnary(e.op(), v[0]) : ApplyBinary(e.op(), v[0], v[1]);
+      });
+}
+
+Expression Expression::Derivative(int slot) const {
+  return internal::PostOrder<Expression>(
+      *this, Args,
+      [&](const Expression& e) -> std::optional<Expression> {
+        if (e.is_constant()) return Constant(0.0);
+        if (e.is_symbol()) return Constant(e.slot() == slot ? 1.0 : 0.0);
+        return std::nullopt;
+      },
+      [](const Expression& e, std::span<Expression> d) { return DerivativeOf(e, d); });
 }
 
 std::vector<int> Expression::Slots() const {
   std::vector<int> slots;
-  CollectSlots(*this, &slots);
+  internal::PreOrder(*this, Args, [&](const Expression& e) {
+    if (e.is_symbol()) slots.push_back(e.slot());
+  });
   std::sort(slots.begin(), slots.end());
   slots.erase(std::unique(slots.begin(), slots.end()), slots.end());
   return slots;
 }
 
 std::optional<AffineForm> Expression::AsAffine() const {
-  const Node& n = *node_;
-  if (n.op == Op::kConstant) return AffineForm{n.value, {}};
-  if (n.op == Op::kSymbol) return AffineForm{0.0, {{n.slot, 1.0}}};
-  std::vector<AffineForm> parts;
-  for (const Expression& a : n.args) {
-    auto f = a.AsAffine();
-    if (!f) return std::nullopt;
-    parts.push_back(std::move(*f));
-  }
-  const bool all_constant =
-      std::all_of(parts.begin(), parts.end(), [](const AffineForm& f) { return f.terms.empty(); });
-  if (all_constant) {
-    const double v = Arity(n.op) == 1 ? ApplyUnary(n.op, parts[0].constant)
-                                      : ApplyBinary(n.op, parts[0].constant, parts[1].constant);
-    if (!std::isfinite(v)) return std::nullopt;
-    return AffineForm{v, {}};
-  }
-  switch (n.op) {
-    case Op::kNeg:
-      return Scale(parts[0], -1.0);
-    case Op::kAdd:
-      return Combine(parts[0], parts[1], 1.0);
-    case Op::kSub:
-      return Combine(parts[0], parts[1], -1.0);
-    case Op::kMul:
-      if (parts[0].terms.empty()) return Scale(parts[1], parts[0].constant);
-      if (parts[1].terms.empty()) return Scale(parts[0], parts[1].constant);
-      return std::nullopt;
-    case Op::kDiv:
-      if (parts[1].terms.empty() && parts[1].constant != 0.0) {
-        return Scale(parts[0], 1.0 / parts[1].constant);
-      }
-      return std::nullopt;
-    case Op::kPow:
-      if (parts[1].terms.empty() && parts[1].constant == 1.0) return parts[0];
-      return std::nullopt;
-    default:
-      return std::nullopt;
-  }
+  return internal::PostOrder<std::optional<AffineForm>>(
+      *this, Args,
+      [](const Expression& e) -> std::optional<std::optional<AffineForm>> {
+        if (e.is_constant()) return AffineForm{e.constant(), {}};
+        if (e.is_symbol()) return AffineForm{0.0, {{e.slot(), 1.0}}};
+        return std::nullopt;
+      },
+      [](const Expression& e, std::span<std::optional<AffineForm>> parts) {
+        return AffineOf(e, parts);
+      });
 }
 
 Expression Expression::Substitute(
     const std::function<std::optional<Expression>(const std::string&, int)>& f) const {
-  SubstituteMemo memo;
-  return SubstituteShared(*this, f, memo);
+  // A shared subexpression is rewritten once (memo by node) and stays shared.
+  std::unordered_map<const void*, Expression> memo;
+  return internal::PostOrder<Expression>(
+      *this, Args,
+      [&](const Expression& e) -> std::optional<Expression> {
+        if (e.is_constant()) return e;
+        if (e.is_symbol()) {
+          std::optional<Expression> replacement = f(e.symbol_name(), e.slot());
+          if (replacement) return replacement;
+          return e;
+        }
+        if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
+        return std::nullopt;
+      },
+      [&](const Expression& e, std::span<Expression> args) {
+        Expression out = Rebuild(e.op(), args);
+        memo.emplace(e.node_id(), out);
+        return out;
+      });
 }
 
 Expression Expression::FoldConstants() const {
-  FoldMemo memo;
-  return FoldWithValue(*this, memo).first;
+  // A symbol-free subtree whose value is not finite stays unfolded but still passes its value up,
+  // so that a finite result above it (`sign(log(0))`, `min(1 / 0, 2)`) folds like any other
+  // symbol-free subtree. Shared subexpressions are folded once and stay shared.
+  std::unordered_map<const void*, Folded> memo;
+  return internal::PostOrder<Folded>(
+             *this, Args,
+             [&](const Expression& e) -> std::optional<Folded> {
+               if (e.is_constant()) return Folded{e, e.constant()};
+               if (e.is_symbol()) return Folded{e, std::nullopt};
+               if (auto it = memo.find(e.node_id()); it != memo.end()) return it->second;
+               return std::nullopt;
+             },
+             [&](const Expression& e, std::span<Folded> parts) {
+               std::vector<Expression> args;
+               std::vector<double> values;
+               for (const Folded& p : parts) {
+                 args.push_back(p.first);
+                 if (p.second) values.push_back(*p.second);
+               }
+               std::optional<double> value;
+               if (values.size() == args.size()) {
+                 value = values.size() == 1 ? ApplyUnary(e.op(), values[0])
+                                            : ApplyBinary(e.op(), values[0], values[1]);
+               }
+               Folded out = value && std::isfinite(*value)
+                                ? Folded{Expression::Constant(*value), value}
+                                : Folded{Rebuild(e.op(), args), value};
+               memo.emplace(e.node_id(), out);
+               return out;
+             })
+      .first;
 }
 
 std::string Expression::ToString() const {
@@ -575,14 +659,17 @@ std::string Expression::ToString() const {
 }
 
 bool operator==(const Expression& a, const Expression& b) {
-  if (a.node_ == b.node_) return true;
-  const auto& x = *a.node_;
-  const auto& y = *b.node_;
-  if (x.op != y.op || x.args.size() != y.args.size()) return false;
-  if (x.op == Op::kConstant) return x.value == y.value;
-  if (x.op == Op::kSymbol) return x.slot == y.slot && x.name == y.name;
-  for (size_t i = 0; i < x.args.size(); ++i) {
-    if (!(x.args[i] == y.args[i])) return false;
+  std::vector<std::pair<const Expression*, const Expression*>> todo = {{&a, &b}};
+  while (!todo.empty()) {
+    const auto [p, q] = todo.back();
+    todo.pop_back();
+    if (p->node_ == q->node_) continue;
+    const auto& x = *p->node_;
+    const auto& y = *q->node_;
+    if (x.op != y.op || x.args.size() != y.args.size()) return false;
+    if (x.op == Op::kConstant && x.value != y.value) return false;
+    if (x.op == Op::kSymbol && (x.slot != y.slot || x.name != y.name)) return false;
+    for (size_t i = 0; i < x.args.size(); ++i) todo.emplace_back(&x.args[i], &y.args[i]);
   }
   return true;
 }

@@ -50,6 +50,22 @@ std::optional<std::string_view> FunctionName(Op op);
 /// The function-call operation spelled `name` with `arity` arguments, or nullopt if none.
 std::optional<Op> FunctionByName(std::string_view name, int arity);
 
+/// Deepest expression a model may declare, in tree levels: a number or a name is one level, an
+/// operator or function call one more than its deepest argument (so the sum `a + b + c`, which
+/// is (a + b) + c, has 3 levels, and a comparison one more than its deeper side). The parser, the
+/// Automaton API and the System API refuse deeper expressions and predicates with a message
+/// (docs/model_language.md, "Limits"). The value is set by the stack the solvers' recursive
+/// walks need (the SMT encoding: about 2.1 KiB per level under AddressSanitizer): at
+/// kMaxTreeDepth they fit a 1 MiB stack with room to spare. The IR's own walks (printing,
+/// evaluation, compilation, derivatives, comparison, destruction) use no stack per level.
+inline constexpr int kMaxExpressionDepth = 256;
+
+/// Deepest expression or predicate tree that can be built at all: Expression::Unary and
+/// Expression::Binary (and Predicate's combinators) throw std::invalid_argument beyond it. It is
+/// above kMaxExpressionDepth to leave room for what solvers derive from model expressions
+/// (residuals, negations, integrals), and bounds every recursive walk of a tree.
+inline constexpr int kMaxTreeDepth = kMaxExpressionDepth + 128;
+
 /// An affine form c0 + sum_i a_i * x_{slot_i} with numeric coefficients.
 struct AffineForm {
   double constant = 0.0;
@@ -75,10 +91,12 @@ class Expression {
   static Expression Constant(double value);
   /// A reference to the value at `slot` of the environment; `slot` >= 0, `name` non-empty.
   static Expression Symbol(std::string name, int slot);
-  /// `op` applied to `arg`; throws std::invalid_argument if `op` is not unary. Negation of a
-  /// constant folds to the negated constant (so `-5` is the constant -5), nothing else folds.
+  /// `op` applied to `arg`; throws std::invalid_argument if `op` is not unary or the result
+  /// would be deeper than kMaxTreeDepth. Negation of a constant folds to the negated constant
+  /// (so `-5` is the constant -5), nothing else folds.
   static Expression Unary(Op op, Expression arg);
-  /// `op` applied to (lhs, rhs); throws std::invalid_argument if `op` is not binary.
+  /// `op` applied to (lhs, rhs); throws std::invalid_argument if `op` is not binary or the result
+  /// would be deeper than kMaxTreeDepth.
   static Expression Binary(Op op, Expression lhs, Expression rhs);
 
   Op op() const;
@@ -91,6 +109,9 @@ class Expression {
   int slot() const;
   /// The arguments (empty for leaves).
   std::span<const Expression> args() const;
+  /// Levels of the tree: 1 for a leaf, 1 + the deepest argument's otherwise (at most
+  /// kMaxTreeDepth). Constant time.
+  int depth() const;
   /// Identity of the shared, immutable node behind this expression: equal for copies of one
   /// expression and for a subexpression used in several places (expressions built from shared
   /// parts are DAGs). CompiledExpression uses it to evaluate a shared subexpression once.
@@ -102,7 +123,9 @@ class Expression {
   Interval EvaluateInterval(std::span<const Interval> env) const;
   /// The symbolic partial derivative with respect to the symbol at `slot`, lightly simplified
   /// (0 and 1 are folded). Non-smooth functions use a subgradient: d|x| = sign(x) dx,
-  /// d min(a, b) = (da + db)/2 - sign(a - b) (da - db)/2, and likewise for max.
+  /// d min(a, b) = (da + db)/2 - sign(a - b) (da - db)/2, and likewise for max. The derivative
+  /// can be up to three times as deep as the expression; throws std::invalid_argument if it
+  /// would be deeper than kMaxTreeDepth.
   Expression Derivative(int slot) const;
   /// Sorted, de-duplicated slots this expression reads.
   std::vector<int> Slots() const;

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "automaton/expression.h"  // FormatNumber
+
 namespace hybrid {
 namespace {
 
@@ -50,8 +52,8 @@ Interval::Interval(double x) : lo_(x), hi_(x) {}
 
 Interval::Interval(double lo, double hi) : lo_(lo), hi_(hi) {
   if (std::isnan(lo) || std::isnan(hi) || lo > hi) {
-    throw std::invalid_argument("Interval: invalid bounds [" + std::to_string(lo) + ", " +
-                                std::to_string(hi) + "]");
+    throw std::invalid_argument("invalid interval [" + FormatNumber(lo) + ", " + FormatNumber(hi) +
+                                "]: the lower bound must not exceed the upper one");
   }
 }
 

@@ -1,13 +1,18 @@
 #include "automaton/parser.h"
 
+#include <pthread.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
-#include <sstream>
+#include <system_error>
 #include <tao/pegtl.hpp>
 #include <tao/pegtl/contrib/limit_depth.hpp>
 #include <tao/pegtl/contrib/parse_tree.hpp>
@@ -402,6 +407,18 @@ struct depth_action : limit_depth<1000> {};
 
 using Node = pegtl::parse_tree::node;
 
+// A location in the model text (line and column from 1, columns in bytes), copied out of the
+// parse tree. A node's begin() would hold a view of the input's source name, so it is never
+// used: only these plain numbers are kept.
+struct SourcePosition {
+  int line = 0;
+  int column = 0;
+};
+
+SourcePosition Where(const Node& n) {
+  return {static_cast<int>(n.m_begin.line), static_cast<int>(n.m_begin.column)};
+}
+
 // ---------------------------------------------------------------------------------------------
 // Building the model from the parse tree.
 
@@ -411,25 +428,20 @@ class Builder {
       : file_(std::move(file)), active_imports_(active_imports) {}
 
   [[noreturn]] void Fail(const Node& n, const std::string& message) const {
-    throw ParseError(file_, static_cast<int>(n.m_begin.line), static_cast<int>(n.m_begin.column),
-                     message);
+    Fail(Where(n), message);
+  }
+  [[noreturn]] void Fail(const SourcePosition& at, const std::string& message) const {
+    throw ParseError(file_, at.line, at.column, message);
   }
 
-  // Runs `f`; an std::invalid_argument from the model API becomes a ParseError at `n` with the
-  // API name stripped ("Automaton::AddMode: duplicate mode 'x'" -> "duplicate mode 'x'").
+  // Runs `f`; an std::invalid_argument from the model API (whose messages speak of the model)
+  // becomes a ParseError at `n`.
   template <class F>
   auto At(const Node& n, F&& f) -> decltype(f()) {
     try {
       return f();
     } catch (const std::invalid_argument& e) {
-      std::string message = e.what();
-      while (true) {
-        const auto colon = message.find(": ");
-        const auto api = message.find("::");
-        if (colon == std::string::npos || api == std::string::npos || api > colon) break;
-        message = message.substr(colon + 2);
-      }
-      Fail(n, message);
+      Fail(n, e.what());
     }
   }
 
@@ -449,16 +461,11 @@ class Builder {
   System Result(const Node& root) {
     if (system_) return std::move(*system_);
     if (local_automata_.size() == 1) return System::Of(automata_.at(local_automata_.front()));
-    if (local_automata_.empty()) {
-      throw ParseError(file_, static_cast<int>(root.m_begin.line),
-                       static_cast<int>(root.m_begin.column),
-                       "the file declares no automaton and no system");
-    }
+    if (local_automata_.empty()) Fail(root, "the file declares no automaton and no system");
     // Point at the second automaton: the first one alone would have been the model.
-    const pegtl::position& second = local_positions_.at(1);
-    throw ParseError(file_, static_cast<int>(second.line), static_cast<int>(second.column),
-                     "the file declares " + std::to_string(local_automata_.size()) +
-                         " automata and no system: add 'system NAME { instance A = a; ... }'");
+    Fail(local_positions_.at(1),
+         "the file declares " + std::to_string(local_automata_.size()) +
+             " automata and no system: add 'system NAME { instance A = a; ... }'");
   }
 
   const std::map<std::string, Automaton>& automata() const { return automata_; }
@@ -503,25 +510,24 @@ class Builder {
     return value;
   }
 
-  // depth + 1: the depth of a tree node whose deepest child has `depth`. Fails at `n` past
-  // kMaxExpressionDepth.
-  int Deeper(const Node& n, int depth) const {
-    if (depth >= kMaxExpressionDepth) {
-      Fail(n, "expression too long or nested too deeply (more than " +
-                  std::to_string(kMaxExpressionDepth) + " levels)");
-    }
-    return depth + 1;
+  // The message for an expression or predicate deeper than kMaxExpressionDepth.
+  static std::string TooDeep() {
+    return "expression too long or nested too deeply (more than " +
+           std::to_string(kMaxExpressionDepth) + " levels)";
   }
 
+  // `e`, built at `n`; fails at `n` if it is deeper than kMaxExpressionDepth. Every node is
+  // checked as it is built, so the error points at the operator that crosses the limit and no
+  // tree deeper than the limit plus one level is ever built.
+  template <class Tree>
+  Tree Checked(const Node& n, Tree e) const {
+    if (e.depth() > kMaxExpressionDepth) Fail(n, TooDeep());
+    return e;
+  }
+
+  // Builds the expression of `n`.
   Expression Expr(const Node& n, const Scope& scope) const {
-    int depth = 0;
-    return Expr(n, scope, &depth);
-  }
-
-  // Builds the expression of `n` and sets `*depth` to the depth of its tree.
-  Expression Expr(const Node& n, const Scope& scope, int* depth) const {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
-    *depth = 1;
     if (n.is_type<number>()) return Expression::Constant(Number(n));
     if (n.is_type<name>()) {
       const std::string id = Text(n);
@@ -534,70 +540,57 @@ class Builder {
       }
       return Expression::Symbol(id, *slot);
     }
-    int d = 0;
-    if (n.is_type<negation>()) {
-      Expression arg = Expr(*n.children.back(), scope, &d);
-      *depth = Deeper(n, d);
-      return -arg;
-    }
+    if (n.is_type<negation>()) return Checked(n, -Expr(*n.children.back(), scope));
     if (n.is_type<power>()) {
-      Expression base = Expr(*n.children.at(0), scope, depth);
+      Expression base = Expr(*n.children.at(0), scope);
       if (n.children.size() == 1) return base;
-      Expression exponent = Expr(*n.children.at(1), scope, &d);
-      *depth = Deeper(n, std::max(*depth, d));
-      return Expression::Binary(Op::kPow, base, exponent);
+      return Checked(n, Expression::Binary(Op::kPow, base, Expr(*n.children.at(1), scope)));
     }
-    if (n.is_type<call>()) {
-      const std::string fn = Text(*n.children.at(0));
-      std::vector<Expression> args;
-      int deepest = 0;
-      if (n.children.size() > 1) {
-        for (const auto& a : n.children.at(1)->children) {
-          args.push_back(Expr(*a, scope, &d));
-          deepest = std::max(deepest, d);
-        }
-      }
-      const auto op = FunctionByName(fn, static_cast<int>(args.size()));
-      if (!op) {
-        if (FunctionByName(fn, 1) || FunctionByName(fn, 2)) {
-          Fail(n, "function '" + fn + "' takes " + (FunctionByName(fn, 1) ? "1" : "2") +
-                      " argument(s), not " + std::to_string(args.size()));
-        }
-        Fail(n, "unknown function '" + fn + "'");
-      }
-      *depth = Deeper(n, deepest);
-      return args.size() == 1 ? Expression::Unary(*op, args[0])
-                              : Expression::Binary(*op, args[0], args[1]);
-    }
+    if (n.is_type<call>()) return Call(n, scope);
     if (n.is_type<sum>() || n.is_type<product>()) {
       // Left-associative: a long sum is a deep tree, one level per operator.
-      Expression acc = Expr(*n.children.at(0), scope, depth);
+      Expression acc = Expr(*n.children.at(0), scope);
       for (size_t i = 1; i + 1 < n.children.size(); i += 2) {
         const Node& op = *n.children[i];
-        Expression rhs = Expr(*n.children[i + 1], scope, &d);
-        *depth = Deeper(op, std::max(*depth, d));
+        Expression rhs = Expr(*n.children[i + 1], scope);
         if (op.is_type<plus_op>())
-          acc = acc + rhs;
+          acc = Checked(op, acc + rhs);
         else if (op.is_type<minus_op>())
-          acc = acc - rhs;
+          acc = Checked(op, acc - rhs);
         else if (op.is_type<times_op>())
-          acc = acc * rhs;
+          acc = Checked(op, acc * rhs);
         else
-          acc = acc / rhs;
+          acc = Checked(op, acc / rhs);
       }
       return acc;
     }
     Fail(n, "internal error: unexpected expression node " + std::string(n.type));
   }
 
-  Comparison Compare(const Node& n, const Scope& scope) const {
-    int depth = 0;
-    return Compare(n, scope, &depth);
+  // A function call `f(args)`.
+  Expression Call(const Node& n, const Scope& scope) const {
+    const std::string fn = Text(*n.children.at(0));
+    std::vector<Expression> args;
+    if (n.children.size() > 1) {
+      for (const auto& a : n.children.at(1)->children) args.push_back(Expr(*a, scope));
+    }
+    const auto op = FunctionByName(fn, static_cast<int>(args.size()));
+    if (!op) {
+      if (FunctionByName(fn, 1) || FunctionByName(fn, 2)) {
+        Fail(n, "function '" + fn + "' takes " + (FunctionByName(fn, 1) ? "1" : "2") +
+                    " argument(s), not " + std::to_string(args.size()));
+      }
+      Fail(n, "unknown function '" + fn + "'");
+    }
+    return Checked(n, args.size() == 1 ? Expression::Unary(*op, args[0])
+                                       : Expression::Binary(*op, args[0], args[1]));
   }
 
-  // Sets `*depth` to the depth of the comparison's residual lhs - rhs.
-  Comparison Compare(const Node& n, const Scope& scope, int* depth) const {
-    const std::string rel = Text(*n.children.at(1));
+  // A comparison; its residual lhs - rhs (one level above the deeper side) must be within
+  // kMaxExpressionDepth, checked at the relation.
+  Comparison Compare(const Node& n, const Scope& scope) const {
+    const Node& relation = *n.children.at(1);
+    const std::string rel = Text(relation);
     Relation r = Relation::kEqual;
     if (rel.starts_with("<="))
       r = Relation::kLessEqual;
@@ -609,10 +602,9 @@ class Builder {
       r = Relation::kLess;
     else if (rel.starts_with(">"))
       r = Relation::kGreater;
-    int lhs_depth = 0, rhs_depth = 0;
-    Expression lhs = Expr(*n.children.at(0), scope, &lhs_depth);
-    Expression rhs = Expr(*n.children.at(2), scope, &rhs_depth);
-    *depth = Deeper(*n.children.at(1), std::max(lhs_depth, rhs_depth));
+    Expression lhs = Expr(*n.children.at(0), scope);
+    Expression rhs = Expr(*n.children.at(2), scope);
+    if (std::max(lhs.depth(), rhs.depth()) + 1 > kMaxExpressionDepth) Fail(relation, TooDeep());
     return {std::move(lhs), r, std::move(rhs)};
   }
 
@@ -628,16 +620,7 @@ class Builder {
   Predicate Pred(const Node& n, const Scope& scope,
                  const std::function<bool(const std::string&)>& is_mode,
                  const std::string& property) const {
-    int depth = 0;
-    return Pred(n, scope, is_mode, property, &depth);
-  }
-
-  // Sets `*depth` to the depth of the predicate tree, counting its comparisons' expressions.
-  Predicate Pred(const Node& n, const Scope& scope,
-                 const std::function<bool(const std::string&)>& is_mode,
-                 const std::string& property, int* depth) const {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
-    *depth = 1;
     if (n.is_type<non_predicate>()) {
       const Expression e = Expr(*n.children.at(0), scope);
       Fail(n, "property '" + property + "': '" + e.ToString() +
@@ -646,32 +629,23 @@ class Builder {
     }
     if (n.is_type<kw_true>()) return Predicate::True();
     if (n.is_type<kw_false>()) return Predicate::False();
-    if (n.is_type<comparison>()) {
-      Comparison c = Compare(n, scope, depth);
-      *depth = Deeper(n, *depth);
-      return Predicate::Compare(std::move(c));
-    }
+    if (n.is_type<comparison>()) return Predicate::Compare(Compare(n, scope));
     if (n.is_type<in_mode>()) {
       const std::string m = Text(*n.children.at(0));
       if (!is_mode(m)) Fail(*n.children.at(0), "unknown mode '" + m + "'");
       return Predicate::InMode(m);
     }
     if (n.is_type<negated>()) {
-      Predicate operand = Pred(*n.children.at(0), scope, is_mode, property, depth);
-      *depth = Deeper(n, *depth);
-      return Predicate::Not(std::move(operand));
+      return Checked(n, Predicate::Not(Pred(*n.children.at(0), scope, is_mode, property)));
     }
-    if (n.is_type<paren_predicate>()) {
-      return Pred(*n.children.at(0), scope, is_mode, property, depth);
-    }
+    if (n.is_type<paren_predicate>()) return Pred(*n.children.at(0), scope, is_mode, property);
     if (n.is_type<and_predicate>() || n.is_type<predicate>()) {
       // Left-associative, like sums.
-      Predicate acc = Pred(*n.children.at(0), scope, is_mode, property, depth);
+      Predicate acc = Pred(*n.children.at(0), scope, is_mode, property);
       for (size_t i = 1; i < n.children.size(); ++i) {
-        int d = 0;
-        Predicate rhs = Pred(*n.children[i], scope, is_mode, property, &d);
-        *depth = Deeper(*n.children[i], std::max(*depth, d));
-        acc = n.is_type<and_predicate>() ? Predicate::And(acc, rhs) : Predicate::Or(acc, rhs);
+        Predicate rhs = Pred(*n.children[i], scope, is_mode, property);
+        acc = Checked(*n.children[i], n.is_type<and_predicate>() ? Predicate::And(acc, rhs)
+                                                                 : Predicate::Or(acc, rhs));
       }
       return acc;
     }
@@ -785,7 +759,10 @@ class Builder {
         Fail(input, "input '" + Text(input) + "' driven twice");
       }
       sig.slot = *slot;
-      const auto [lo, hi] = bounds(*slot);
+      // Plain variables, not a structured binding: clang before 16 cannot capture structured
+      // bindings in a lambda (a C++20 feature).
+      const std::pair<double, double> input_bounds = bounds(*slot);
+      const double lo = input_bounds.first, hi = input_bounds.second;
       const Node& value = *item->children.at(1);
       InputSignal shaped = SignalOf(value, [&](const Node& v, double x) {
         if (x < lo || x > hi) {
@@ -864,7 +841,7 @@ class Builder {
     }
     automata_.emplace(name, std::move(a));
     local_automata_.push_back(name);
-    local_positions_.push_back(name_node.begin());
+    local_positions_.push_back(Where(name_node));
   }
 
   void ModeDecl(const Node& n, Automaton* a) {
@@ -1033,30 +1010,66 @@ class Builder {
   std::set<std::filesystem::path>* active_imports_;
   std::map<std::string, Automaton> automata_;
   std::vector<std::string> local_automata_;
-  // Where each of local_automata_ is declared (its name).
-  std::vector<pegtl::position> local_positions_;
+  // Where each of local_automata_ is declared (its name), as plain numbers: nothing taken from the
+  // parse tree may outlive it.
+  std::vector<SourcePosition> local_positions_;
   std::optional<System> system_;
 };
 
-std::string ReadFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw ParseError(path.string(), 0, 0, "cannot read file: " + ec.message());
-  if (size > kMaxModelFileBytes) {
-    throw ParseError(path.string(), 0, 0,
-                     "file is " + std::to_string(size) + " bytes, larger than the " +
-                         std::to_string(kMaxModelFileBytes) + "-byte limit for model files");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path.string(), 0, 0, "cannot open file");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+[[noreturn]] void CannotRead(const std::filesystem::path& path, const std::string& why) {
+  throw ParseError(path.string(), 0, 0, "cannot read file: " + why);
 }
 
-// Parses `text` with grammar rule `Rule` into a parse tree; every failure is a ParseError.
+// `size` is "N bytes" when known.
+[[noreturn]] void TooLarge(const std::filesystem::path& path, const std::string& size) {
+  throw ParseError(path.string(), 0, 0,
+                   "file is " + (size.empty() ? "" : size + ", ") + "larger than the " +
+                       std::to_string(kMaxModelFileBytes) + "-byte limit for model files");
+}
+
+// The whole content of the model file `path`, read as a stream so that pipes, FIFOs and
+// /dev/stdin work like regular files. A regular file's size is checked before reading; any other
+// file is read up to the limit.
+std::string ReadFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (ec) CannotRead(path, ec.message());
+  if (std::filesystem::is_directory(status)) CannotRead(path, "it is a directory");
+  if (std::filesystem::is_regular_file(status)) {
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) CannotRead(path, ec.message());
+    if (size > kMaxModelFileBytes) TooLarge(path, std::to_string(size) + " bytes");
+  }
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) CannotRead(path, errno != 0 ? std::generic_category().message(errno) : "cannot open it");
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof(chunk)) || in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxModelFileBytes) TooLarge(path, "");
+  }
+  if (in.bad())
+    CannotRead(path, errno != 0 ? std::generic_category().message(errno) : "read error");
+  return text;
+}
+
+// A parse tree with the input it was parsed from. Nodes hold views into the input (of its text
+// and of its source name), so the input lives exactly as long as the tree: `input` is declared
+// first and destroyed last. The text itself belongs to the caller and must outlive both.
+struct ParsedText {
+  std::unique_ptr<pegtl::memory_input<>> input;
+  std::unique_ptr<Node> tree;
+};
+
+// The UTF-8 encoding of U+FEFF, which some editors write at the start of a file.
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+
+// Parses `text` with grammar rule `Rule` into a parse tree; every failure is a ParseError. A
+// leading byte-order mark is skipped (columns of line 1 count from after it).
 template <class Rule>
-std::unique_ptr<Node> ParseTree(std::string_view text, const std::string& file_name) {
+ParsedText ParseTree(std::string_view text, const std::string& file_name) {
+  if (text.starts_with(kByteOrderMark)) text.remove_prefix(kByteOrderMark.size());
   // Binary input: report the first NUL or control byte precisely instead of a grammar error.
   int line = 1, column = 1;
   for (unsigned char c : text) {
@@ -1073,11 +1086,12 @@ std::unique_ptr<Node> ParseTree(std::string_view text, const std::string& file_n
       ++column;
     }
   }
-  pegtl::memory_input<> in(text.data(), text.size(), file_name);
-  std::unique_ptr<Node> tree;
+  ParsedText parsed;
+  parsed.input = std::make_unique<pegtl::memory_input<>>(text.data(), text.size(), file_name);
   try {
-    tree = pegtl::parse_tree::parse<Rule, grammar::selector, grammar::depth_action,
-                                    grammar::control>(in);
+    parsed.tree =
+        pegtl::parse_tree::parse<Rule, grammar::selector, grammar::depth_action, grammar::control>(
+            *parsed.input);
   } catch (const pegtl::parse_error& e) {
     const auto& pos = e.positions().front();
     std::string message(e.message());
@@ -1088,15 +1102,15 @@ std::unique_ptr<Node> ParseTree(std::string_view text, const std::string& file_n
     }
     throw ParseError(file_name, static_cast<int>(pos.line), static_cast<int>(pos.column), message);
   }
-  if (!tree) throw ParseError(file_name, 1, 1, "syntax error");
-  return tree;
+  if (!parsed.tree) throw ParseError(file_name, 1, 1, "syntax error");
+  return parsed;
 }
 
-// Parses `text` into a parse tree and builds it with `builder`.
+// Parses `text` into `*parsed` and builds it with `builder`.
 void ParseInto(std::string_view text, const std::string& file_name, Builder* builder,
-               std::unique_ptr<Node>* tree) {
-  *tree = ParseTree<grammar::file>(text, file_name);
-  builder->File(**tree);
+               ParsedText* parsed) {
+  *parsed = ParseTree<grammar::file>(text, file_name);
+  builder->File(*parsed->tree);
 }
 
 void Builder::Import(const Node& n) {
@@ -1110,15 +1124,20 @@ void Builder::Import(const Node& n) {
   if (!active_imports_->insert(canonical).second) {
     Fail(n, "import cycle through '" + relative + "'");
   }
+  // The top-level file is in the set too.
+  if (static_cast<int>(active_imports_->size()) > kMaxImportDepth + 1) {
+    Fail(n, "imports nested more than " + std::to_string(kMaxImportDepth) + " files deep");
+  }
   std::string text;
   try {
     text = ReadFile(path);
   } catch (const ParseError& e) {
     Fail(n, "cannot import '" + relative + "': " + e.message());
   }
-  Builder imported(path.string(), active_imports_);
-  std::unique_ptr<Node> tree;
-  ParseInto(text, path.string(), &imported, &tree);  // errors point into the imported file
+  const std::string imported_name = path.string();
+  Builder imported(imported_name, active_imports_);
+  ParsedText parsed;
+  ParseInto(text, imported_name, &imported, &parsed);  // errors point into the imported file
   active_imports_->erase(canonical);
   for (const auto& [name, automaton] : imported.automata()) {
     if (auto it = automata_.find(name); it != automata_.end()) {
@@ -1128,6 +1147,46 @@ void Builder::Import(const Node& n) {
     }
     automata_.emplace(name, automaton);
   }
+}
+
+// The stack the parser runs on, whatever its caller's. PEGTL's rules and the tree builder recurse
+// once per level of nesting (about 7 rules per parenthesis), up to the grammar's limit
+// (grammar::depth_action) and kMaxImportDepth imports; at that bound a parse takes under 4 MiB of
+// stack even under AddressSanitizer (tests/automaton/parser_test.cc checks the nesting limit on a
+// 1 MiB caller stack). Only the pages touched are committed.
+constexpr std::size_t kParserStackBytes = std::size_t{64} << 20;
+
+// Runs `f` on a thread with a kParserStackBytes stack; returns its result or rethrows what it
+// throws. If no thread can be made, runs `f` here.
+template <class F>
+auto OnParserStack(F f) -> decltype(f()) {
+  using Result = decltype(f());
+  struct Call {
+    F* f;
+    std::optional<Result> result;
+    std::exception_ptr error;
+  } call{&f, std::nullopt, nullptr};
+  auto body = [](void* p) -> void* {
+    auto* c = static_cast<Call*>(p);
+    try {
+      c->result.emplace((*c->f)());
+    } catch (...) {
+      c->error = std::current_exception();
+    }
+    return nullptr;
+  };
+  pthread_attr_t attr;
+  pthread_t thread;
+  bool started = false;
+  if (pthread_attr_init(&attr) == 0) {
+    started = pthread_attr_setstacksize(&attr, kParserStackBytes) == 0 &&
+              pthread_create(&thread, &attr, body, &call) == 0;
+    pthread_attr_destroy(&attr);
+  }
+  if (!started) return f();
+  pthread_join(thread, nullptr);
+  if (call.error) std::rethrow_exception(call.error);
+  return std::move(*call.result);
 }
 
 // The import stack of a top-level file: the file itself, so that importing it is a cycle.
@@ -1141,11 +1200,13 @@ std::set<std::filesystem::path> TopLevelImports(const std::string& file_name) {
 }  // namespace
 
 System ParseModel(std::string_view text, const std::string& file_name) {
-  std::set<std::filesystem::path> active = TopLevelImports(file_name);
-  Builder builder(file_name, &active);
-  std::unique_ptr<Node> tree;
-  ParseInto(text, file_name, &builder, &tree);
-  return builder.Result(*tree);
+  return OnParserStack([&] {
+    std::set<std::filesystem::path> active = TopLevelImports(file_name);
+    Builder builder(file_name, &active);
+    ParsedText parsed;
+    ParseInto(text, file_name, &builder, &parsed);
+    return builder.Result(*parsed.tree);
+  });
 }
 
 System ParseModelFile(const std::filesystem::path& path) {
@@ -1153,21 +1214,25 @@ System ParseModelFile(const std::filesystem::path& path) {
 }
 
 Automaton ParseAutomaton(std::string_view text, const std::string& file_name) {
-  std::set<std::filesystem::path> active = TopLevelImports(file_name);
-  Builder builder(file_name, &active);
-  std::unique_ptr<Node> tree;
-  ParseInto(text, file_name, &builder, &tree);
-  if (builder.has_system() || builder.local_automata().size() != 1) {
-    throw ParseError(file_name, 1, 1, "expected exactly one automaton and no system");
-  }
-  return builder.automata().at(builder.local_automata().front());
+  return OnParserStack([&] {
+    std::set<std::filesystem::path> active = TopLevelImports(file_name);
+    Builder builder(file_name, &active);
+    ParsedText parsed;
+    ParseInto(text, file_name, &builder, &parsed);
+    if (builder.has_system() || builder.local_automata().size() != 1) {
+      throw ParseError(file_name, 1, 1, "expected exactly one automaton and no system");
+    }
+    return builder.automata().at(builder.local_automata().front());
+  });
 }
 
 InputSignal ParseSignal(std::string_view text, const std::string& source_name) {
-  const std::unique_ptr<Node> tree = ParseTree<grammar::signal_text>(text, source_name);
-  std::set<std::filesystem::path> none;
-  const Builder builder(source_name, &none);
-  return builder.StandaloneSignal(*tree);
+  return OnParserStack([&] {
+    const ParsedText parsed = ParseTree<grammar::signal_text>(text, source_name);
+    std::set<std::filesystem::path> none;
+    const Builder builder(source_name, &none);
+    return builder.StandaloneSignal(*parsed.tree);
+  });
 }
 
 }  // namespace hybrid

@@ -31,20 +31,22 @@ class ParseError : public std::runtime_error {
 /// Largest model file accepted (bytes); larger files are rejected before parsing.
 inline constexpr std::size_t kMaxModelFileBytes = 16u << 20;
 
-/// Deepest expression or predicate tree accepted, in levels of operators (each operator of a
-/// left-associative chain such as `a + b + c` is one level). Deeper ones are a ParseError: the
-/// IR's tree walks recurse, so a sum of millions of terms would overflow the stack.
-inline constexpr int kMaxExpressionDepth = 10000;
+/// Deepest chain of imports (a file importing a file importing ...) accepted.
+inline constexpr int kMaxImportDepth = 64;
 
 /// Parses model-language text (see docs/model_language.md) into the model it declares: its
 /// `system` block if it has one, otherwise its only automaton wrapped by System::Of. `file_name`
-/// is used in messages and to resolve `import "path";` (relative to its directory).
-/// Throws ParseError for every syntax error, undefined or duplicate name and invalid model; never
+/// is used in messages and to resolve `import "path";` (relative to its directory). A leading
+/// UTF-8 byte-order mark is skipped (columns of the first line count from after it).
+/// Throws ParseError for every syntax error, undefined or duplicate name and invalid model,
+/// including expressions and predicates deeper than kMaxExpressionDepth (expression.h) and
+/// parentheses, unary minus signs, powers or calls nested too deeply for the parser; never
 /// anything else for bad input.
 System ParseModel(std::string_view text, const std::string& file_name);
 
-/// Reads and parses a model file. Throws ParseError (with line 0, column 0 when the file cannot be
-/// read or is larger than kMaxModelFileBytes).
+/// Reads and parses a model file. The file is read as a stream, so a pipe, a FIFO or /dev/stdin
+/// works like a regular file. Throws ParseError (with line 0, column 0 when the file cannot be
+/// read, is a directory, or is larger than kMaxModelFileBytes).
 System ParseModelFile(const std::filesystem::path& path);
 
 /// Parses text that declares exactly one automaton and no system (used by round-trip tests and

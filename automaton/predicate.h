@@ -21,6 +21,8 @@ class Predicate {
   Predicate();
   static Predicate True();
   static Predicate False();
+  /// A comparison; throws std::invalid_argument if the predicate would be deeper than
+  /// kMaxTreeDepth (as Not, And and Or do).
   static Predicate Compare(Comparison c);
   /// Holds exactly when the current mode is named `mode` (for a composed system, a qualified
   /// component mode such as `A.c000_l000`).
@@ -36,6 +38,10 @@ class Predicate {
   const std::string& mode() const;
   /// Operands of kNot (one), kAnd and kOr (two).
   std::span<const Predicate> operands() const;
+  /// Levels of the tree, counting the expressions of its comparisons: 1 for true, false and `in`
+  /// atoms, 1 + the deeper side for a comparison, 1 + the deepest operand otherwise (at most
+  /// kMaxTreeDepth). Every recursive walk of a predicate descends at most this deep. Constant time.
+  int depth() const;
 
   /// Truth value at `env` when the current mode(s) are `modes` (names, as in InMode); comparisons
   /// use Comparison::Holds with tolerance `tol`.

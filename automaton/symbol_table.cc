@@ -19,7 +19,7 @@ std::string_view KindName(SymbolKind kind) {
 }
 
 int SymbolTable::Add(Symbol symbol) {
-  if (symbol.name.empty()) throw std::invalid_argument("SymbolTable::Add: empty name");
+  if (symbol.name.empty()) throw std::invalid_argument("empty name");
   if (auto it = index_.find(symbol.name); it != index_.end()) {
     throw std::invalid_argument("duplicate name '" + symbol.name + "' (already declared as " +
                                 std::string(KindName(symbols_[it->second].kind)) + ")");

@@ -6,11 +6,18 @@
 #include <map>
 #include <stdexcept>
 
+#include "automaton/tree_walk.h"
+
 namespace hybrid {
 namespace {
 
-[[noreturn]] void Fail(std::string_view api, const std::string& message) {
-  throw std::invalid_argument(std::string(api) + ": " + message);
+// Messages speak of the model (instances, names, values), never of this API: they reach users as
+// they are.
+[[noreturn]] void Fail(const std::string& message) { throw std::invalid_argument(message); }
+
+// `context` names what is wrong ("property 'p'").
+[[noreturn]] void Fail(std::string_view context, const std::string& message) {
+  throw std::invalid_argument(std::string(context) + ": " + message);
 }
 
 // "a variable", "an input", ...
@@ -48,22 +55,31 @@ Constraint Remap(const Constraint& c, const std::vector<int>& m, const SymbolTab
 
 Predicate Remap(const Predicate& p, const std::vector<int>& m, const SymbolTable& n,
                 const std::function<std::string(const std::string&)>& mode_name) {
-  switch (p.kind()) {
-    case Predicate::Kind::kComparison:
-      return Predicate::Compare(Remap(p.comparison(), m, n));
-    case Predicate::Kind::kInMode:
-      return Predicate::InMode(mode_name(p.mode()));
-    case Predicate::Kind::kNot:
-      return Predicate::Not(Remap(p.operands()[0], m, n, mode_name));
-    case Predicate::Kind::kAnd:
-      return Predicate::And(Remap(p.operands()[0], m, n, mode_name),
-                            Remap(p.operands()[1], m, n, mode_name));
-    case Predicate::Kind::kOr:
-      return Predicate::Or(Remap(p.operands()[0], m, n, mode_name),
-                           Remap(p.operands()[1], m, n, mode_name));
-    default:
-      return p;
-  }
+  return internal::PostOrder<Predicate>(
+      p, [](const Predicate& x) { return x.operands(); },
+      [&](const Predicate& x) -> std::optional<Predicate> {
+        switch (x.kind()) {
+          case Predicate::Kind::kComparison:
+            return Predicate::Compare(Remap(x.comparison(), m, n));
+          case Predicate::Kind::kInMode:
+            return Predicate::InMode(mode_name(x.mode()));
+          case Predicate::Kind::kTrue:
+          case Predicate::Kind::kFalse:
+            return x;
+          default:
+            return std::nullopt;
+        }
+      },
+      [](const Predicate& x, std::span<Predicate> operands) {
+        switch (x.kind()) {
+          case Predicate::Kind::kNot:
+            return Predicate::Not(operands[0]);
+          case Predicate::Kind::kAnd:
+            return Predicate::And(operands[0], operands[1]);
+          default:
+            return Predicate::Or(operands[0], operands[1]);
+        }
+      });
 }
 
 // Copies `a` into a new automaton whose symbols are renamed by `rename`; slots are preserved.
@@ -133,7 +149,7 @@ Automaton Renamed(const Automaton& a, const std::function<std::string(const std:
 }  // namespace
 
 System::System(std::string name) : name_(std::move(name)) {
-  if (name_.empty()) Fail("System", "empty name");
+  if (name_.empty()) Fail("a system needs a name");
 }
 
 System System::Of(const Automaton& automaton) {
@@ -153,11 +169,10 @@ System System::Of(const Automaton& automaton) {
 void System::Share(std::string name) { shared_.insert(std::move(name)); }
 
 void System::AddComponent(std::string instance, const Automaton& automaton) {
-  constexpr std::string_view kApi = "System::AddComponent";
   for (const Component& c : components_) {
     if (c.instance == instance) {
-      Fail(kApi, instance.empty() ? "two unqualified components"
-                                  : "duplicate instance '" + instance + "'");
+      Fail(instance.empty() ? "two unnamed instances (at most one instance may keep its names)"
+                            : "duplicate instance '" + instance + "'");
     }
   }
   auto rename = [&](const std::string& n) {
@@ -169,9 +184,8 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
   for (int s = 0; s < local.size(); ++s) {
     if (auto g = symbols_.Find(local[s].name)) {
       if (symbols_[*g].kind != local[s].kind) {
-        Fail(kApi, "'" + local[s].name + "' is " + WithArticle(KindName(local[s].kind)) + " in '" +
-                       automaton.name() + "' but " + WithArticle(KindName(symbols_[*g].kind)) +
-                       " elsewhere");
+        Fail("'" + local[s].name + "' is " + WithArticle(KindName(local[s].kind)) + " in '" +
+             automaton.name() + "' but " + WithArticle(KindName(symbols_[*g].kind)) + " elsewhere");
       }
       if (local[s].kind == SymbolKind::kParameter) {
         // A shared parameter is one constant: its values and declared ranges must agree.
@@ -181,16 +195,16 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
           const int other_slot = static_cast<int>(it - other.global_slot.begin());
           const double theirs = other.automaton.ParameterEnvironment()[other_slot];
           if (theirs != parameters[s]) {
-            Fail(kApi, "shared parameter '" + local[s].name + "' is " +
-                           FormatNumber(parameters[s]) + " in '" + automaton.name() + "' but " +
-                           FormatNumber(theirs) + " in '" + other.automaton.name() + "'");
+            Fail("shared parameter '" + local[s].name + "' is " + FormatNumber(parameters[s]) +
+                 " in '" + automaton.name() + "' but " + FormatNumber(theirs) + " in '" +
+                 other.automaton.name() + "'");
           }
           const std::string ours = RangeText(c.automaton, s);
           const std::string their_range = RangeText(other.automaton, other_slot);
           if (ours != their_range) {
-            Fail(kApi, "shared parameter '" + local[s].name + "' has range " + ours + " in '" +
-                           automaton.name() + "' but " + their_range + " in '" +
-                           other.automaton.name() + "'");
+            Fail("shared parameter '" + local[s].name + "' has range " + ours + " in '" +
+                 automaton.name() + "' but " + their_range + " in '" + other.automaton.name() +
+                 "'");
           }
           break;
         }
@@ -218,7 +232,7 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
         });
       };
       if (other_has_flow(other.automaton)) {
-        Fail(kApi, "shared variable '" + local[s].name + "' has flows in two components");
+        Fail("shared variable '" + local[s].name + "' has flows in two components");
       }
     }
   }
@@ -245,9 +259,14 @@ std::string System::QualifiedModeName(int c, ModeId m) const {
 }
 
 void System::AddProperty(Property property) {
-  const std::string context = "System::AddProperty: property '" + property.name + "'";
+  const std::string context = "property '" + property.name + "'";
+  if (property.predicate.depth() > kMaxExpressionDepth) {
+    Fail(context, "expression too long or nested too deeply (" +
+                      std::to_string(property.predicate.depth()) + " levels, more than " +
+                      std::to_string(kMaxExpressionDepth) + ")");
+  }
   for (const Property& p : properties_) {
-    if (p.name == property.name) Fail("System::AddProperty", "duplicate property '" + p.name + "'");
+    if (p.name == property.name) Fail("duplicate property '" + p.name + "'");
   }
   property.predicate.ForEachComparison([&](const Comparison& c) {
     for (int slot : c.Residual().Slots()) {
@@ -265,7 +284,7 @@ void System::AddProperty(Property property) {
 
 std::pair<double, double> System::InputBounds(int slot) const {
   if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kInput) {
-    Fail("System::InputBounds", "slot " + std::to_string(slot) + " is not an input");
+    Fail("bounds asked for something that is not an input of system '" + name_ + "'");
   }
   for (const Component& c : components_) {
     auto it = std::find(c.global_slot.begin(), c.global_slot.end(), slot);
@@ -273,15 +292,15 @@ std::pair<double, double> System::InputBounds(int slot) const {
     const int local = static_cast<int>(it - c.global_slot.begin());
     for (const InputInfo& in : c.automaton.inputs()) {
       if (in.slot != local) continue;
-      return {c.automaton.EvaluateConstant(in.bounds.lo, "System::InputBounds"),
-              c.automaton.EvaluateConstant(in.bounds.hi, "System::InputBounds")};
+      const std::string context = "bounds of input '" + symbols_[slot].name + "'";
+      return {c.automaton.EvaluateConstant(in.bounds.lo, context),
+              c.automaton.EvaluateConstant(in.bounds.hi, context)};
     }
   }
-  Fail("System::InputBounds", "no component declares input '" + symbols_[slot].name + "'");
+  Fail("no component declares input '" + symbols_[slot].name + "'");
 }
 
 void System::SetParameter(std::string_view name, double value) {
-  constexpr std::string_view kApi = "System::SetParameter";
   // Set on copies and commit only if every component accepts the value: a shared parameter must
   // not be left set in some components only.
   std::vector<Component> updated = components_;
@@ -293,18 +312,17 @@ void System::SetParameter(std::string_view name, double value) {
       c.automaton.SetParameter(name, value);
       c.source.SetParameter(c.source.symbols()[*slot].name, value);
     } catch (const std::invalid_argument& e) {
-      Fail(kApi, e.what());
+      Fail(e.what());
     }
     ++found;
   }
-  if (found == 0) Fail(kApi, "no component has a parameter '" + std::string(name) + "'");
+  if (found == 0) Fail("no component has a parameter '" + std::string(name) + "'");
   components_ = std::move(updated);
 }
 
 void System::SetInitialValue(std::string_view variable, double value) {
-  constexpr std::string_view kApi = "System::SetInitialValue";
   if (!std::isfinite(value)) {
-    Fail(kApi, "initial value of '" + std::string(variable) + "' is not finite");
+    Fail("initial value of '" + std::string(variable) + "' is not finite");
   }
   int found = 0;
   for (Component& c : components_) {
@@ -317,40 +335,39 @@ void System::SetInitialValue(std::string_view variable, double value) {
       c.automaton.SetInitialValue(*slot, initial);
       c.source.SetInitialValue(*slot, initial);
     } catch (const std::invalid_argument& e) {
-      Fail(kApi, e.what());
+      Fail(e.what());
     }
     ++found;
   }
   if (found == 0) {
-    Fail(kApi, "no component has a continuous variable '" + std::string(variable) + "'");
+    Fail("no component has a continuous variable '" + std::string(variable) + "'");
   }
 }
 
 void System::SetScenario(Scenario scenario) {
-  constexpr std::string_view kApi = "System::SetScenario";
   if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {
-    Fail(kApi, "'until' must be positive and finite");
+    Fail("'until' must be positive and finite");
   }
   std::set<int> seen;
   for (const InputSignal& s : scenario.inputs) {
     if (s.slot < 0 || s.slot >= symbols_.size() || symbols_[s.slot].kind != SymbolKind::kInput) {
-      Fail(kApi, "signal for something that is not an input");
+      Fail("signal for something that is not an input");
     }
     const std::string& name = symbols_[s.slot].name;
-    if (!seen.insert(s.slot).second) Fail(kApi, "input '" + name + "' driven twice");
-    if (s.points.empty()) Fail(kApi, "signal for '" + name + "' has no points");
+    if (!seen.insert(s.slot).second) Fail("input '" + name + "' driven twice");
+    if (s.points.empty()) Fail("signal for '" + name + "' has no points");
     const auto [lo, hi] = InputBounds(s.slot);
     for (size_t i = 0; i < s.points.size(); ++i) {
       const auto [t, v] = s.points[i];
       if (!std::isfinite(t) || !std::isfinite(v)) {
-        Fail(kApi, "signal for '" + name + "' has a non-finite point");
+        Fail("signal for '" + name + "' has a non-finite point");
       }
       if (i > 0 && !(s.points[i - 1].first < t)) {
-        Fail(kApi, "signal for '" + name + "': times must increase strictly");
+        Fail("signal for '" + name + "': times must increase strictly");
       }
       if (v < lo || v > hi) {
-        Fail(kApi, "signal for '" + name + "' takes value " + FormatNumber(v) +
-                       " outside its bounds [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+        Fail("signal for '" + name + "' takes value " + FormatNumber(v) + " outside its bounds [" +
+             FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
       }
     }
   }
@@ -358,9 +375,8 @@ void System::SetScenario(Scenario scenario) {
 }
 
 Automaton System::Product(int max_modes) const {
-  constexpr std::string_view kApi = "System::Product";
   const int n = static_cast<int>(components_.size());
-  if (n == 0) Fail(kApi, "system has no components");
+  if (n == 0) Fail("system '" + name_ + "' has no components");
   Automaton out(name_);
   // Declare the global symbols in slot order so that slots coincide.
   std::vector<int> identity(symbols_.size());
@@ -424,7 +440,7 @@ Automaton System::Product(int max_modes) const {
   auto mode_of = [&](const Tuple& tuple) -> ModeId {
     if (auto it = index.find(tuple); it != index.end()) return it->second;
     if (static_cast<int>(index.size()) >= max_modes) {
-      Fail(kApi, "more than " + std::to_string(max_modes) + " product modes");
+      Fail("the composed system has more than " + std::to_string(max_modes) + " product modes");
     }
     Mode m;
     for (int i = 0; i < n; ++i) {
@@ -534,7 +550,7 @@ Automaton System::Product(int max_modes) const {
               const int g = c.global_slot[r.slot];
               if (std::any_of(joint.resets.begin(), joint.resets.end(),
                               [g](const Reset& x) { return x.slot == g; })) {
-                Fail(kApi, "synchronised transitions reset '" + symbols_[g].name + "' twice");
+                Fail("synchronised transitions reset '" + symbols_[g].name + "' twice");
               }
               joint.resets.push_back({g, global(c, r.value)});
             }

@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "tests/automaton/stack_budget.h"
 #include "tests/test_utilities/random_models.h"
 
 namespace hybrid {
@@ -154,7 +155,7 @@ TEST(CompiledExpressionTest, NonCommutativeOperandsKeepTheirOrder) {
 
 TEST(CompiledExpressionTest, DeepExpressionsUseAHeapStack) {
   for (int depth : {CompiledExpression::kMaxInlineStack - 2, CompiledExpression::kMaxInlineStack,
-                    CompiledExpression::kMaxInlineStack + 1, 200, 3000}) {
+                    CompiledExpression::kMaxInlineStack + 1, 200, kMaxTreeDepth - 2}) {
     for (Op op : {Op::kAdd, Op::kSub, Op::kMul, Op::kAtan2}) {
       const Expression e = RightChain(depth, op);
       const CompiledExpression c(e);
@@ -166,9 +167,29 @@ TEST(CompiledExpressionTest, DeepExpressionsUseAHeapStack) {
   }
   // A deep left-nested chain needs no stack but many instructions.
   Expression left = x;
-  for (int i = 0; i < 5000; ++i) left = Expression::Unary(Op::kSin, left) + y;
+  while (left.depth() + 2 <= kMaxTreeDepth) left = Expression::Unary(Op::kSin, left) + y;
+  ASSERT_GE(left.depth(), kMaxTreeDepth - 1);
   const std::vector<double> env = {0.5, 0.001, 0.0, 0.0};
   EXPECT_TRUE(SameDouble(CompiledExpression(left)(env), Reference(left, env)));
+}
+
+// Compiling walks the tree with a heap stack of tasks: trees at the depth limit, left- and
+// right-deep, compile and run on a 1 MiB stack (AddressSanitizer's larger frames included).
+TEST(CompiledExpressionTest, TreesAtTheDepthLimitCompileOnASmallStack) {
+  testing::RunOnStack(testing::kOneMebibyte, [] {
+    for (Op op : {Op::kAdd, Op::kSub, Op::kMul, Op::kDiv, Op::kMin, Op::kAtan2}) {
+      const Expression right = RightChain(kMaxTreeDepth - 2, op);
+      Expression left = x;
+      while (left.depth() < kMaxTreeDepth) {
+        left = Expression::Binary(op, left, Expression::Unary(Op::kSin, y));
+      }
+      for (const Expression& e : {right, left}) {
+        ASSERT_GE(e.depth(), kMaxTreeDepth - 1);
+        const std::vector<double> env = {0.5, -1.0, 2.0, 0.25};
+        EXPECT_TRUE(SameDouble(CompiledExpression(e)(env), e.Evaluate(env)));
+      }
+    }
+  });
 }
 
 TEST(CompiledExpressionTest, CopiesEvaluateIndependently) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <ostream>
 #include <span>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "automaton/parser.h"
+#include "tests/automaton/stack_budget.h"
 #include "tests/test_utilities/random_models.h"
 
 namespace hybrid {
@@ -85,6 +87,136 @@ TEST(ExpressionTest, ConstructorsValidateTheirArguments) {
   EXPECT_THROW(Expression::Unary(Op::kConstant, x), std::invalid_argument);
   EXPECT_THROW(Expression::Binary(Op::kSin, x, y), std::invalid_argument);
   EXPECT_THROW(Expression::Binary(Op::kSymbol, x, y), std::invalid_argument);
+}
+
+// The message of the std::invalid_argument `f` throws ("" and a failure if none).
+std::string InvalidArgumentMessage(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::invalid_argument";
+  return "";
+}
+
+// Messages reach users (through the model API): they name no C++ function.
+TEST(ExpressionTest, ConstructorMessagesNameNoCppFunction) {
+  EXPECT_EQ(InvalidArgumentMessage([] { Expression::Constant(HUGE_VAL); }),
+            "constant inf is not finite");
+  EXPECT_EQ(InvalidArgumentMessage([] { Expression::Symbol("", 0); }),
+            "a name in an expression is empty");
+  EXPECT_EQ(InvalidArgumentMessage([] { Expression::Symbol("x", -1); }), "name 'x' has no slot");
+  EXPECT_EQ(InvalidArgumentMessage([] { Expression::Unary(Op::kAdd, x); }),
+            "operation does not take one argument");
+  EXPECT_EQ(InvalidArgumentMessage([] { Expression::Binary(Op::kSin, x, y); }),
+            "operation does not take two arguments");
+}
+
+// --- depth -----------------------------------------------------------------------------------
+
+TEST(ExpressionDepthTest, DepthCountsLevels) {
+  EXPECT_EQ(x.depth(), 1);
+  EXPECT_EQ(C(2.0).depth(), 1);
+  EXPECT_EQ((-C(2.0)).depth(), 1);  // folded
+  EXPECT_EQ((-x).depth(), 2);
+  EXPECT_EQ((x + y).depth(), 2);
+  EXPECT_EQ((x + y + z).depth(), 3);
+  EXPECT_EQ((x + y * (z - w)).depth(), 4);
+  EXPECT_EQ(Fn(Op::kAtan2, x, Fn(Op::kSin, Fn(Op::kSin, y))).depth(), 4);
+  EXPECT_EQ(Parse("x + y + z + w").depth(), 4);
+  EXPECT_EQ(Parse("((x))").depth(), 1);  // parentheses are not levels
+}
+
+// Chains of `n` levels of four shapes, with their values at x computed without the tree.
+struct Chain {
+  const char* shape;
+  Expression e;
+  double value;  // at x = kChainX, computed in the same order as the tree
+  int leaves;    // occurrences of x
+};
+constexpr double kChainX = 0.75;
+
+std::vector<Chain> Chains(int n) {
+  std::vector<Chain> out;
+  Expression sum = x, diff = x, sines = x, mixed = x;
+  double diff_value = kChainX, sine_value = kChainX, mixed_value = kChainX;
+  for (int i = 1; i < n; ++i) {
+    sum = sum + x;    // (x + x) + x ...: left-deep
+    diff = x - diff;  // x - (x - (...)): right-deep
+    diff_value = kChainX - diff_value;
+    sines = Fn(Op::kSin, sines);  // unary chain
+    sine_value = std::sin(sine_value);
+    mixed = i % 2 == 1 ? mixed * C(2.0) : C(0.5) / mixed;  // both sides deep in turn
+    mixed_value = i % 2 == 1 ? mixed_value * 2.0 : 0.5 / mixed_value;
+  }
+  out.push_back({"left-deep sum", sum, n * kChainX, n});
+  out.push_back({"right-deep difference", diff, diff_value, n});
+  out.push_back({"nested sines", sines, sine_value, 1});
+  out.push_back({"products and quotients", mixed, mixed_value, 1});
+  return out;
+}
+
+TEST(ExpressionDepthTest, TreesDeeperThanTheLimitCannotBeBuilt) {
+  const std::string too_deep = "expression too long or nested too deeply (more than " +
+                               std::to_string(kMaxTreeDepth) + " levels)";
+  for (const Chain& c : Chains(kMaxTreeDepth)) {
+    SCOPED_TRACE(c.shape);
+    ASSERT_EQ(c.e.depth(), kMaxTreeDepth);
+    EXPECT_EQ(InvalidArgumentMessage([&] { c.e + x; }), too_deep);
+    EXPECT_EQ(InvalidArgumentMessage([&] { x* c.e; }), too_deep);
+    EXPECT_EQ(InvalidArgumentMessage([&] { -c.e; }), too_deep);
+    EXPECT_EQ(InvalidArgumentMessage([&] { Fn(Op::kMin, x, c.e); }), too_deep);
+  }
+  EXPECT_GT(kMaxTreeDepth, kMaxExpressionDepth);  // room for what solvers derive
+}
+
+// Every recursive walk of the tree, at the deepest tree that can exist, on a 1 MiB stack (the
+// sanitized test run checks the same under AddressSanitizer, whose frames are larger).
+TEST(ExpressionDepthTest, EveryWalkAtTheTreeDepthLimitFitsASmallStack) {
+  testing::RunOnStack(testing::kOneMebibyte, [] {
+    for (const Chain& c : Chains(kMaxTreeDepth)) {
+      SCOPED_TRACE(c.shape);
+      const std::vector<double> env = {kChainX};
+      EXPECT_DOUBLE_EQ(c.e.Evaluate(env), c.value);
+      const Interval enclosure = c.e.EvaluateInterval(std::vector<Interval>{Interval(kChainX)});
+      EXPECT_LE(enclosure.lo(), c.e.Evaluate(env));
+      EXPECT_GE(enclosure.hi(), c.e.Evaluate(env));
+      EXPECT_EQ(c.e.Slots(), std::vector<int>{0});
+      const std::string text = c.e.ToString();
+      EXPECT_EQ(std::count(text.begin(), text.end(), 'x'), c.leaves);
+      const Expression renamed =
+          c.e.Substitute([](const std::string&, int) -> std::optional<Expression> { return y; });
+      EXPECT_EQ(renamed.Slots(), std::vector<int>{1});
+      EXPECT_EQ(renamed.depth(), kMaxTreeDepth);
+      EXPECT_FALSE(renamed == c.e);
+      const Expression copy = renamed.Substitute(
+          [](const std::string&, int) -> std::optional<Expression> { return x; });
+      EXPECT_TRUE(copy == c.e);  // equal, but no node shared
+      const Expression constant = c.e.Substitute(
+          [](const std::string&, int) -> std::optional<Expression> { return C(kChainX); });
+      const Expression folded = constant.FoldConstants();
+      ASSERT_TRUE(folded.is_constant());
+      EXPECT_EQ(folded.constant(), c.e.Evaluate(env));
+      (void)c.e.AsAffine();
+      // A derivative can be deeper than its expression: built, or refused with the message.
+      try {
+        EXPECT_LE(c.e.Derivative(0).depth(), kMaxTreeDepth);
+      } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "expression too long or nested too deeply (more than " +
+                                             std::to_string(kMaxTreeDepth) + " levels)");
+      }
+    }
+  });
+}
+
+// The printed text of an expression of every shape at the limit: each operator once, no
+// parentheses for a left-deep sum.
+TEST(ExpressionDepthTest, DeepSumPrintsFlat) {
+  const Expression sum = Chains(kMaxTreeDepth)[0].e;
+  EXPECT_EQ(sum.ToString().size(), 4u * kMaxTreeDepth - 3);  // "x + x + ... + x"
+  EXPECT_EQ(sum.AsAffine(), (AffineForm{0.0, {{0, double(kMaxTreeDepth)}}}));
+  EXPECT_EQ(sum.Derivative(0), C(kMaxTreeDepth));
 }
 
 TEST(ExpressionTest, NegationFoldsOnlyConstants) {

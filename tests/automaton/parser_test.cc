@@ -6,6 +6,8 @@
 #include "automaton/parser.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cctype>
 #include <chrono>
@@ -16,11 +18,15 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "automaton/automaton.h"
+#include "automaton/compiled_expression.h"
 #include "automaton/expression.h"
+#include "automaton/printer.h"
 #include "automaton/system.h"
+#include "tests/automaton/stack_budget.h"
 #include "tests/test_utilities/command_line.h"
 
 namespace hybrid {
@@ -252,7 +258,15 @@ TEST(ParseErrors, MissingFileIsReportedAtLineZero) {
 }
 
 TEST(ParseErrors, DirectoryIsNotAModelFile) {
-  EXPECT_THROW(ParseModelFile(kMalformedDir), ParseError);
+  try {
+    ParseModelFile(kMalformedDir);
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), kMalformedDir.string());
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_EQ(e.column(), 0);
+    EXPECT_EQ(e.message(), "cannot read file: it is a directory");
+  }
 }
 
 TEST(ParseErrors, FileLargerThanTheLimitIsRejectedBeforeReading) {
@@ -372,6 +386,250 @@ TEST(ParseErrors, LongInvariantParsesQuickly) {
   while (text.size() < (256u << 10)) text += " and x <= 1";
   text += "; }\n  init m { x = 0; }\n}\n";
   EXPECT_TRUE(ParsesOrFailsCleanly(text, kTimeLimit));
+}
+
+// A flow `x' = <expression>` in an otherwise valid model; the expression starts at line 3,
+// column 17.
+std::string ModelWithFlow(const std::string& expression) {
+  return "automaton a {\n  var x;\n  mode m { x' = " + expression + "; }\n  init m { x = 0; }\n}\n";
+}
+
+// `open` repeated n times, then `middle`, then `close` n times.
+std::string Nested(const std::string& open, int n, const std::string& middle,
+                   const std::string& close = "") {
+  std::string out;
+  for (int i = 0; i < n; ++i) out += open;
+  out += middle;
+  for (int i = 0; i < n; ++i) out += close;
+  return out;
+}
+
+// The sum x + x + ... of `terms` terms (as many levels).
+std::string SumOf(int terms) {
+  std::string text = "x";
+  for (int i = 1; i < terms; ++i) text += " + x";
+  return text;
+}
+
+// A 10000-term sum used to overflow the stack of the IR's tree walks (printing, evaluation, ...)
+// under AddressSanitizer or a 1 MiB stack: it is now refused at the operator that crosses the
+// limit, before any tree that deep exists.
+TEST(ParseErrors, TenThousandTermSumIsAClearError) {
+  const ParseError e = ParseFailure(ModelWithFlow(SumOf(10000)), "sum.ha");
+  EXPECT_EQ(e.file(), "sum.ha");
+  EXPECT_EQ(e.line(), 3);
+  // Operator j (from 1) is at column 19 + 4 (j - 1); operator kMaxExpressionDepth makes the
+  // tree one level too deep.
+  EXPECT_EQ(e.column(), 19 + 4 * (kMaxExpressionDepth - 1));
+  EXPECT_EQ(e.message(), "expression too long or nested too deeply (more than " +
+                             std::to_string(kMaxExpressionDepth) + " levels)");
+}
+
+// Nesting recurses in the parser itself (PEGTL's rules and parse tree): 10000 levels of each
+// kind of nesting are refused with a located message, and refusing them fits a 1 MiB stack.
+TEST(ParseErrors, TenThousandNestingLevelsAreAClearErrorOnASmallStack) {
+  struct Case {
+    const char* what;
+    std::string text;
+  };
+  const std::vector<Case> cases = {
+      {"parentheses", ModelWithFlow(Nested("(", 10000, "x", ")"))},
+      {"unary minus", ModelWithFlow(Nested("-", 10000, "x"))},
+      {"spaced unary minus", ModelWithFlow(Nested("- ", 10000, "x"))},
+      {"powers", ModelWithFlow(Nested("x^", 10000, "x"))},
+      {"calls", ModelWithFlow(Nested("sin(", 10000, "x", ")"))},
+      {"parenthesised predicate", std::string(kSmallModel, std::string(kSmallModel).size() - 2) +
+                                      "  property p: always " + Nested("(", 10000, "x > 0", ")") +
+                                      ";\n}\n"},
+      {"negated predicate", std::string(kSmallModel, std::string(kSmallModel).size() - 2) +
+                                "  property p: always " + Nested("not ", 10000, "x > 0") +
+                                ";\n}\n"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    testing::RunOnStack(testing::kOneMebibyte, [&] {
+      const ParseError e = ParseFailure(c.text, "nest.ha");
+      EXPECT_EQ(e.file(), "nest.ha");
+      EXPECT_GE(e.line(), 3);
+      EXPECT_GT(e.column(), 1);
+      EXPECT_TRUE(e.message() == "expression nested too deeply" ||
+                  e.message().starts_with("expression too long or nested too deeply"))
+          << e.message();
+    });
+  }
+}
+
+// The deepest expressions the parser accepts, of every shape, go through every walk of the IR on
+// a 1 MiB stack: building, printing the model, parsing the print back, evaluation, compilation,
+// composition and destruction. The values are checked against closed forms.
+TEST(Parser, DeepestAcceptedExpressionsFitASmallStack) {
+  // The deepest nesting of `open` the parser accepts (found by bisection; 10000 is refused).
+  auto deepest = [](const std::string& open, const std::string& middle, const std::string& close) {
+    int lo = 1, hi = 10000;
+    while (lo + 1 < hi) {
+      const int mid = (lo + hi) / 2;
+      try {
+        ParseModel(ModelWithFlow(Nested(open, mid, middle, close)), "t.ha");
+        lo = mid;
+      } catch (const ParseError&) {
+        hi = mid;
+      }
+    }
+    return lo;
+  };
+  testing::RunOnStack(testing::kOneMebibyte, [&] {
+    const int parens = deepest("(x - ", "x", ")");
+    const int minus = deepest("-", "x", "");
+    EXPECT_GE(parens, 20);  // enough for any hand-written model
+    EXPECT_GE(minus, 20);
+    // Sum at the limit (x at 1: kMaxExpressionDepth), nested differences x - (x - (...)) (x at
+    // 1: 1 when the count of x is odd, 0 when even), alternating signs -(-(...x)) (x at 1:
+    // (-1)^minus), and a comparison whose residual is at the limit.
+    const std::string text =
+        "automaton a {\n  var x;\n  var y;\n  var z;\n  mode m {\n    x' = " +
+        SumOf(kMaxExpressionDepth) + ";\n    y' = " + Nested("(x - ", parens, "x", ")") +
+        ";\n    z' = " + Nested("-", minus, "x") + ";\n    inv " + SumOf(kMaxExpressionDepth - 1) +
+        " >= 0;\n  }\n  init m { x = 1; y = 0; z = 0; }\n}\n";
+    const System s = ParseModel(text, "deep.ha");
+    const Automaton& a = s.components()[0].automaton;
+    const auto& flows = a.modes()[0].flows;
+    ASSERT_EQ(flows.size(), 3u);
+    EXPECT_EQ(flows[0].second.depth(), kMaxExpressionDepth);
+    EXPECT_EQ(a.modes()[0].invariant.comparisons[0].Residual().depth(), kMaxExpressionDepth);
+    const std::vector<double> env = {1.0, 0.0, 0.0};
+    EXPECT_EQ(flows[0].second.Evaluate(env), kMaxExpressionDepth);
+    EXPECT_EQ(flows[1].second.Evaluate(env), (parens + 1) % 2 == 1 ? 1.0 : 0.0);
+    EXPECT_EQ(flows[2].second.Evaluate(env), minus % 2 == 0 ? 1.0 : -1.0);
+    for (const auto& [slot, rhs] : flows) {
+      EXPECT_EQ(CompiledExpression(rhs).Evaluate(env.data()), rhs.Evaluate(env));
+    }
+    // Print and parse back: the same model.
+    const std::string printed = PrintSystem(s);
+    EXPECT_EQ(ParseModel(printed, "printed.ha"), s);
+    EXPECT_EQ(s.Product().num_modes(), 1);
+  });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading model files.
+
+// Positions in the parse tree refer to its input (its text and its source name). One taken after
+// the input was destroyed read freed memory on every parse of a file (valgrind and
+// AddressSanitizer saw it with a file name longer than the small-string buffer); under the
+// sanitized test run these fail if it comes back.
+TEST(Parser, ModelFromALongAbsolutePath) {
+  TempDir dir;
+  const fs::path deep = dir.path() / std::string(100, 'd') / "a_directory_with_a_long_name";
+  fs::create_directories(deep);
+  const fs::path model = deep / "thermostat_copied_under_a_rather_long_file_name.ha";
+  fs::copy_file(kSourceDir / "spec" / "thermostat.ha", model);
+  ASSERT_GT(model.string().size(), 150u);
+  const System s = ParseModelFile(model);
+  EXPECT_EQ(s.name(), "thermostat");
+  EXPECT_EQ(s.components()[0].automaton.num_modes(), 2);
+}
+
+// The error is located after the whole file is built, from a position kept since the second
+// automaton's name was parsed.
+TEST(ParseErrors, SecondAutomatonWithoutSystemFromALongAbsolutePath) {
+  TempDir dir;
+  const fs::path deep = dir.path() / std::string(100, 'd');
+  fs::create_directories(deep);
+  const fs::path path = deep / "two_automata_and_no_system_in_one_file.ha";
+  std::ofstream(path) << kSmallModel
+                      << "automaton b {\n  var y;\n  mode n { y' = 1; }\n  init n { y = 0; }\n}\n";
+  try {
+    ParseModelFile(path);
+    FAIL() << "parsed";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), path.string());
+    EXPECT_EQ(e.line(), 6);
+    EXPECT_EQ(e.column(), 11);
+    EXPECT_EQ(e.message(),
+              "the file declares 2 automata and no system: add 'system NAME { instance A = a; ... "
+              "}'");
+  }
+}
+
+// A UTF-8 byte-order mark, which some editors write, used to be "expected 'automaton', ...".
+TEST(Parser, LeadingByteOrderMarkIsSkipped) {
+  const std::string bom = "\xEF\xBB\xBF";
+  EXPECT_EQ(OnlyAutomaton(bom + kSmallModel).num_modes(), 1);
+  TempDir dir;
+  EXPECT_EQ(ParseModelFile(dir.Write("bom.ha", bom + kSmallModel)).name(), "a");
+  // Columns of the first line count from after the mark.
+  const ParseError first = ParseFailure(bom + "automaton 1 { }\n");
+  EXPECT_EQ(first.line(), 1);
+  EXPECT_EQ(first.column(), 11);
+  EXPECT_EQ(first.message(), "expected a name");
+  // Only one mark, only at the start: anywhere else it is a stray byte.
+  const ParseError twice = ParseFailure(bom + bom + kSmallModel);
+  EXPECT_EQ(twice.line(), 1);
+  EXPECT_EQ(twice.column(), 1);
+  EXPECT_EQ(twice.message(), "expected 'automaton', 'system' or 'import' at top level");
+  const ParseError later = ParseFailure(std::string(kSmallModel) + bom);
+  EXPECT_EQ(later.line(), 6);
+  EXPECT_EQ(later.column(), 1);
+}
+
+// A model on a pipe (`hybrid info <(cat m.ha)`, /dev/stdin) used to fail with "Operation not
+// supported": the file's size was asked before reading.
+TEST(Parser, ModelOnAPipe) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const std::string text = kSmallModel;
+  ASSERT_EQ(write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(fds[1]);
+  const fs::path path = "/dev/fd/" + std::to_string(fds[0]);
+  try {
+    const System s = ParseModelFile(path);
+    EXPECT_EQ(s.name(), "a");
+    EXPECT_EQ(s.components()[0].automaton.num_modes(), 1);
+  } catch (const ParseError& e) {
+    ADD_FAILURE() << e.what();
+  }
+  close(fds[0]);
+}
+
+// Writes `text` into the FIFO `path` from another thread (a FIFO opens only with both ends).
+class FifoWriter {
+ public:
+  FifoWriter(const fs::path& path, std::string text)
+      : thread_([path, text = std::move(text)] {
+          std::ofstream out(path, std::ios::binary);
+          out << text;
+        }) {}
+  ~FifoWriter() { thread_.join(); }
+
+ private:
+  std::thread thread_;
+};
+
+TEST(Parser, ModelOnAFifoLargerThanAPipeBuffer) {
+  TempDir dir;
+  const fs::path fifo = dir.path() / "model.fifo";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // A megabyte of comment first: many reads, far beyond the 64 KiB a pipe holds.
+  const std::string text = "#" + std::string(1u << 20, 'c') + "\n" + kSmallModel;
+  FifoWriter writer(fifo, text);
+  EXPECT_EQ(ParseModelFile(fifo).components()[0].automaton.num_modes(), 1);
+}
+
+TEST(ParseErrors, StreamLargerThanTheLimitIsRejected) {
+  TempDir dir;
+  const fs::path fifo = dir.path() / "huge.fifo";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  FifoWriter writer(fifo, std::string(kMaxModelFileBytes + 1, '#'));
+  try {
+    ParseModelFile(fifo);
+    ADD_FAILURE() << "parsed";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), fifo.string());
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_EQ(e.column(), 0);
+    EXPECT_EQ(e.message(), "file is larger than the " + std::to_string(kMaxModelFileBytes) +
+                               "-byte limit for model files");
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
