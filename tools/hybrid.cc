@@ -1,8 +1,9 @@
 // The `hybrid` command: inspect, draw (and, in later versions, simulate, check and diagnose)
 // hybrid-automaton models written in the model language (docs/model_language.md).
 //
-// Exit codes (docs/cli.md): 0 success, 1 invalid model (parse or validation error, reported as
-// FILE:LINE:COL: message), 2 usage error (bad options), 3 output error (cannot write a file).
+// Exit codes (docs/cli.md): 0 success, 1 invalid model or data (parse or validation error,
+// reported as FILE:LINE:COL: message), 2 usage error (bad options, named), 3 output error
+// (cannot write a file), 4 out of memory or internal error.
 
 #include <unistd.h>
 
@@ -323,9 +324,10 @@ int ExitFor(std::exception_ptr error, const std::string& prefix, int invalid_cod
 int main(int argc, char** argv) {
   CLI::App app{"hybrid: declare, inspect and draw hybrid automata (see docs/cli.md)", "hybrid"};
   app.footer(
-      "Exit codes: 0 success; 1 invalid model (FILE:LINE:COL: message on stderr); 2 usage error; "
-      "3 cannot write output; 4 internal error; 5 simulation stopped early; 6 check: a property "
-      "violated; 7 check: a verdict unknown.");
+      "Exit codes: 0 success; 1 invalid model or data (FILE:LINE:COL: message on stderr); 2 usage "
+      "error (a bad option value, named); 3 cannot write output; 4 out of memory or internal "
+      "error; 5 simulation stopped early; 6 check: a property violated; 7 check: a verdict "
+      "unknown. Numbers, output files and limits: docs/cli.md.");
   app.require_subcommand(1);
   app.set_version_flag("--version", "hybrid 0.1.0");
 

@@ -74,6 +74,42 @@ TEST(HybridCli, UsageErrorsExitTwo) {
   }
 }
 
+// Numbers are numbers in every command: an empty value is not 0, a negative seed is not
+// 18446744073709551615, hexadecimal and doubled signs are refused; exit 2 naming the option,
+// before any work (the model is never read).
+TEST(HybridCli, NumericOptionsOfEveryCommandAreNumbers) {
+  const std::string model = Quote(kSourceDir / "spec" / "thermostat.ha");
+  const std::string data = Quote(kSourceDir / "data" / "finger_demo.csv");
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"check " + model + " --depth ''", "--depth: empty: a number is required"},
+           {"check " + model + " --depth 0x10", "--depth: '0x10' is not a decimal number"},
+           {"check " + model + " --depth 2.5", "--depth: '2.5' is not an integer"},
+           {"check " + model + " --induction ''", "--induction: empty"},
+           {"check " + model + " --budget ''", "--budget: empty"},
+           {"check " + model + " --budget +-5", "--budget: '+-5' is not a decimal number"},
+           {"check " + model + " --runs 1e2", "--runs: '1e2' is not an integer"},
+           {"check " + model + " --method sample --seed -1",
+            "--seed: '-1' is negative; a number >= 0 is required"},
+           {"check " + model + " --seed 0x1", "--seed: '0x1' is not a decimal number"},
+           {"simulate " + model + " --until ''", "--until: empty"},
+           {"simulate " + model + " --sample ''", "--sample: empty"},
+           {"diagnose " + data + " --threads ''", "--threads: empty"},
+           {"diagnose " + data + " --significance 0x19", "--significance: '0x19' is not"},
+           {"synthesize --samples ''", "--samples: empty"},
+           {"hand --g ''", "--g: empty"},
+           {"finger --g '' ", "--g: empty"},
+       }) {
+    const Result r = RunHybrid(c.args);
+    EXPECT_EQ(r.exit_code, 2) << "hybrid " << c.args << "\n" << r.err;
+    EXPECT_TRUE(r.err.starts_with(c.message)) << "hybrid " << c.args << "\n" << r.err;
+    EXPECT_EQ(r.out, "") << "hybrid " << c.args;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // info.
 
