@@ -69,7 +69,7 @@ Code UnaryCode(Op op) {
     case Op::kSign:
       return Code::kSign;
     default:
-      throw std::logic_error("CompiledExpression: not a unary op");
+      throw std::logic_error("compiling an expression: not a unary operation");
   }
 }
 
@@ -93,7 +93,7 @@ Code BinaryCode(Op op) {
     case Op::kAtan2:
       return Code::kAtan2S;
     default:
-      throw std::logic_error("CompiledExpression: not a binary op");
+      throw std::logic_error("compiling an expression: not a binary operation");
   }
 }
 
