@@ -28,7 +28,7 @@ using namespace hybrid::fuzz;  // NOLINT(google-build-using-namespace): the harn
 constexpr size_t kMaxArguments = 64;
 
 // The texts an option's value may come from: each argument, and its part after the first '='
-// (`--until=5`), each also split at commas (list options).
+// (`--until=5`) or after a short option's letter (`-s7`), each also split at commas (list options).
 std::vector<std::string> Candidates(const std::vector<std::string>& args) {
   std::vector<std::string> out;
   auto add_pieces = [&](const std::string& text) {
@@ -43,6 +43,7 @@ std::vector<std::string> Candidates(const std::vector<std::string>& args) {
   for (const std::string& a : args) {
     add_pieces(a);
     if (const size_t eq = a.find('='); eq != std::string::npos) add_pieces(a.substr(eq + 1));
+    if (a.size() > 2 && a[0] == '-' && a[1] != '-') add_pieces(a.substr(2));  // `-s7`
   }
   return out;
 }
