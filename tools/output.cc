@@ -1,6 +1,7 @@
 #include "tools/output.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <unordered_map>
 
 #include "tools/options.h"
 
@@ -98,38 +100,45 @@ bool IsStreamOutput(const std::string& path) {
   return fs::exists(status) && !fs::is_regular_file(status) && !fs::is_directory(status);
 }
 
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) {
-    const bool same = fs::equivalent(a, b, ec);
-    if (!ec) return same;
+namespace {
+
+// A key that two paths share exactly when they name one file (SameFile): the device and inode
+// of an existing file, else the absolute path with "." and ".." and the symbolic links of its
+// existing part resolved.
+std::string FileKey(const std::string& path) {
+  struct stat s {};
+  if (::stat(path.c_str(), &s) == 0) {
+    return "inode " + std::to_string(s.st_dev) + ":" + std::to_string(s.st_ino);
   }
-  const fs::path pa = fs::weakly_canonical(fs::absolute(a, ec), ec);
-  if (ec) return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
-  const fs::path pb = fs::weakly_canonical(fs::absolute(b, ec), ec);
-  if (ec) return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
-  return pa == pb;
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(path, ec);
+  if (ec) return "path " + fs::path(path).lexically_normal().string();
+  const fs::path canonical = fs::weakly_canonical(absolute, ec);
+  return "path " + (ec ? absolute.lexically_normal() : canonical).string();
 }
+
+}  // namespace
+
+bool SameFile(const std::string& a, const std::string& b) { return FileKey(a) == FileKey(b); }
 
 void CheckDistinctFiles(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs) {
-  for (std::size_t i = 0; i < outputs.size(); ++i) {
-    const NamedFile& out = outputs[i];
+  std::unordered_map<std::string, const NamedFile*> inputs_by_key, outputs_by_key;
+  for (const NamedFile& in : inputs) {
+    if (!in.path.empty()) inputs_by_key.emplace(FileKey(in.path), &in);
+  }
+  for (const NamedFile& out : outputs) {
     if (out.path.empty() || IsStreamOutput(out.path)) continue;
-    for (std::size_t j = 0; j < i; ++j) {
-      const NamedFile& other = outputs[j];
-      if (other.path.empty() || IsStreamOutput(other.path)) continue;
-      if (SameFile(out.path, other.path)) {
-        throw UsageError(other.option + " and " + out.option + " name the same file ('" +
-                         other.path + "', '" + out.path + "'); give each output its own file");
-      }
+    const std::string key = FileKey(out.path);
+    const auto [it, added] = outputs_by_key.emplace(key, &out);
+    if (!added) {
+      const NamedFile& other = *it->second;
+      throw UsageError(other.option + " and " + out.option + " name the same file ('" + other.path +
+                       "', '" + out.path + "'); give each output its own file");
     }
-    for (const NamedFile& in : inputs) {
-      if (in.path.empty()) continue;
-      if (SameFile(out.path, in.path)) {
-        throw UsageError(out.option + " '" + out.path + "' names the input " + in.option + " '" +
-                         in.path + "'; an output may not overwrite an input");
-      }
+    if (const auto in = inputs_by_key.find(key); in != inputs_by_key.end()) {
+      throw UsageError(out.option + " '" + out.path + "' names the input " + in->second->option +
+                       " '" + in->second->path + "'; an output may not overwrite an input");
     }
   }
 }
