@@ -444,17 +444,19 @@ class Run final : public OdeSystem {
     return std::make_pair(residual, tolerance);
   }
 
-  // Loads a recorded state (its modes' discrete values, its variables and the inputs at its time)
-  // and returns the first invariant comparison it violates beyond the resolution tolerance, with
-  // its residual, or nullopt. Leaves the environment at that state: for after the run.
-  std::optional<std::pair<std::string, double>> OutsideInvariant(const StateSample& s) {
+  // Loads a recorded state (its modes' discrete values, its variables and the inputs at
+  // `input_time`, normally its own time) and returns the first invariant comparison it violates
+  // beyond the resolution tolerance, with its residual, or nullopt. Leaves the environment at
+  // that state: for after the run.
+  std::optional<std::pair<std::string, double>> OutsideInvariant(const StateSample& s,
+                                                                 double input_time) {
     for (size_t c = 0; c < components_.size(); ++c) {
       for (const auto& [slot, value] : components_[c].modes[s.modes[c]].discrete) {
         env_[slot] = value;
       }
     }
     for (size_t i = 0; i < variable_slots_.size(); ++i) env_[variable_slots_[i]] = s.x[i];
-    for (const InputSignal& signal : signals_) env_[signal.slot] = signal.ValueAt(s.time);
+    for (const InputSignal& signal : signals_) env_[signal.slot] = signal.ValueAt(input_time);
     for (size_t c = 0; c < components_.size(); ++c) {
       for (const CompiledComparison& cmp : components_[c].modes[s.modes[c]].invariant) {
         if (cmp.may_jump) continue;
@@ -506,26 +508,56 @@ std::vector<InputSignal> MergedInputs(const System& system, std::span<const Inpu
   return inputs;
 }
 
-// The first recorded state outside its modes' invariants (beyond the resolution tolerance), as
-// a message, or nullopt. A state left by a jump at its own instant (a kBeforeEvent sample at the
-// same time in the same modes follows) is exempt: an urgent transition may leave at once a mode
-// entered outside its invariant.
-std::optional<std::string> StateOutsideInvariant(Run& run, const std::vector<StateSample>& samples,
-                                                 const Simulator& simulator) {
+// The first recorded state outside its modes' invariants (beyond the resolution tolerance): its
+// index and a message, or nullopt. Exempt: a state that a jump leaves at its own instant (a
+// kBeforeEvent sample in the same modes at the same time, itself or later) if it was entered at
+// that instant (an urgent transition may leave at once a mode entered outside its invariant) or
+// was inside with the inputs just before that instant (an input jump put it outside: a lazy
+// transition takes it away); and states at or after `exempt_from` (the final instant of a run
+// that stopped on a violated invariant).
+std::optional<std::pair<size_t, std::string>> StateOutsideInvariant(
+    Run& run, const std::vector<StateSample>& samples, const Simulator& simulator,
+    double exempt_from = std::numeric_limits<double>::infinity()) {
   for (size_t i = 0; i < samples.size(); ++i) {
     const StateSample& s = samples[i];
-    const auto outside = run.OutsideInvariant(s);
+    if (s.time >= exempt_from) break;
+    const auto outside = run.OutsideInvariant(s, s.time);
     if (!outside) continue;
-    bool left = false;
-    for (size_t j = i + 1; j < samples.size() && samples[j].time == s.time && !left; ++j) {
-      left = samples[j].kind == StateSample::Kind::kBeforeEvent && samples[j].modes == s.modes;
+    auto same_instant = [&](size_t j) {
+      return samples[j].time == s.time && samples[j].modes == s.modes;
+    };
+    bool left = false, entered = false;
+    for (size_t j = i; j < samples.size() && same_instant(j) && !left; ++j) {
+      left = samples[j].kind == StateSample::Kind::kBeforeEvent;
     }
-    if (left) continue;
-    return "the state recorded at t = " + FormatNumber(s.time) + " lies outside the invariant '" +
-           outside->first + "' of mode " + simulator.ModeLabel(s.modes) + " (residual " +
-           FormatNumber(outside->second) + "): the run is not resolved there";
+    for (size_t j = i + 1; j-- > 0 && same_instant(j) && !entered;) {
+      entered = samples[j].kind == StateSample::Kind::kAfterEvent;
+    }
+    const double before = std::nextafter(s.time, -std::numeric_limits<double>::infinity());
+    if (left && (entered || !run.OutsideInvariant(s, before))) continue;
+    return std::make_pair(
+        i, "the state recorded at t = " + FormatNumber(s.time) + " lies outside the invariant '" +
+               outside->first + "' of mode " + simulator.ModeLabel(s.modes) + " (residual " +
+               FormatNumber(outside->second) + "): the run is not resolved there");
   }
   return std::nullopt;
+}
+
+// Ends `result` as kUnresolved at its recorded state `index` (which is not trustworthy): the
+// states and events from that state's time on are dropped, and the last state kept is repeated
+// as the end. The start (index 0) is always kept.
+void TruncateUnresolved(SimulationResult& result, size_t index, std::string message) {
+  result.status = SimulationStatus::kUnresolved;
+  result.message = std::move(message);
+  result.zeno.reset();
+  const double bad_time = result.samples[index].time;
+  std::erase_if(result.events, [&](const EventRecord& e) { return e.time >= bad_time; });
+  size_t keep = index;
+  while (keep > 1 && result.samples[keep - 1].time >= bad_time) --keep;
+  result.samples.resize(std::max<size_t>(keep, 1));
+  StateSample end = result.samples.back();
+  end.kind = StateSample::Kind::kEnd;
+  result.samples.push_back(std::move(end));
 }
 
 // Throws std::invalid_argument for a setting out of its range, or for a run that would record
@@ -960,7 +992,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     if (!g->empty()) run.Roots(time, state.data(), g->data());
   };
   evaluate_roots(t, x, &g_prev);
-  Eigen::VectorXd x_new, x_mid;
+  Eigen::VectorXd x_new, x_mid, x_start;
   // Per-step buffers, reused so that a step allocates nothing.
   std::vector<double> ga, gm;
   std::vector<int> crossed;
@@ -998,6 +1030,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     const double t_stop = std::min(
         {until, next_sample, next_break < breakpoints.size() ? breakpoints[next_break] : until});
     const double t_prev = t;
+    x_start = x;
     const size_t events_before = result.events.size();
     double t_new = t;
     crossed.clear();
@@ -1164,8 +1197,12 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     forget_reached();  // a new instant
     if (status == CvodeIntegrator::Status::kRoot || interior) {
       if (auto off = unresolved_crossing(crossed)) {
+        // The state reached is not trustworthy: the run ends at the start of this pass.
         result.status = SimulationStatus::kUnresolved;
         result.message = *off;
+        t = t_prev;
+        x = x_start;
+        run.Load(t, x.data());
         break;
       }
       note_reached(crossed);
@@ -1248,11 +1285,13 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     result.message = "stopped before the horizon";
   }
   record(StateSample::Kind::kEnd);
-  if (result.status == SimulationStatus::kCompleted) {
-    if (auto outside = StateOutsideInvariant(run, result.samples, *this)) {
-      result.status = SimulationStatus::kUnresolved;
-      result.message = *outside;
-    }
+  // The general guard: no recorded state outside its modes' invariants (the final instant of an
+  // invariant violation aside), whatever the status; the first one ends the run there.
+  const double exempt_from = result.status == SimulationStatus::kInvariantViolated
+                                 ? t
+                                 : std::numeric_limits<double>::infinity();
+  if (auto outside = StateOutsideInvariant(run, result.samples, *this, exempt_from)) {
+    TruncateUnresolved(result, outside->first, std::move(outside->second));
   }
   return result;
 }
@@ -1272,7 +1311,9 @@ std::optional<std::string> Simulator::FirstStateOutsideInvariant(
   }
   hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env,
                   MergedInputs(*c_->system, signals), options);
-  return StateOutsideInvariant(run, result.samples, *this);
+  const auto outside = StateOutsideInvariant(run, result.samples, *this);
+  if (!outside) return std::nullopt;
+  return outside->second;
 }
 
 }  // namespace hybrid

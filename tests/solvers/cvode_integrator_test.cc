@@ -1,11 +1,13 @@
 // Tests of the CVODE RAII wrapper on its own (solvers/cvode_integrator.h): accuracy on x' = -x,
 // root location with crossing directions, restarts with another number of root functions,
-// interpolation inside the last step, run-time failures reported as a status, and CVODE messages
-// kept for message() instead of printed.
+// interpolation inside the last step, run-time failures reported as a status (leaking nothing),
+// CVODE messages kept for message() instead of printed, and a first step that does not depend on
+// how far away the stop time is.
 
 #include "solvers/cvode_integrator.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <cmath>
 #include <functional>
@@ -340,6 +342,62 @@ TEST(CvodeIntegratorTest, CvodeMessagesAreKeptNotPrinted) {
   ASSERT_EQ(AdvanceUntil(integrator, 2.0, &t, &x), CvodeIntegrator::Status::kReachedTime)
       << integrator.message();
   EXPECT_NEAR(x[0], 1.0, 1e-12);
+}
+
+TEST(CvodeIntegratorTest, FirstStepIsSizedNearTheCurrentTimeNotTheStopTime) {
+  EXPECT_EQ(InitialStepTarget(0.0, 1e50), 1000.0);
+  EXPECT_EQ(InitialStepTarget(60.0, 100.0), 100.0);
+  EXPECT_EQ(InitialStepTarget(1e6, 1e50), 1e6 + 1e9);
+  EXPECT_EQ(InitialStepTarget(-5.0, 1e50), 4995.0);
+  // x' = -0.1 x (time scale 10) restarted at t = 60 towards a stop time of 1e20 or 1e50: the
+  // trajectory is the analytic one and every step stays within the time scale. (Sized towards
+  // the stop time, CVODE's first step is at least 100 * unit roundoff * 1e50 = 2e36: the run
+  // failed at 1e20 and jumped to x = 0 at 1e50.)
+  FunctionSystem decay([](double, const double* x, double* dx) { dx[0] = -0.1 * x[0]; });
+  for (double stop : {1e3, 1e20, 1e50, 1e300}) {
+    SCOPED_TRACE(stop);
+    CvodeIntegrator integrator(&decay, 1, {});
+    integrator.Restart(60.0, Vec({20.0}), {});
+    double t = 60.0, t_prev = 60.0;
+    Eigen::VectorXd x;
+    while (t < 200.0) {
+      ASSERT_EQ(integrator.Advance(stop, &t, &x), CvodeIntegrator::Status::kStep)
+          << integrator.message();
+      EXPECT_LT(t - t_prev, 10.0);
+      EXPECT_NEAR(x[0], 20.0 * std::exp(-0.1 * (t - 60.0)), 1e-7);
+      t_prev = t;
+    }
+  }
+}
+
+TEST(CvodeIntegratorTest, FailuresLeakNothingAndSpeakOfTheSolver) {
+  // Each failure names CVODE's return flag (CVodeGetReturnFlagName allocates the name). Under
+  // LeakSanitizer (HYBRID_SANITIZE) a lost name fails the test binary; here the heap in use must
+  // not grow with the number of failures either.
+  FunctionSystem clock([](double, const double*, double* dx) { dx[0] = 1.0; });
+  CvodeIntegrator integrator(&clock, 1, {});
+  double t = 0.0;
+  Eigen::VectorXd x;
+  auto fail_once = [&] {
+    integrator.Restart(1.0, Vec({0.0}), {});
+    return integrator.Advance(std::nextafter(1.0, 2.0), &t, &x);  // CV_TOO_CLOSE
+  };
+  ASSERT_EQ(fail_once(), CvodeIntegrator::Status::kFailure);
+  const std::string message = integrator.message();
+  EXPECT_NE(message.find("CVODE"), std::string::npos) << message;
+  EXPECT_NE(message.find("CV_TOO_CLOSE"), std::string::npos) << message;
+  EXPECT_EQ(message.find("::"), std::string::npos) << message;
+  const size_t before = mallinfo2().uordblks;
+  for (int i = 0; i < 10000; ++i) ASSERT_EQ(fail_once(), CvodeIntegrator::Status::kFailure);
+  const size_t after = mallinfo2().uordblks;
+  // 10000 lost names would be 240 kB or more (sanitizers keep their own books: 0 here).
+  EXPECT_LT(after, before + 10000) << "heap grew by " << after - before << " bytes";
+  try {
+    CvodeIntegrator none(nullptr, 1, {});
+    ADD_FAILURE() << "accepted a null system";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).find("::"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CvodeIntegratorTest, MovedIntegratorKeepsWorking) {

@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -1418,6 +1419,314 @@ TEST(SimulatorTest, HandFingersMoveTogether) {
       EXPECT_EQ(e.time, f.events[k].time);
       ASSERT_EQ(e.transitions.size(), 1u);
       EXPECT_EQ(e.transitions[0], std::string(1, "ABC"[i]) + "." + f.events[k].transitions[0]);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Resolution: a run whose events time can no longer resolve never reports `completed`, and
+// every state it records is trustworthy.
+
+// Messages are for the user: no C++ names.
+void ExpectUserMessage(const std::string& message) {
+  EXPECT_FALSE(message.empty());
+  EXPECT_EQ(message.find("::"), std::string::npos) << message;
+}
+
+TEST(SimulatorTest, ThermostatFollowsItsAnalyticSolutionWhateverTheHorizon) {
+  // Horizons of 1e20 to 1e300: the first 200 switches are those of the analytic solution (before,
+  // 1e20 to 1e45 failed at t = 60 and 1e50 and beyond "completed" with x = 0 in mode off, whose
+  // invariant is x >= 18). The event limit ends the run honestly, long before time loses its
+  // resolution.
+  const Model m(SpecText("thermostat"));
+  const int x = m.Var("x");
+  for (double until : {1e20, 1e30, 1e40, 1e50, 1e300}) {
+    SCOPED_TRACE("until " + Number(until));
+    SimulationOptions o = Until(until);
+    o.max_events = 200;
+    const SimulationResult r = m.Run(o);
+    EXPECT_EQ(r.status, SimulationStatus::kEventLimit) << r.message;
+    ExpectUserMessage(r.message);
+    ASSERT_EQ(r.events.size(), 200u) << Describe(m, r);
+    const Checker checker(m, {});
+    EXPECT_EQ(checker.Invariants(r, 1e-6), std::nullopt);
+    double x_end = 0.0;
+    const auto expected =
+        ThermostatSwitches(0.1, 3.0, 20.0, {{0, 10}, {60, 0}}, r.events.back().time + 1.0, &x_end);
+    ASSERT_GE(expected.size(), r.events.size());
+    for (size_t k = 0; k < r.events.size(); ++k) {
+      EXPECT_NEAR(r.events[k].time, expected[k].time, 1e-9 * expected[k].time) << k;
+      EXPECT_NEAR(r.events[k].before[x], expected[k].to_on ? 18.0 : 22.0, 1e-9) << k;
+    }
+  }
+}
+
+// A clock that waits until t = `start`, then a sawtooth y' = 1 wrapping at y = 10 (invariant
+// y <= 10): every event lies on y = 10 exactly, but at t = 1e17 time is resolved only to 16.
+std::string LateSawtooth(double start) {
+  return R"(
+automaton late_saw {
+  var c, y;
+  mode wait { c' = 1; }
+  mode saw { c' = 1; y' = 1; inv y <= 10; }
+  transition go: wait -> saw { guard c >= )" +
+         Number(start) + R"(; }
+  transition wrap: saw -> saw { guard y >= 10; reset y := 0; }
+  init wait { c = 0; y = 0; }
+}
+)";
+}
+
+// The thermostat, off from t = `start` (its nonlinear flows are integrated by CVODE).
+std::string LateThermostat(double start) {
+  return R"(
+automaton late_thermostat {
+  var c, x;
+  mode wait { c' = 1; }
+  mode off { c' = 1; x' = 0.1 * (10 - x); inv x >= 18; }
+  mode on { c' = 1; x' = 0.1 * (10 - x) + 3; inv x <= 22; }
+  transition go: wait -> off { guard c >= )" +
+         Number(start) + R"(; }
+  transition switch_on: off -> on { guard x <= 19; lazy; }
+  transition switch_off: on -> off { guard x >= 21; lazy; }
+  init wait { c = 0; x = 20; }
+}
+)";
+}
+
+TEST(SimulatorTest, EventsTimeCannotResolveEndUnresolvedNotCompleted) {
+  // Exact segments: at t = 1e17 the wrap at y = 10 rounds to t + 16, where y = 16.
+  const Model saw(LateSawtooth(1e17));
+  const SimulationResult r = saw.Run(Until(1e17 + 1024));
+  EXPECT_EQ(r.status, SimulationStatus::kUnresolved) << Describe(saw, r);
+  EXPECT_NE(r.message.find("'y >= 10'"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("cannot be located"), std::string::npos) << r.message;
+  ExpectUserMessage(r.message);
+  // What was recorded is trustworthy: inside the invariant, ending where the run was resolved.
+  EXPECT_EQ(Checker(saw, {}).Invariants(r, 1e-6), std::nullopt) << Describe(saw, r);
+  EXPECT_EQ(r.samples.back().time, 1e17);
+  EXPECT_EQ(r.samples.back().x[saw.Var("y")], 0.0);
+
+  // CVODE: at t = 1e13 its root location (about 100 ulps of t) moves x by about 4e-3.
+  const Model thermostat(LateThermostat(1e13));
+  const SimulationResult q = thermostat.Run(Until(1e13 + 1000));
+  EXPECT_EQ(q.status, SimulationStatus::kUnresolved) << Describe(thermostat, q);
+  ExpectUserMessage(q.message);
+  EXPECT_EQ(Checker(thermostat, {}).Invariants(q, 1e-6), std::nullopt);
+  for (const StateSample& s : q.samples) {
+    EXPECT_GE(s.x[thermostat.Var("x")], 18.0 - 1e-9) << s.time;
+    EXPECT_LE(s.x[thermostat.Var("x")], 22.0 + 1e-9) << s.time;
+  }
+}
+
+TEST(SimulatorTest, EventsTimeResolvesAreNotReportedUnresolved) {
+  // The same models from t = 1e6: every event where the analytic solution puts it.
+  const Model saw(LateSawtooth(1e6));
+  const SimulationResult r = saw.Run(Until(1e6 + 1000));
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  ASSERT_EQ(r.events.size(), 101u);  // go, then a wrap every 10 up to t = 1e6 + 1000
+  for (size_t k = 1; k < r.events.size(); ++k) {
+    EXPECT_EQ(r.events[k].time, 1e6 + 10.0 * static_cast<double>(k)) << k;
+    EXPECT_EQ(r.events[k].before[saw.Var("y")], 10.0) << k;
+  }
+  const Model thermostat(LateThermostat(1e6));
+  const SimulationResult q = thermostat.Run(Until(1e6 + 200));
+  ASSERT_EQ(q.status, SimulationStatus::kCompleted) << q.message;
+  double x_end = 0.0;
+  const auto expected = ThermostatSwitches(0.1, 3.0, 20.0, {{0, 10}}, 200.0, &x_end);
+  ASSERT_EQ(q.events.size(), expected.size() + 1);
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_NEAR(q.events[k + 1].time, 1e6 + expected[k].time, 1e-6) << k;
+  }
+  EXPECT_EQ(Checker(thermostat, {}).Invariants(q, 1e-6), std::nullopt);
+}
+
+TEST(SimulatorTest, RecordedStatesOutsideTheirInvariantAreFound) {
+  // The general guard on a result doctored by hand: x = 0 in mode off (x >= 18).
+  const Model m(SpecText("thermostat"));
+  SimulationOptions o;
+  o.sample_step = 1.0;
+  SimulationResult r = m.Run(o);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  EXPECT_EQ(m.sim.FirstStateOutsideInvariant(r, {}), std::nullopt);
+  const int off = m.Mode(0, "off"), on = m.Mode(0, "on");
+  size_t i = 1;
+  while (i < r.samples.size() &&
+         (r.samples[i].modes[0] != off || r.samples[i].kind != StateSample::Kind::kSample)) {
+    ++i;
+  }
+  ASSERT_LT(i, r.samples.size());
+  SimulationResult doctored = r;
+  doctored.samples[i].x[0] = 0.0;
+  const auto found = m.sim.FirstStateOutsideInvariant(doctored, {});
+  ASSERT_TRUE(found.has_value());
+  EXPECT_NE(found->find("t = " + FormatNumber(r.samples[i].time)), std::string::npos) << *found;
+  EXPECT_NE(found->find("'x >= 18'"), std::string::npos) << *found;
+  ExpectUserMessage(*found);
+  // Within the resolution tolerance (1e-9 + 1e-6 * (18 + 18)) is inside; beyond is not.
+  doctored.samples[i].x[0] = 18.0 - 3e-5;
+  EXPECT_EQ(m.sim.FirstStateOutsideInvariant(doctored, {}), std::nullopt);
+  doctored.samples[i].x[0] = 18.0 - 4e-5;
+  EXPECT_TRUE(m.sim.FirstStateOutsideInvariant(doctored, {}).has_value());
+  // A state left by a jump at its own instant is exempt; one that is not left is not.
+  SimulationResult left = r;
+  StateSample entered = left.samples[i];
+  entered.kind = StateSample::Kind::kAfterEvent;
+  entered.x[0] = 25.0;
+  entered.modes[0] = on;  // inv x <= 22
+  StateSample leaving = entered;
+  leaving.kind = StateSample::Kind::kBeforeEvent;
+  left.samples.insert(left.samples.begin() + static_cast<long>(i), {entered, leaving});
+  EXPECT_EQ(m.sim.FirstStateOutsideInvariant(left, {}), std::nullopt);
+  left.samples.erase(left.samples.begin() + static_cast<long>(i) + 1);
+  EXPECT_TRUE(m.sim.FirstStateOutsideInvariant(left, {}).has_value());
+  // A state that does not fit the model is misuse.
+  SimulationResult bad = r;
+  bad.samples[0].modes = {7};
+  EXPECT_THROW(m.sim.FirstStateOutsideInvariant(bad, {}), std::invalid_argument);
+}
+
+TEST(SimulatorTest, InputJumpOutOfAnInvariantIsAViolationOrALazyJump) {
+  // x = 2 stays; the invariant x <= u holds until u drops from 5 to 1 at t = 1.
+  const std::string text = R"(
+automaton capped {
+  var x;
+  input u in [0, 10];
+  mode a { inv x <= u; }
+  mode b { }
+  transition give_way: a -> b { guard x >= 1.5; lazy; }
+  init a { x = 2; }
+  scenario { until 3; u = step(0: 5, 1: 1); }
+}
+)";
+  const Model lazy(text);
+  const SimulationResult r = lazy.Run();
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  ASSERT_EQ(Transitions(r), std::vector<std::string>{"give_way"});
+  EXPECT_EQ(r.events[0].time, 1.0);
+  EXPECT_EQ(r.events[0].cause, EventRecord::Cause::kInvariant);
+  // Without an enabled transition the input jump violates the invariant (before: `completed`
+  // with x = 2 > u = 1 recorded up to t = 3).
+  const Model stuck(ReplaceOnce(text, "guard x >= 1.5;", "guard x >= 3;"));
+  const SimulationResult q = stuck.Run();
+  EXPECT_EQ(q.status, SimulationStatus::kInvariantViolated) << q.message;
+  EXPECT_NE(q.message.find("'x <= u'"), std::string::npos) << q.message;
+  ExpectUserMessage(q.message);
+  EXPECT_EQ(q.samples.back().time, 1.0);
+  EXPECT_TRUE(q.events.empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bounds: samples, events and steps.
+
+TEST(SimulatorTest, TooManySamplesAreRefusedBeforeTheRun) {
+  const Model m(SpecText("thermostat"));  // until 120
+  SimulationOptions o;
+  o.sample_step = 1e-9;  // 1.2e11 samples: 3.6 GB before the limit
+  try {
+    m.Run(o);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("--sample"), std::string::npos) << message;
+    EXPECT_NE(message.find("1e-09"), std::string::npos) << message;
+    EXPECT_NE(message.find("1000000"), std::string::npos) << message;
+    ExpectUserMessage(message);
+  }
+  // The limit itself is allowed: 1 / 1e-6 = 1e6 samples (one at each k * step < 1), on a clock
+  // (exact segments, so that the test is fast).
+  const Model clock(R"(automaton clock { var x; mode m { x' = 1; } init m { x = 0; } })");
+  SimulationOptions c = Until(1.0);
+  c.sample_step = 1e-6;
+  const SimulationResult r = clock.Run(c);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  const auto sampled = std::count_if(r.samples.begin(), r.samples.end(), [](const StateSample& s) {
+    return s.kind == StateSample::Kind::kSample;
+  });
+  EXPECT_LE(sampled, 1000000);
+  EXPECT_GE(sampled, 999999);
+  c.sample_step = 1e-7;
+  EXPECT_THROW(clock.Run(c), std::invalid_argument);
+  // Listed times count too.
+  o.sample_step = 0.0;
+  o.max_samples = 10;
+  o.sample_times.assign(11, 1.0);
+  EXPECT_THROW(m.Run(o), std::invalid_argument);
+  o.sample_times.assign(10, 1.0);
+  EXPECT_EQ(m.Run(o).status, SimulationStatus::kCompleted);
+  o.sample_step = 50.0;  // two more (t = 50, 100)
+  EXPECT_THROW(m.Run(o), std::invalid_argument);
+}
+
+TEST(SimulatorTest, EventAndStepLimitsEndTheRun) {
+  const Model m(SpecText("thermostat"));
+  SimulationOptions o = Until(1e6);
+  o.max_events = 50;
+  SimulationResult r = m.Run(o);
+  EXPECT_EQ(r.status, SimulationStatus::kEventLimit);
+  EXPECT_EQ(r.events.size(), 50u);
+  ExpectUserMessage(r.message);
+  // Many sample intervals, each reached in a few hundred steps of at most 1e-5: without a bound
+  // on the whole run this would take 1.2e7 steps.
+  o = SimulationOptions{};
+  o.sample_step = 0.01;
+  o.max_step = 1e-5;
+  o.max_steps = 20000;
+  r = m.Run(o);
+  EXPECT_EQ(r.status, SimulationStatus::kStepLimit) << r.message;
+  EXPECT_NE(r.message.find("20000"), std::string::npos) << r.message;
+  ExpectUserMessage(r.message);
+  EXPECT_LE(r.steps, 20000);
+  EXPECT_NEAR(r.samples.back().time, 20000 * 1e-5, 0.02);
+  EXPECT_EQ(Checker(m, {}).Invariants(r, 1e-6), std::nullopt);
+}
+
+TEST(SimulatorTest, OptionsOutOfRangeAreRefused) {
+  const Model m(SpecText("thermostat"));
+  auto refused = [&](auto change) {
+    SimulationOptions o;
+    change(o);
+    try {
+      m.Run(o);
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      ExpectUserMessage(e.what());
+    }
+  };
+  refused([](SimulationOptions& o) { o.sample_step = -1.0; });
+  refused([](SimulationOptions& o) { o.sample_step = kNaN; });
+  refused([](SimulationOptions& o) { o.relative_tolerance = 0.0; });
+  refused([](SimulationOptions& o) { o.absolute_tolerance = kInf; });
+  refused([](SimulationOptions& o) { o.event_tolerance = -1e-9; });
+  refused([](SimulationOptions& o) { o.resolution_tolerance = kNaN; });
+  refused([](SimulationOptions& o) { o.dense_checks = -1; });
+  refused([](SimulationOptions& o) { o.max_event_iterations = 0; });
+  refused([](SimulationOptions& o) { o.max_events = -1; });
+  refused([](SimulationOptions& o) { o.max_steps = 0; });
+}
+
+TEST(SimulatorTest, RunTimeMessagesNameNoCxxSymbols) {
+  // One run per status that carries a message, and the misuse messages.
+  const Model blow_up(R"(
+automaton blow_up { var x; mode a { x' = x^2; } init a { x = 1; } scenario { until 2; } }
+)");
+  const Model stuck(testing::kInvariantViolationModel);
+  const Model zeno(BallText({.v_rest = 0.0}));
+  for (const SimulationResult& r : {blow_up.Run(), stuck.Run(), zeno.Run()}) {
+    EXPECT_NE(r.status, SimulationStatus::kCompleted);
+    ExpectUserMessage(r.message);
+  }
+  const Model plain(R"(automaton a { var x; mode m { x' = 1; } init m { x = 1; } })");
+  for (auto run : std::vector<std::function<void()>>{
+           [&] { plain.Run(); }, [&] { plain.Run(Until(-1)); },
+           [&] {
+             plain.Run(Until(1), {InputSignal{0, InputSignal::Shape::kStep, {{0, 1}}}});
+           }}) {
+    try {
+      run();
+      ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+      ExpectUserMessage(e.what());
     }
   }
 }
