@@ -1,5 +1,8 @@
 #include "solvers/check_result.h"
 
+#include <exception>
+#include <utility>
+
 namespace hybrid {
 
 std::string_view VerdictName(Verdict verdict) {
@@ -16,6 +19,33 @@ std::string_view VerdictName(Verdict verdict) {
       return "unknown";
   }
   return "?";
+}
+
+void ConfirmTrace(const System& system, const Property& property, CheckResult& result) {
+  if (result.verdict != Verdict::kViolated && result.verdict != Verdict::kReachable) return;
+  const std::string what = result.verdict == Verdict::kViolated ? "counterexample" : "witness";
+  std::string failure;
+  if (!result.trace) {
+    failure = "no trace";
+  } else {
+    Trace fresh;
+    fresh.parameters = result.trace->parameters;
+    fresh.initial_values = result.trace->initial_values;
+    fresh.inputs = result.trace->inputs;
+    try {
+      if (ReplayTrace(system, property, fresh)) {
+        result.trace = std::move(fresh);
+        return;
+      }
+      failure = "its trace does not replay in the simulator";
+    } catch (const std::exception& e) {
+      failure = std::string("its trace could not be replayed: ") + e.what();
+    }
+  }
+  result.verdict = Verdict::kUnknown;
+  result.trace.reset();
+  result.reason = "a " + what + " was found (" + result.reason + "), but " + failure +
+                  ", so it is not reported";
 }
 
 }  // namespace hybrid

@@ -1,10 +1,14 @@
 #include "solvers/property_prover.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -80,15 +84,20 @@ void DebugPath(SmtEncoding& enc, const z3::model& model, int n) {
   }
 }
 
-// The solver for every query: Z3's nlsat (complete for polynomial real arithmetic, with Boolean
-// structure), which handles the separable (nonlinear) flows far better than the default core.
-// Limits are Z3 resource units (`rlimit`), not seconds, so that verdicts do not depend on the
-// machine's load; about 2.5 million units per second on the development machine.
-z3::solver MakeSolver(z3::context& ctx, unsigned resource_limit) {
-  z3::solver s = z3::tactic(ctx, "qfnra-nlsat").mk_solver();
+// The solver for the induction and unreachability queries: Z3's nlsat (complete for polynomial
+// real arithmetic, with Boolean structure), which handles the separable (nonlinear) flows far
+// better than the default core. Its limits are set per query (Meter).
+z3::solver MakeSolver(z3::context& ctx) { return z3::tactic(ctx, "qfnra-nlsat").mk_solver(); }
+
+// Z3's default solver, for bounded model checking (incremental) and the one-query induction
+// step: without its calls to nlsat from the arithmetic core (`arith.nl.nra`), whose algebraic
+// number work Z3 neither counts in the resource limit nor interrupts on time (a query of the
+// finger's search ran for minutes on 600,000 units); its other nonlinear reasoning is counted.
+// Incomplete for nonlinear problems: such a query may come back `unknown`.
+z3::solver MakeIncremental(z3::context& ctx) {
+  z3::solver s(ctx);
   z3::params p(ctx);
-  p.set("rlimit", resource_limit);
-  p.set("timeout", 10000u);  // a safety net: the resource limit is the intended bound
+  p.set("arith.nl.nra", false);
   s.set(p);
   return s;
 }
@@ -99,13 +108,122 @@ void Add(z3::solver& s, SmtEncoding& enc, const z3::expr& e) {
   s.add(enc.TakeDefinitions());
 }
 
-class Engine {
- public:
-  Engine(const System& system, const PropertyProver::Options& options, Clock::time_point start,
-         std::vector<CheckResult>& results)
-      : system_(system), options_(options), start_(start), results_(results) {}
+// The resource units charged per mode and per transition for each step of the encoding asserted
+// in a solver: the work of building and asserting it, which Z3's count leaves out (about what
+// Z3 counts for the same time, measured on chains of 300 to 10^4 modes).
+constexpr std::uint64_t kUnitsPerEncodedElement = 400;
 
-  void Run(const Job& job);
+// Z3's count of resource units spent so far in the context of `s` (cumulative over all its
+// solvers), from the solver's statistics.
+std::uint64_t ResourceCount(const z3::solver& s) {
+  const z3::stats st = s.statistics();
+  for (unsigned i = 0; i < st.size(); ++i) {
+    const std::string key = st.key(i);
+    if (key == "rlimit count" || key == "rlimit-count") {
+      return st.is_uint(i) ? st.uint_value(i) : static_cast<std::uint64_t>(st.double_value(i));
+    }
+  }
+  return 0;
+}
+
+// Runs the solver queries of one Z3 context against a SolverBudget.
+class Meter {
+ public:
+  explicit Meter(SolverBudget& budget) : budget_(budget) {}
+
+  // s.check() with at most `cap` resource units and never past `ceiling` (a level of
+  // budget.used()): z3::unknown without a query once the ceiling is reached (counted in
+  // starved(), as a query that the budget, not `cap`, cut short).
+  z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling) {
+    if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
+      ++starved_;
+      return z3::unknown;
+    }
+    // What is left, rounded down to a power of two when less than `cap`: setting a solver's
+    // parameters costs time on a large incremental solver, so they change only when the
+    // rounded value does.
+    const std::uint64_t left = ceiling - budget_.used();
+    std::uint64_t allowed = cap;
+    if (left < cap) {
+      allowed = 1;
+      while (allowed * 2 <= left) allowed *= 2;
+    }
+    const unsigned safety = budget_.SafetyMilliseconds(allowed);
+    const bool same =
+        last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
+    if (!same || last_allowed_ != allowed) {
+      z3::params p(s.ctx());
+      p.set("rlimit", static_cast<unsigned>(allowed));
+      p.set("timeout", safety);
+      s.set(p);
+      last_solver_ = s;  // held, so that no other solver can take its address
+      last_allowed_ = allowed;
+    }
+    if (const char* dir = std::getenv("HYBRID_CHECK_DUMP")) {
+      std::ofstream(std::string(dir) + "/q" + std::to_string(dumped_++) + ".smt2")
+          << "; rlimit " << allowed << "\n"
+          << s.to_smt2();
+    }
+    const Clock::time_point t0 = Clock::now();
+    const z3::check_result r = s.check();
+    const double seconds = Since(t0);
+    const std::uint64_t count = ResourceCount(s);
+    const std::uint64_t spent = count > seen_ ? count - seen_ : 0;
+    seen_ = std::max(seen_, count);
+    budget_.Charge(spent);
+    if (r == z3::unknown) {
+      if (spent < allowed && seconds * 1000.0 >= 0.9 * safety) budget_.NoteSafetyStop();
+      if (allowed < cap) ++starved_;
+    }
+    if (std::getenv("HYBRID_CHECK_TIMING")) {
+      std::cerr << "query: " << r << ", " << spent << " units, " << seconds << " s\n";
+    }
+    return r;
+  }
+  // How many queries the budget refused or cut short so far.
+  int starved() const { return starved_; }
+
+  // Pays `units` for work Z3 does not count (building and asserting the encoding) if the
+  // ceiling allows it; otherwise sets starved() and returns false.
+  bool Afford(std::uint64_t units, std::uint64_t ceiling) {
+    if (budget_.used() + units > ceiling || budget_.SafetyExpired()) {
+      ++starved_;
+      return false;
+    }
+    budget_.Charge(units);
+    return true;
+  }
+
+ private:
+  SolverBudget& budget_;
+  std::uint64_t seen_ = 0;  // the context's count after the last query
+  int starved_ = 0;
+  int dumped_ = 0;
+  std::optional<z3::solver> last_solver_;  // the solver of the last query, and its rlimit
+  std::uint64_t last_allowed_ = 0;
+};
+
+// The check of one automaton (one Job) within `share` resource units of the budget: its Z3
+// context, encoding and candidates, and the phases of PropertyProver's comment.
+class JobRun {
+ public:
+  JobRun(const System& system, const PropertyProver::Options& options, SolverBudget& budget,
+         Clock::time_point start, std::vector<CheckResult>& results, const Job& job,
+         std::uint64_t share)
+      : system_(system),
+        options_(options),
+        budget_(budget),
+        start_(start),
+        results_(results),
+        job_(job),
+        a_(*job.automaton),
+        enc_(ctx_, a_),
+        meter_(budget),
+        bmc_(MakeIncremental(ctx_)),
+        first_(budget.used()),
+        share_(share) {}
+
+  void Go();
 
  private:
   struct Candidate {
@@ -118,16 +236,65 @@ class Engine {
     int replays = 0;
   };
 
-  bool TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth, Candidate& c);
-  void Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace = {});
+  // The budget level up to which a phase may draw: a fraction of this job's share.
+  std::uint64_t Ceiling(double fraction) const {
+    return first_ + static_cast<std::uint64_t>(static_cast<double>(share_) * fraction);
+  }
+  bool Open() const;
+  // Bounded properties are checked like unbounded ones (sound for `proved`); their traces are
+  // replayed with the horizon.
+  static bool Pending(const Candidate& c) { return !c.decided && c.replays < 8; }
+  void Decide(Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace = {});
+  bool TryTrace(const z3::model& model, int depth, Candidate& c);
+  bool Extend(int n, std::uint64_t ceiling);
+  // The charge for one step of the encoding (a State and a Transition) asserted in a solver.
+  std::uint64_t StepUnits() const {
+    return kUnitsPerEncodedElement *
+           static_cast<std::uint64_t>(a_.num_modes() + a_.num_transitions() + 1);
+  }
+  z3::expr Bad(const Candidate& c, int n, double margin);
+  void Search(int n, bool invariants_only, std::initializer_list<bool> passes,
+              std::uint64_t ceiling);
+  void Induction(int k);
+  void DeepSearch();
+  bool Unreachable(const Candidate& c);
+  void Conclude();
 
   const System& system_;
   const PropertyProver::Options& options_;
+  SolverBudget& budget_;
   Clock::time_point start_;
   std::vector<CheckResult>& results_;
+  const Job& job_;
+  const Automaton& a_;
+  z3::context ctx_;
+  SmtEncoding enc_;
+  Meter meter_;
+  z3::solver bmc_;  // the incremental solver of bounded model checking
+  std::vector<Candidate> cands_;
+  std::uint64_t first_;  // budget_.used() when this job started
+  std::uint64_t share_;
+  bool bmc_complete_ = true;
+  bool base_complete_ = false;
+  bool deep_ = false;   // in the counterexample search (lemmas need none of their own)
+  int bmc_depth_ = -1;  // paths up to this length are in bmc_
+  int searched_ = -1;   // the deep search covered paths up to this length
+  // Where the budget ran out: it left the base case or the induction short, cut the search
+  // for counterexamples and witnesses, or the unreachability proofs.
+  bool proof_cut_ = false;
+  bool search_cut_ = false;
+  bool unreach_cut_ = false;
 };
 
-void Engine::Decide(const Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace) {
+bool JobRun::Open() const {
+  for (const Candidate& c : cands_) {
+    if (!c.decided && c.goal->result >= 0) return true;
+  }
+  return false;
+}
+
+void JobRun::Decide(Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace) {
+  c.decided = true;
   if (c.goal->result < 0) return;
   std::vector<int> targets = c.goal->also;
   targets.insert(targets.begin(), c.goal->result);
@@ -140,32 +307,30 @@ void Engine::Decide(const Candidate& c, Verdict v, std::string reason, std::opti
   }
 }
 
-bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, int depth,
-                      Candidate& c) {
-  const Automaton& a = *job.automaton;
-  const auto path = enc.ReadPath(model, depth);
+bool JobRun::TryTrace(const z3::model& model, int depth, Candidate& c) {
+  const auto path = enc_.ReadPath(model, depth);
   Trace trace;
-  trace.parameters = enc.ReadParameters(model);
+  trace.parameters = enc_.ReadParameters(model);
   // Initial values where the model's initial state is a box.
-  for (const InitialState& init : a.initial_states()) {
+  for (const InitialState& init : a_.initial_states()) {
     if (init.mode.value() != path[0].mode) continue;
     for (const InitialValue& iv : init.values) {
       if (iv.is_point) continue;
       int index = 0;
-      for (const VariableInfo& v : a.variables()) {
+      for (const VariableInfo& v : a_.variables()) {
         if (v.slot == iv.slot) break;
         ++index;
       }
-      trace.initial_values.emplace_back(system_.symbols()[job.to_system[iv.slot]].name,
+      trace.initial_values.emplace_back(system_.symbols()[job_.to_system[iv.slot]].name,
                                         path[0].x[index]);
     }
   }
   // The input schedule: one step piece per flow segment of positive duration.
-  const int ni = static_cast<int>(a.inputs().size());
+  const int ni = static_cast<int>(a_.inputs().size());
   std::vector<InputSignal> signals(ni);
   double t = 0.0;
   for (int i = 0; i < ni; ++i) {
-    signals[i].slot = job.to_system[a.inputs()[i].slot];
+    signals[i].slot = job_.to_system[a_.inputs()[i].slot];
     signals[i].shape = InputSignal::Shape::kStep;
   }
   auto add_piece = [&](const std::vector<double>& u, double duration) {
@@ -209,316 +374,358 @@ bool Engine::TryTrace(const Job& job, SmtEncoding& enc, const z3::model& model, 
     if (std::getenv("HYBRID_CHECK_DEBUG")) {
       std::cerr << "path of " << depth << " steps for " << c.goal->property.name
                 << " does not replay:\n";
-      DebugPath(enc, model, depth);
+      DebugPath(enc_, model, depth);
     }
     return false;
   }
   Decide(c, c.invariant ? Verdict::kViolated : Verdict::kReachable,
          std::string(c.invariant ? "counterexample" : "witness") + " of " + std::to_string(depth) +
-             " steps found by bounded model checking, replayed by " + "the simulator",
+             " steps found by bounded model checking, replayed by the simulator",
          std::move(trace));
-  c.decided = true;
   return true;
 }
 
-void Engine::Run(const Job& job) {
-  const Automaton& a = *job.automaton;
-  z3::context ctx;
-  SmtEncoding enc(ctx, a);
-  std::vector<Candidate> cands;
-  for (const Goal& g : job.goals) {
-    const Property& p = g.property;
-    switch (p.kind) {
-      case Property::Kind::kAlways:
-        cands.push_back({&g, Predicate::Not(p.predicate), true});
-        break;
-      case Property::Kind::kNever:
-        cands.push_back({&g, p.predicate, true});
-        break;
-      case Property::Kind::kReach:
-        cands.push_back({&g, p.predicate, false});
-        break;
+// Adds the paths of up to n steps to bmc_, each step paid for (StepUnits) before it is built;
+// false when the ceiling does not allow it.
+bool JobRun::Extend(int n, std::uint64_t ceiling) {
+  while (bmc_depth_ < n) {
+    if (bmc_depth_ >= 0 && !meter_.Afford(StepUnits(), ceiling)) return false;
+    ++bmc_depth_;
+    if (bmc_depth_ > 0) {
+      Add(bmc_, enc_, enc_.Transition(bmc_depth_ - 1));
+      Add(bmc_, enc_, enc_.State(bmc_depth_));
     }
   }
-  // Bounded properties are checked like unbounded ones (sound for `proved`); their traces are
-  // replayed with the horizon.
-  auto pending = [&](const Candidate& c) { return !c.decided && c.replays < 8; };
+  return true;
+}
 
-  // 1. Base case: no violation within max_induction - 1 steps (what k-induction needs).
-  // Bounded model checking: Z3's default (incremental) solver, which handles long unrollings
-  // better than nlsat.
-  z3::solver bmc(ctx);
-  {
-    z3::params p(ctx);
-    p.set("rlimit", options_.resource_limit);
-    p.set("timeout", 10000u);  // a safety net: not every engine honours the resource limit
-    bmc.set(p);
-  }
-  Add(bmc, enc, enc.Initial());
-  Add(bmc, enc, enc.State(0));
-  bool bmc_complete = true;
-  std::string budget_note;
-  int bmc_depth = -1;  // paths up to this length are in `bmc`
-  // The budget of the deep search (step 3): checked before every query.
-  std::optional<Clock::time_point> deep_start;
-  auto over_budget = [&]() { return deep_start && Since(*deep_start) > options_.search_seconds; };
-  auto search = [&](int n, bool invariants_only, std::initializer_list<bool> passes) {
-    while (bmc_depth < n) {
-      ++bmc_depth;
-      if (bmc_depth > 0) {
-        Add(bmc, enc, enc.Transition(bmc_depth - 1));
-        Add(bmc, enc, enc.State(bmc_depth));
-      }
-    }
-    // Parameters at their nominal values first (fewer ties between events, which the simulator
-    // breaks by declaration order), then over their ranges; per pass, one query for all
-    // candidates, then one per candidate (robust violations first: they replay clear of
-    // rounding; then exact ones).
-    for (bool pinned : passes) {
-      if (pinned && enc.uncertain().empty()) continue;
-      z3::expr_vector any(ctx);
-      for (Candidate& c : cands) {
-        if (!pending(c) || (invariants_only && !c.invariant)) continue;
-        // Lemmas need no counterexample of their own beyond the base case.
-        if (deep_start && c.goal->result < 0) continue;
-        any.push_back(c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, 0.0)
-                                  : enc.Holds(c.bad, n, 0.0));
-      }
-      if (any.empty()) return;
-      bmc.push();
-      Add(bmc, enc, z3::mk_or(any));
-      if (pinned) bmc.add(enc.NominalParameters());
-      const auto t_query = Clock::now();
-      const z3::check_result r = bmc.check();
-      bmc.pop();
-      if (std::getenv("HYBRID_CHECK_TIMING")) {
-        std::cerr << "bmc depth " << n << (pinned ? " pinned: " : " free: ") << r << " "
-                  << Since(t_query) << " s\n";
-      }
-      if (r == z3::unknown && !pinned) bmc_complete = false;
-      if (r == z3::unsat) continue;
-      for (Candidate& c : cands) {
-        if (!pending(c) || (invariants_only && !c.invariant)) continue;
-        if (deep_start && c.goal->result < 0) continue;
-        for (double margin : {options_.robust_margin, 0.0}) {
-          if (!pending(c) || (!c.invariant && margin > 0) || over_budget()) continue;
-          bmc.push();
-          Add(bmc, enc,
-              c.invariant ? !enc.Holds(Predicate::Not(c.bad), n, margin)
-                          : enc.Holds(c.bad, n, 0.0));
-          if (pinned) bmc.add(enc.NominalParameters());
-          const z3::check_result rc = bmc.check();
-          if (rc == z3::sat) {
-            c.refuted = c.refuted || c.invariant;
-            const z3::model model = bmc.get_model();
-            TryTrace(job, enc, model, n, c);
-          } else if (rc == z3::unknown && !pinned) {
-            bmc_complete = false;
-          }
-          bmc.pop();
-          if (rc == z3::sat) break;
-        }
-      }
-    }
-  };
-  for (int n = 0; n < options_.max_induction && n <= options_.max_depth; ++n) {
-    search(n, true, {true, false});
-  }
-  const bool base_complete = bmc_complete;
+// s_n is a counterexample (by at least `margin`) or a witness of `c`.
+z3::expr JobRun::Bad(const Candidate& c, int n, double margin) {
+  return c.invariant ? !enc_.Holds(Predicate::Not(c.bad), n, margin) : enc_.Holds(c.bad, n, 0.0);
+}
 
-  // 2. k-induction with Houdini over the surviving invariants (and negated reach targets).
-  auto open = [&]() {
-    for (const Candidate& c : cands) {
-      if (!c.decided && c.goal->result >= 0) return true;
-    }
-    return false;
+// Paths of exactly n steps: parameters at their nominal values first (fewer ties between
+// events, which the simulator breaks by declaration order), then over their ranges; per pass,
+// one query for all candidates, then one per candidate (robust violations first: they replay
+// clear of rounding; then exact ones).
+void JobRun::Search(int n, bool invariants_only, std::initializer_list<bool> passes,
+                    std::uint64_t ceiling) {
+  if (!Extend(n, ceiling)) {
+    bmc_complete_ = false;
+    return;
+  }
+  auto wanted = [&](const Candidate& c) {
+    // Lemmas need no counterexample of their own beyond the base case.
+    return Pending(c) && (!invariants_only || c.invariant) && !(deep_ && c.goal->result < 0);
   };
-  for (int k = 1; k <= options_.max_induction && open() && base_complete; ++k) {
-    std::vector<Candidate*> set;
-    for (Candidate& c : cands) {
-      if (c.invariant && !c.refuted && !c.decided) set.push_back(&c);
+  for (bool pinned : passes) {
+    if (pinned && enc_.uncertain().empty()) continue;
+    z3::expr_vector any(ctx_);
+    for (const Candidate& c : cands_) {
+      if (wanted(c)) any.push_back(Bad(c, n, 0.0));
     }
-    // The step query is split on the mode of s_(k-1): one small nonlinear problem per mode is
-    // far easier for nlsat than their disjunction. Per mode, all candidates are checked at once;
-    // a model names the ones that fail (dropped, Houdini), a timeout splits per candidate.
-    std::vector<bool> alive(set.size(), true);
-    std::vector<std::optional<z3::expr>> path_from(a.num_modes());
-    std::optional<z3::expr> hypotheses;  // of the alive candidates
-    bool changed = true;
-    while (changed) {
-      changed = false;
-      hypotheses.reset();
-      for (int m = 0; m < a.num_modes(); ++m) {
-        auto check = [&](const std::vector<std::size_t>& goals, unsigned resource_limit,
-                         std::vector<std::size_t>& failed) {
-          z3::solver s = MakeSolver(ctx, resource_limit);
-          if (!path_from[m]) {
-            z3::expr e = ctx.bool_val(true);
-            for (int i = 0; i <= k; ++i) e = e && enc.State(i);
-            for (int i = 0; i + 1 < k; ++i) e = e && enc.Transition(i);
-            e = e && enc.TransitionFrom(k - 1, ModeId(m));
-            path_from[m] = e && enc.TakeDefinitions();
-          }
-          s.add(*path_from[m]);
-          if (!hypotheses) {
-            z3::expr e = ctx.bool_val(true);
-            for (std::size_t j = 0; j < set.size(); ++j) {
-              if (!alive[j]) continue;
-              for (int i = 0; i < k; ++i) e = e && !enc.Holds(set[j]->bad, i, 0.0);
-            }
-            hypotheses = e && enc.TakeDefinitions();
-          }
-          s.add(*hypotheses);
-          z3::expr_vector bad(ctx);
-          std::vector<z3::expr> at_k;
-          for (std::size_t j : goals) {
-            at_k.push_back(enc.Holds(set[j]->bad, k, 0.0));
-            bad.push_back(at_k.back());
-          }
-          Add(s, enc, z3::mk_or(bad));
-          const z3::check_result r = s.check();
-          if (r == z3::sat) {
-            const z3::model model = s.get_model();
-            for (std::size_t g = 0; g < goals.size(); ++g) {
-              if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
-            }
-            if (std::getenv("HYBRID_CHECK_DEBUG")) {
-              std::cerr << "induction k=" << k << " from mode " << a.modes()[m].name
-                        << " fails for";
-              for (std::size_t j : failed) std::cerr << " " << set[j]->goal->property.name;
-              std::cerr << ":\n";
-              DebugPath(enc, model, k);
-            }
-            if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
-          }
-          return r;
-        };
-        std::vector<std::size_t> goals, failed;
-        for (std::size_t j = 0; j < set.size(); ++j) {
-          if (alive[j]) goals.push_back(j);
+    if (any.empty()) return;
+    bmc_.push();
+    Add(bmc_, enc_, z3::mk_or(any));
+    if (pinned) bmc_.add(enc_.NominalParameters());
+    const z3::check_result r = meter_.Check(bmc_, options_.resource_limit, ceiling);
+    bmc_.pop();
+    if (r == z3::unknown && !pinned) bmc_complete_ = false;
+    if (r == z3::unsat) continue;
+    for (Candidate& c : cands_) {
+      if (!wanted(c)) continue;
+      for (double margin : {options_.robust_margin, 0.0}) {
+        if (!Pending(c) || (!c.invariant && margin > 0)) continue;
+        bmc_.push();
+        Add(bmc_, enc_, Bad(c, n, margin));
+        if (pinned) bmc_.add(enc_.NominalParameters());
+        const z3::check_result rc = meter_.Check(bmc_, options_.resource_limit, ceiling);
+        if (rc == z3::sat) {
+          c.refuted = c.refuted || c.invariant;
+          TryTrace(bmc_.get_model(), n, c);
+        } else if (rc == z3::unknown && !pinned) {
+          bmc_complete_ = false;
         }
-        if (goals.empty()) break;
-        const auto t_mode = Clock::now();
-        z3::check_result r = check(goals, options_.resource_limit / 25, failed);
-        if (std::getenv("HYBRID_CHECK_TIMING")) {
-          std::cerr << "k=" << k << " mode " << a.modes()[m].name << ": " << r << " "
-                    << Since(t_mode) << " s\n";
-        }
-        (void)t_mode;
-        if (r == z3::unknown) {
-          // Split per candidate with the full time budget.
-          for (std::size_t j : goals) {
-            std::vector<std::size_t> f;
-            const z3::check_result rj = check({j}, options_.resource_limit / 5, f);
-            if (rj == z3::unknown) f.push_back(j);
-            for (std::size_t x : f) failed.push_back(x);
-          }
-        }
-        for (std::size_t j : failed) {
-          if (alive[j]) {
-            alive[j] = false;
-            changed = true;
-            hypotheses.reset();  // weaker now: modes already passed are checked again
-          }
-        }
+        bmc_.pop();
+        if (rc == z3::sat) break;
       }
     }
-    std::size_t lemmas = 0;
-    for (std::size_t j = 0; j < set.size(); ++j) lemmas += alive[j] ? 1 : 0;
+  }
+}
+
+// k-induction with Houdini over the surviving invariants. The step query is split on the mode
+// of s_(k-1): one small nonlinear problem per mode is far easier for nlsat than their
+// disjunction. Per mode, all candidates are checked at once; a model names the ones that fail
+// (dropped), a query that runs out splits per candidate, and one that runs out alone is dropped.
+void JobRun::Induction(int k) {
+  std::vector<Candidate*> set;
+  for (Candidate& c : cands_) {
+    if (c.invariant && !c.refuted && !c.decided) set.push_back(&c);
+  }
+  const std::uint64_t ceiling = Ceiling(0.5);
+  std::vector<bool> alive(set.size(), true);
+  std::vector<std::optional<z3::expr>> path_from(a_.num_modes());
+  std::optional<z3::expr> hypotheses;  // of the alive candidates
+  std::optional<z3::expr> path_any;
+  // The step query from mode m, or from any mode (m = -1, with Z3's default solver).
+  auto check = [&](int m, const std::vector<std::size_t>& goals, unsigned limit,
+                   std::vector<std::size_t>& failed) {
+    // A path of k steps (k + 1 states) asserted in a new solver.
+    if (!meter_.Afford(StepUnits() * (k + 1), ceiling)) return z3::unknown;
+    z3::solver s = m < 0 ? MakeIncremental(ctx_) : MakeSolver(ctx_);
+    std::optional<z3::expr>& path = m < 0 ? path_any : path_from[m];
+    if (!path) {
+      z3::expr_vector e(ctx_);
+      for (int i = 0; i <= k; ++i) e.push_back(enc_.State(i));
+      for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
+      e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
+      e.push_back(enc_.TakeDefinitions());
+      path = z3::mk_and(e);
+    }
+    s.add(*path);
+    if (!hypotheses) {
+      z3::expr_vector e(ctx_);
+      for (std::size_t j = 0; j < set.size(); ++j) {
+        if (!alive[j]) continue;
+        for (int i = 0; i < k; ++i) e.push_back(!enc_.Holds(set[j]->bad, i, 0.0));
+      }
+      e.push_back(enc_.TakeDefinitions());
+      hypotheses = z3::mk_and(e);
+    }
+    s.add(*hypotheses);
+    z3::expr_vector bad(ctx_);
+    std::vector<z3::expr> at_k;
+    for (std::size_t j : goals) {
+      at_k.push_back(enc_.Holds(set[j]->bad, k, 0.0));
+      bad.push_back(at_k.back());
+    }
+    Add(s, enc_, z3::mk_or(bad));
+    const z3::check_result r = meter_.Check(s, limit, ceiling);
+    if (r == z3::sat) {
+      const z3::model model = s.get_model();
+      for (std::size_t g = 0; g < goals.size(); ++g) {
+        if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
+      }
+      if (std::getenv("HYBRID_CHECK_DEBUG")) {
+        std::cerr << "induction k=" << k << " from mode "
+                  << (m < 0 ? std::string("(any)") : a_.modes()[m].name) << " fails:\n";
+        DebugPath(enc_, model, k);
+      }
+      if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
+    }
+    return r;
+  };
+  auto drop = [&](const std::vector<std::size_t>& failed) {
+    bool changed = false;
+    for (std::size_t j : failed) {
+      changed = changed || alive[j];
+      alive[j] = false;
+    }
+    if (changed) hypotheses.reset();  // weaker now: modes already passed are checked again
+    return changed;
+  };
+  auto living = [&] {
+    std::vector<std::size_t> goals;
     for (std::size_t j = 0; j < set.size(); ++j) {
-      if (!alive[j]) continue;
-      Candidate& c = *set[j];
-      const std::string how = std::to_string(k) + "-induction, together with " +
-                              std::to_string(lemmas - 1) + " other invariant(s) as lemmas";
-      Decide(c, Verdict::kProved, "proved by " + how);
-      c.decided = true;
-      c.proved = true;
+      if (alive[j]) goals.push_back(j);
+    }
+    return goals;
+  };
+  // First the step from any mode in one query (cheap where the flows are simple, however many
+  // modes), while it decides; then per mode.
+  bool whole = true;
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    hypotheses.reset();
+    if (whole && !living().empty() && budget_.used() < ceiling && !budget_.SafetyExpired()) {
+      std::vector<std::size_t> failed;
+      const z3::check_result r = check(-1, living(), options_.resource_limit / 25, failed);
+      if (r == z3::unsat) break;
+      if (r == z3::sat) {
+        changed = drop(failed);
+        continue;
+      }
+      whole = false;
+    }
+    for (int m = 0; m < a_.num_modes(); ++m) {
+      std::vector<std::size_t> goals = living(), failed;
+      if (goals.empty()) break;
+      if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
+        proof_cut_ = true;  // nothing left to prove with: every candidate is dropped
+        failed = goals;
+      } else if (check(m, goals, options_.resource_limit / 25, failed) == z3::unknown) {
+        // Split per candidate with a larger limit.
+        for (std::size_t j : goals) {
+          std::vector<std::size_t> f;
+          if (check(m, {j}, options_.resource_limit / 5, f) == z3::unknown) f.push_back(j);
+          failed.insert(failed.end(), f.begin(), f.end());
+        }
+      }
+      changed = drop(failed) || changed;
     }
   }
+  std::size_t lemmas = 0;
+  for (std::size_t j = 0; j < set.size(); ++j) lemmas += alive[j] ? 1 : 0;
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    if (!alive[j]) continue;
+    Candidate& c = *set[j];
+    Decide(c, Verdict::kProved,
+           "proved by " + std::to_string(k) + "-induction, together with " +
+               std::to_string(lemmas - 1) + " other invariant(s) as lemmas");
+    c.proved = true;
+  }
+}
 
-  // 3. Counterexamples and witnesses for what is still open, up to max_depth steps.
-  // Search order: short paths with nominal and with free parameters; then longer paths with
-  // nominal parameters (cheap: fewer branches; at most 40% of the budget); then longer paths with
-  // every parameter value (the search space grows fast with the depth).
-  const Clock::time_point bmc_start = Clock::now();
-  deep_start = bmc_start;
+// Counterexamples and witnesses for what is still open, up to max_depth steps. Search order:
+// short paths with nominal and with free parameters; then longer paths with nominal parameters
+// (cheap: fewer branches; at most 40% of this phase); then longer paths with every parameter
+// value (the search space grows fast with the depth).
+void JobRun::DeepSearch() {
+  deep_ = true;
+  const std::uint64_t end = Ceiling(0.9);
+  const std::uint64_t from = std::min(budget_.used(), end);
+  const std::uint64_t pinned_end = from + (end - from) * 2 / 5;
   const int shallow = std::min(options_.max_depth, 3);
   struct Pass {
     int from, to;
     std::initializer_list<bool> pinned;
-    double budget_fraction;
+    std::uint64_t ceiling;
   };
-  const Pass passes[] = {{0, shallow, {true, false}, 1.0},
-                         {shallow + 1, options_.max_depth, {true}, 0.4},
-                         {shallow + 1, options_.max_depth, {false}, 1.0}};
-  int searched = -1;
+  const Pass passes[] = {{0, shallow, {true, false}, end},
+                         {shallow + 1, options_.max_depth, {true}, pinned_end},
+                         {shallow + 1, options_.max_depth, {false}, end}};
   for (const Pass& pass : passes) {
     const bool pinned_only = pass.pinned.size() == 1 && *pass.pinned.begin();
-    if (pinned_only && enc.uncertain().empty()) continue;  // the next pass covers it
-    for (int n = pass.from; n <= pass.to && open(); ++n) {
-      if (Since(bmc_start) > options_.search_seconds * pass.budget_fraction) {
-        if (pass.budget_fraction < 1.0) break;  // on to the next pass
-        bmc_complete = false;
-        budget_note =
-            "the search budget of " + FormatNumber(options_.search_seconds) + " s ran out" +
-            (searched >= 0 ? " after paths of " + std::to_string(searched) + " steps" : "") + "; ";
-        break;
+    if (pinned_only && enc_.uncertain().empty()) continue;  // the next pass covers it
+    for (int n = pass.from; n <= pass.to && Open(); ++n) {
+      const int starved = meter_.starved();
+      if (budget_.used() < pass.ceiling && !budget_.SafetyExpired()) {
+        Search(n, false,
+               enc_.uncertain().empty() ? std::initializer_list<bool>{false} : pass.pinned,
+               pass.ceiling);
       }
-      if (enc.uncertain().empty()) {
-        search(n, false, {false});
-      } else {
-        search(n, false, pass.pinned);
-      }
-      if (!pinned_only) searched = n;
+      const bool cut =
+          meter_.starved() > starved || budget_.used() >= pass.ceiling || budget_.SafetyExpired();
+      if (cut && !pinned_only) search_cut_ = true;
+      if (cut) break;  // the pinned pass leaves the rest of its share to the next one
+      if (!pinned_only) searched_ = n;
     }
-    if (!budget_note.empty()) break;
+    if (search_cut_) break;
   }
-  for (Candidate& c : cands) {
+}
+
+// `reach` target `c`: no initial state is in it, and `not P` is inductive relative to the proved
+// invariants (checked per mode, as the induction).
+bool JobRun::Unreachable(const Candidate& c) {
+  const std::uint64_t ceiling = Ceiling(1.0);
+  if (!meter_.Afford(StepUnits(), ceiling)) return false;
+  z3::solver base = MakeSolver(ctx_);
+  Add(base, enc_, enc_.Initial() && enc_.State(0) && enc_.Holds(c.bad, 0, 0.0));
+  if (meter_.Check(base, options_.resource_limit, ceiling) != z3::unsat) return false;
+  for (int m = 0; m < a_.num_modes(); ++m) {
+    if (!meter_.Afford(StepUnits() * 2, ceiling)) return false;
+    z3::solver s = MakeSolver(ctx_);
+    z3::expr_vector e(ctx_);
+    e.push_back(enc_.State(0));
+    e.push_back(enc_.State(1));
+    e.push_back(enc_.TransitionFrom(0, ModeId(m)));
+    e.push_back(!enc_.Holds(c.bad, 0, 0.0));
+    e.push_back(enc_.Holds(c.bad, 1, 0.0));
+    for (const Candidate& lemma : cands_) {
+      if (lemma.invariant && lemma.proved) e.push_back(!enc_.Holds(lemma.bad, 0, 0.0));
+    }
+    Add(s, enc_, z3::mk_and(e));
+    if (meter_.Check(s, options_.resource_limit, ceiling) != z3::unsat) return false;
+  }
+  return true;
+}
+
+void JobRun::Conclude() {
+  const std::string budget =
+      "the solver budget (" + FormatNumber(budget_.seconds()) + " budget seconds) ran out";
+  std::string note;
+  if (!bmc_complete_ && !proof_cut_ && !search_cut_) {
+    note = "an SMT query ran out of its resource limit; ";
+  }
+  if (budget_.safety_stopped()) {
+    note +=
+        "a solver query was stopped by the wall-clock safety limit, so this result may "
+        "depend on the machine; ";
+  }
+  const std::string depth = std::to_string(options_.max_depth);
+  const std::string paths = searched_ >= 0 ? " after paths of " + std::to_string(searched_) +
+                                                 (searched_ == 1 ? " step" : " steps")
+                                           : " before any path was searched";
+  for (Candidate& c : cands_) {
+    if (c.decided) continue;
+    std::string why = note;
+    if (c.invariant) {
+      why += proof_cut_
+                 ? budget + " before k-induction could prove it"
+                 : "not proved by k-induction for k <= " + std::to_string(options_.max_induction);
+      why += search_cut_ ? "; " + budget + " in the search for counterexamples" + paths
+                         : ", and no counterexample within " + depth + " steps";
+    } else {
+      why += search_cut_ ? budget + " in the search for witnesses" + paths
+                         : "no witness within " + depth + " steps that replays";
+      why += unreach_cut_ ? "; " + budget + " before unreachability could be proved"
+                          : ", and unreachability not proved by induction";
+    }
+    Decide(c, Verdict::kUnknown, why);
+  }
+}
+
+void JobRun::Go() {
+  for (const Goal& g : job_.goals) {
+    const Property& p = g.property;
+    switch (p.kind) {
+      case Property::Kind::kAlways:
+        cands_.push_back({&g, Predicate::Not(p.predicate), true});
+        break;
+      case Property::Kind::kNever:
+        cands_.push_back({&g, p.predicate, true});
+        break;
+      case Property::Kind::kReach:
+        cands_.push_back({&g, p.predicate, false});
+        break;
+    }
+  }
+  // 1. Base case: no violation on paths of fewer than max_induction steps (what k-induction
+  //    needs, whatever max_depth is). Bounded model checking uses Z3's default (incremental)
+  //    solver, which handles long unrollings better than nlsat.
+  Add(bmc_, enc_, enc_.Initial());
+  Add(bmc_, enc_, enc_.State(0));
+  const int starved = meter_.starved();
+  for (int n = 0; n < options_.max_induction; ++n) Search(n, true, {true, false}, Ceiling(0.5));
+  base_complete_ = bmc_complete_;
+  proof_cut_ = meter_.starved() > starved;
+  // 2. k-induction with Houdini over the surviving invariants.
+  const int before_induction = meter_.starved();
+  for (int k = 1; k <= options_.max_induction && Open() && base_complete_; ++k) Induction(k);
+  proof_cut_ = proof_cut_ || meter_.starved() > before_induction;
+  // 3. Counterexamples and witnesses for what is still open.
+  DeepSearch();
+  for (Candidate& c : cands_) {
     if (!c.decided && c.refuted) {
       Decide(c, Verdict::kUnknown,
              "the encoding (an over-approximation) reaches a violation, but no path of at most " +
                  std::to_string(options_.max_depth) + " steps found replays in the simulator");
-      c.decided = true;
     }
   }
-  // 4. Reach targets without a witness: unreachable if `not P` is inductive relative to the
-  //    proved invariants (checked per mode, as above).
-  for (Candidate& c : cands) {
-    if (c.decided || c.invariant || !base_complete) continue;
-    bool inductive = true;
-    for (int m = 0; m < a.num_modes() && inductive; ++m) {
-      z3::solver s = MakeSolver(ctx, options_.resource_limit);
-      z3::expr e = enc.State(0) && enc.State(1) && enc.TransitionFrom(0, ModeId(m)) &&
-                   !enc.Holds(c.bad, 0, 0.0) && enc.Holds(c.bad, 1, 0.0);
-      for (const Candidate& lemma : cands) {
-        if (lemma.invariant && lemma.decided && !lemma.refuted && lemma.proved) {
-          e = e && !enc.Holds(lemma.bad, 0, 0.0);
-        }
-      }
-      Add(s, enc, e);
-      inductive = s.check() == z3::unsat;
-    }
-    if (inductive) {
+  // 4. Reach targets without a witness: unreachable if no initial state is a target and `not P`
+  //    is inductive relative to the proved invariants.
+  for (Candidate& c : cands_) {
+    if (c.decided || c.invariant || c.goal->result < 0) continue;
+    const int starved = meter_.starved();
+    const bool unreachable = Unreachable(c);
+    unreach_cut_ = unreach_cut_ || meter_.starved() > starved;
+    if (unreachable) {
       Decide(c, Verdict::kUnreachable,
              "proved by 1-induction of its negation, with the proved invariants as lemmas");
-      c.decided = true;
     }
   }
-  for (Candidate& c : cands) {
-    if (c.decided) continue;
-    std::string why = !budget_note.empty() ? budget_note
-                      : bmc_complete       ? ""
-                                           : "an SMT query timed out; ";
-    const std::string within =
-        budget_note.empty() ? " within " + std::to_string(options_.max_depth) + " steps" : "";
-    if (c.invariant) {
-      why += "not proved by k-induction for k <= " + std::to_string(options_.max_induction) +
-             " and no counterexample" + within;
-    } else {
-      why += "no witness" + within + " that replays, and unreachability not proved by induction";
-    }
-    Decide(c, Verdict::kUnknown, why);
-  }
+  Conclude();
 }
 
 // Slots and modes a predicate reads.
@@ -532,10 +739,14 @@ void Collect(const Predicate& p, std::set<int>& slots, std::set<std::string>& mo
 
 }  // namespace
 
-std::vector<CheckResult> PropertyProver::Check(const System& system,
-                                               std::span<const Property> properties) const {
-  const Clock::time_point start = Clock::now();
-  std::vector<CheckResult> results(properties.size());
+namespace {
+
+// Sorts `properties` into jobs: one per component for a property that reads only that
+// component's own variables (in its slots and mode names), the product job for the others (made
+// on demand in `product`), or a verdict right away (`unknown`) when neither is possible.
+void PlanJobs(const System& system, std::span<const Property> properties, int max_product_modes,
+              std::vector<CheckResult>& results, std::vector<Job>& jobs,
+              std::optional<Automaton>& product, Job& product_job) {
   const auto components = system.components();
   // Which components write each System slot (continuous variables).
   std::vector<std::vector<int>> owners(system.symbols().size());
@@ -544,9 +755,7 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       owners[components[c].global_slot[v.slot]].push_back(static_cast<int>(c));
     }
   }
-  std::vector<Job> jobs(components.size());
-  std::optional<Automaton> product;
-  Job product_job;
+  std::map<std::string, std::vector<int>> asked;  // goals by their text (see below)
   for (std::size_t i = 0; i < properties.size(); ++i) {
     const Property& p = properties[i];
     results[i].property = p.name;
@@ -559,8 +768,9 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
     for (int s : slots) {
       const SymbolKind kind = system.symbols()[s].kind;
       if (kind == SymbolKind::kInput) {
-        throw std::invalid_argument("PropertyProver::Check: property '" + p.name +
-                                    "' reads input '" + system.symbols()[s].name + "'");
+        throw std::invalid_argument("property '" + p.name + "' reads input '" +
+                                    system.symbols()[s].name +
+                                    "': properties may read variables, parameters and modes");
       }
       if (kind == SymbolKind::kParameter) continue;
       for (std::size_t c = 0; c < components.size(); ++c) {
@@ -599,21 +809,29 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
             auto found = system.FindMode(m);
             return found ? comp.automaton.mode(found->second).name : m;
           });
+      // The same question asked twice is answered once (looked up by its text, then compared).
+      const std::string key = std::to_string(c) + " " + std::string(KindKeyword(q.kind)) + " " +
+                              q.predicate.ToString() + " " +
+                              (q.horizon ? FormatNumber(*q.horizon) : std::string("-"));
       bool same = false;
-      for (Goal& g : jobs[c].goals) {
-        if (g.property.kind == q.kind && g.property.predicate == q.predicate &&
-            g.property.horizon == q.horizon) {
-          g.also.push_back(static_cast<int>(i));
+      for (const int g : asked[key]) {
+        Goal& goal = jobs[c].goals[g];
+        if (goal.property.kind == q.kind && goal.property.predicate == q.predicate &&
+            goal.property.horizon == q.horizon) {
+          goal.also.push_back(static_cast<int>(i));
           same = true;
           break;
         }
       }
-      if (!same) jobs[c].goals.push_back({q, static_cast<int>(i), p, {}});
+      if (!same) {
+        asked[key].push_back(static_cast<int>(jobs[c].goals.size()));
+        jobs[c].goals.push_back({q, static_cast<int>(i), p, {}});
+      }
       continue;
     }
     if (!product) {
       try {
-        product = system.Product(options_.max_product_modes);
+        product = system.Product(max_product_modes);
       } catch (const std::invalid_argument& e) {
         results[i].verdict = Verdict::kUnknown;
         results[i].reason = std::string(
@@ -630,130 +848,214 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
     }
     product_job.goals.push_back({p, static_cast<int>(i), p, {}});
   }
-  Engine engine(system, options_, start, results);
-  for (std::size_t c = 0; c < components.size(); ++c) {
+}
+
+// The declared invariants of component `c` join its job as lemmas.
+void AddLemmas(const System& system, int c, Job& job) {
+  const auto components = system.components();
+  // The component's own declared invariants serve as lemmas.
+  for (const Property& lemma : components[c].automaton.properties()) {
+    if (lemma.kind == Property::Kind::kReach) continue;
+    bool dup = false;
+    for (const Goal& g : job.goals) {
+      dup = dup || (g.property.kind == lemma.kind && g.property.predicate == lemma.predicate &&
+                    g.property.horizon == lemma.horizon);
+    }
+    if (dup) continue;
+    Property original = lemma;
+    original.predicate = Remap(
+        lemma.predicate,
+        [&](const Expression& e) {
+          return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+            return Expression::Symbol(name, components[c].global_slot[slot]);
+          });
+        },
+        [&](const std::string& m) {
+          auto id = components[c].automaton.FindMode(m);
+          return id ? system.QualifiedModeName(c, *id) : m;
+        });
+    job.goals.push_back({lemma, -1, original, {}});
+  }
+}
+
+// An earlier component, instance of the same automaton, whose job asks the same questions as
+// component `c`'s (its proof serves for both), or -1.
+int SameInstance(const System& system, const std::vector<Job>& jobs, int c) {
+  const auto components = system.components();
+  const Job& job = jobs[c];
+  int same = -1;
+  for (int c0 = 0; c0 < c && same < 0; ++c0) {
+    const Job& j0 = jobs[c0];
+    if (j0.goals.size() != job.goals.size() || !(components[c0].source == components[c].source)) {
+      continue;
+    }
+    // Compare with the declared (unqualified) names: slots are the same in both instances.
+    auto plain = [&](const Predicate& p, const Component& comp) {
+      return Remap(
+          p,
+          [&](const Expression& e) {
+            return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
+              return Expression::Symbol(comp.source.symbols()[slot].name, slot);
+            });
+          },
+          [&](const std::string& m) {
+            auto id = comp.automaton.FindMode(m);
+            return id ? comp.source.mode(*id).name : m;
+          });
+    };
+    bool equal = true;
+    for (std::size_t g = 0; g < job.goals.size() && equal; ++g) {
+      const Property& a = j0.goals[g].property;
+      const Property& b = job.goals[g].property;
+      equal = a.kind == b.kind && a.horizon == b.horizon &&
+              plain(a.predicate, components[c0]) == plain(b.predicate, components[c]);
+    }
+    if (equal) same = c0;
+  }
+  return same;
+}
+
+// Copies the results of component `same`'s job to component `c`'s, each trace renamed and
+// replayed for `c` (a trace that does not replay leaves the property `unknown`).
+void CopyShared(const System& system, const std::vector<Job>& jobs, int c, int same,
+                Clock::time_point start, std::vector<CheckResult>& results) {
+  const auto components = system.components();
+  const Job& job = jobs[c];
+  const std::string from = components[same].instance + ".", to = components[c].instance + ".";
+  auto rename = [&](const std::string& name) {
+    return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
+  };
+  for (std::size_t g = 0; g < job.goals.size(); ++g) {
+    const int src = jobs[same].goals[g].result;
+    if (src < 0 || job.goals[g].result < 0) continue;
+    std::vector<int> targets = job.goals[g].also;
+    targets.insert(targets.begin(), job.goals[g].result);
+    for (int dst : targets) {
+      CheckResult r = results[src];
+      r.property = results[dst].property;
+      r.kind = results[dst].kind;
+      if (r.trace) {
+        Trace t = *r.trace;
+        for (auto& [name, v] : t.parameters) name = rename(name);
+        for (auto& [name, v] : t.initial_values) name = rename(name);
+        for (InputSignal& in : t.inputs.inputs) {
+          const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
+          if (slot) in.slot = *slot;
+        }
+        bool ok = false;
+        try {
+          ok = ReplayTrace(system, job.goals[g].original, t);
+        } catch (const std::exception&) {
+        }
+        if (ok) {
+          r.trace = std::move(t);
+        } else {
+          r.trace.reset();
+          r.verdict = Verdict::kUnknown;
+          r.reason = "the trace found for instance " + components[same].instance +
+                     " does not replay for " + components[c].instance;
+        }
+      }
+      r.reason += " (the proof for instance " + components[same].instance +
+                  ", an instance of the same automaton)";
+      r.seconds = Since(start);
+      results[dst] = std::move(r);
+    }
+  }
+}
+
+}  // namespace
+
+SolverBudget::SolverBudget(double seconds) : seconds_(seconds) {
+  if (!(seconds > 0) || !(seconds <= 1e6)) {
+    throw std::invalid_argument("the solver budget must be a number of budget seconds in (0, " +
+                                std::string("1e6], not ") + FormatNumber(seconds));
+  }
+  total_ = static_cast<std::uint64_t>(
+      std::ceil(seconds * static_cast<double>(kResourceUnitsPerBudgetSecond)));
+  start_ = std::chrono::steady_clock::now();
+}
+
+unsigned SolverBudget::SafetyMilliseconds(std::uint64_t units) const {
+  const double ms =
+      10000.0 * static_cast<double>(units) / static_cast<double>(kResourceUnitsPerBudgetSecond);
+  return static_cast<unsigned>(std::clamp(ms, 10000.0, 4.0e9));
+}
+
+bool SolverBudget::SafetyExpired() const { return Since(start_) > std::max(60.0, 10.0 * seconds_); }
+
+double PropertyProver::BudgetSeconds() const {
+  return options_.search_seconds > 0 ? options_.search_seconds : options_.budget;
+}
+
+std::vector<CheckResult> PropertyProver::Check(const System& system,
+                                               std::span<const Property> properties) const {
+  SolverBudget budget(BudgetSeconds());
+  return Check(system, properties, budget);
+}
+
+std::vector<CheckResult> PropertyProver::Check(const System& system,
+                                               std::span<const Property> properties,
+                                               SolverBudget& budget) const {
+  const Clock::time_point start = Clock::now();
+  std::vector<CheckResult> results(properties.size());
+  const auto components = system.components();
+  std::vector<Job> jobs(components.size());
+  std::optional<Automaton> product;
+  Job product_job;
+  PlanJobs(system, properties, options_.max_product_modes, results, jobs, product, product_job);
+  std::vector<int> same(components.size(), -1);
+  int runs = 0;  // jobs that need a check of their own
+  for (int c = 0; c < static_cast<int>(components.size()); ++c) {
     Job& job = jobs[c];
     if (job.goals.empty()) continue;
     job.automaton = &components[c].automaton;
     job.to_system = components[c].global_slot;
-    // The component's own declared invariants serve as lemmas.
-    for (const Property& lemma : components[c].automaton.properties()) {
-      if (lemma.kind == Property::Kind::kReach) continue;
-      bool dup = false;
-      for (const Goal& g : job.goals) {
-        dup = dup || (g.property.kind == lemma.kind && g.property.predicate == lemma.predicate &&
-                      g.property.horizon == lemma.horizon);
-      }
-      if (dup) continue;
-      Property original = lemma;
-      original.predicate = Remap(
-          lemma.predicate,
-          [&](const Expression& e) {
-            return e.Substitute(
-                [&](const std::string& name, int slot) -> std::optional<Expression> {
-                  return Expression::Symbol(name, components[c].global_slot[slot]);
-                });
-          },
-          [&](const std::string& m) {
-            auto id = components[c].automaton.FindMode(m);
-            return id ? system.QualifiedModeName(static_cast<int>(c), *id) : m;
-          });
-      job.goals.push_back({lemma, -1, original, {}});
-    }
-    // Instances of one automaton asked the same questions share the proof: only traces are
-    // carried over (renamed) and replayed for this instance.
-    int same = -1;
-    for (std::size_t c0 = 0; c0 < c && same < 0; ++c0) {
-      const Job& j0 = jobs[c0];
-      if (j0.goals.size() != job.goals.size() || !(components[c0].source == components[c].source)) {
-        continue;
-      }
-      // Compare with the declared (unqualified) names: slots are the same in both instances.
-      auto plain = [&](const Predicate& p, const Component& comp) {
-        return Remap(
-            p,
-            [&](const Expression& e) {
-              return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
-                return Expression::Symbol(comp.source.symbols()[slot].name, slot);
-              });
-            },
-            [&](const std::string& m) {
-              auto id = comp.automaton.FindMode(m);
-              return id ? comp.source.mode(*id).name : m;
-            });
-      };
-      bool equal = true;
-      for (std::size_t g = 0; g < job.goals.size() && equal; ++g) {
-        const Property& a = j0.goals[g].property;
-        const Property& b = job.goals[g].property;
-        equal = a.kind == b.kind && a.horizon == b.horizon &&
-                plain(a.predicate, components[c0]) == plain(b.predicate, components[c]);
-      }
-      if (equal) same = static_cast<int>(c0);
-    }
-    if (same < 0) {
-      engine.Run(job);
-      continue;
-    }
-    const std::string from = components[same].instance + ".", to = components[c].instance + ".";
-    auto rename = [&](const std::string& name) {
-      return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
-    };
-    for (std::size_t g = 0; g < job.goals.size(); ++g) {
-      const int src = jobs[same].goals[g].result;
-      if (src < 0 || job.goals[g].result < 0) continue;
-      std::vector<int> targets = job.goals[g].also;
-      targets.insert(targets.begin(), job.goals[g].result);
-      for (int dst : targets) {
-        CheckResult r = results[src];
-        r.property = results[dst].property;
-        r.kind = results[dst].kind;
-        if (r.trace) {
-          Trace t = *r.trace;
-          for (auto& [name, v] : t.parameters) name = rename(name);
-          for (auto& [name, v] : t.initial_values) name = rename(name);
-          for (InputSignal& in : t.inputs.inputs) {
-            const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
-            if (slot) in.slot = *slot;
-          }
-          bool ok = false;
-          try {
-            ok = ReplayTrace(system, job.goals[g].original, t);
-          } catch (const std::exception&) {
-          }
-          if (ok) {
-            r.trace = std::move(t);
-          } else {
-            r.trace.reset();
-            r.verdict = Verdict::kUnknown;
-            r.reason = "the trace found for instance " + components[same].instance +
-                       " does not replay for " + components[c].instance;
-          }
-        }
-        r.reason += " (the proof for instance " + components[same].instance +
-                    ", an instance of the same automaton)";
-        r.seconds = Since(start);
-        results[dst] = std::move(r);
-      }
-    }
+    AddLemmas(system, c, job);
+    same[c] = SameInstance(system, jobs, c);
+    if (same[c] < 0) ++runs;
   }
   if (product && !product_job.goals.empty()) {
     product_job.automaton = &*product;
     for (int s = 0; s < system.symbols().size(); ++s) product_job.to_system.push_back(s);
-    engine.Run(product_job);
+    ++runs;
+  }
+  // Each job gets an equal share of what is left of the budget; what one leaves goes on.
+  auto run = [&](const Job& job) {
+    const std::uint64_t share = budget.remaining() / std::max(runs--, 1);
+    JobRun(system, options_, budget, start, results, job, share).Go();
+  };
+  for (int c = 0; c < static_cast<int>(components.size()); ++c) {
+    if (jobs[c].goals.empty()) continue;
+    if (same[c] < 0) {
+      run(jobs[c]);
+    } else {
+      CopyShared(system, jobs, c, same[c], start, results);
+    }
+  }
+  if (product && !product_job.goals.empty()) run(product_job);
+  // The gate of every verdict that rests on a trace: a fresh replay.
+  for (std::size_t i = 0; i < properties.size(); ++i) {
+    ConfirmTrace(system, properties[i], results[i]);
   }
   return results;
 }
 
 std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(const System& system,
                                                                              int component) const {
+  SolverBudget budget(BudgetSeconds());
+  return ReachableModes(system, component, budget);
+}
+
+std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(
+    const System& system, int component, SolverBudget& budget) const {
   const Component& comp = system.components()[component];
   std::vector<Property> queries;
   for (int m = 0; m < comp.automaton.num_modes(); ++m) {
     const std::string name = system.QualifiedModeName(component, ModeId(m));
     queries.push_back({"reach " + name, Property::Kind::kReach, Predicate::InMode(name), {}});
   }
-  const std::vector<CheckResult> results = Check(system, queries);
+  const std::vector<CheckResult> results = Check(system, queries, budget);
   std::vector<ModeReachability> out;
   for (int m = 0; m < comp.automaton.num_modes(); ++m) {
     const Mode& mode = comp.automaton.mode(ModeId(m));

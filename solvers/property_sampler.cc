@@ -19,7 +19,7 @@ namespace hybrid {
 namespace {
 
 [[noreturn]] void Fail(const std::string& message) {
-  throw std::invalid_argument("PropertySampler: " + message);
+  throw std::invalid_argument("sampling: " + message);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -470,6 +470,7 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
       result.reason += ", " + Plural(pieces, "input piece");
     }
     result.trace = std::move(best);
+    ConfirmTrace(system, property, result);  // the gate of every reported trace
     return finish(std::move(result));
   }
 

@@ -69,7 +69,7 @@ class PropertySampler {
 
   /// Default options.
   PropertySampler();
-  /// Throws std::invalid_argument ("PropertySampler: ...") for options out of range.
+  /// Throws std::invalid_argument ("sampling: ...") for options out of range.
   explicit PropertySampler(Options options);
 
   const Options& options() const { return options_; }
@@ -83,7 +83,7 @@ class PropertySampler {
   /// clock time. The trace lists every uncertain parameter and every interval initial value, also
   /// those left at their nominal value or midpoint.
   ///
-  /// Throws std::invalid_argument ("PropertySampler: ...") for misuse: a non-positive or
+  /// Throws std::invalid_argument ("sampling: ...") for misuse: a non-positive or
   /// non-finite horizon, an input with non-finite or empty bounds, an uncertain parameter whose
   /// nominal value lies outside its range, a system the simulator rejects (no initial state), or a
   /// model that rejects every drawn run.

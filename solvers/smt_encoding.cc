@@ -167,8 +167,8 @@ void Factor(const Expression& e, bool numerator, std::vector<std::pair<Expressio
 SmtEncoding::SmtEncoding(z3::context& ctx, const Automaton& automaton)
     : ctx_(ctx), automaton_(automaton) {
   if (automaton.initial_states().empty()) {
-    throw std::invalid_argument("SmtEncoding: automaton '" + automaton.name() +
-                                "' has no initial state");
+    throw std::invalid_argument("automaton '" + automaton.name() +
+                                "' has no initial state: nothing to verify");
   }
   const int n = automaton.symbols().size();
   var_index_.assign(n, -1);
@@ -189,7 +189,7 @@ SmtEncoding::SmtEncoding(z3::context& ctx, const Automaton& automaton)
   for (const auto& [slot, value] : automaton.parameters()) {
     const std::string& name = automaton.symbols()[slot].name;
     if (automaton.ParameterRange(slot)) {
-      z3::expr p = ctx_.real_const(("p:" + name).c_str());
+      z3::expr p = ctx_.real_const(ConstantName("p", slot, -1).c_str());
       params_[slot] = p;
       uncertain_slot_[slot] = true;
       uncertain_.emplace_back(name, p);
@@ -206,6 +206,10 @@ SmtEncoding::SmtEncoding(z3::context& ctx, const Automaton& automaton)
   }
   for (const z3::expr& d : definitions_) parameter_definitions_.push_back(d);
   definitions_.clear();
+  outgoing_.assign(automaton.num_modes(), {});
+  for (int t = 0; t < automaton.num_transitions(); ++t) {
+    outgoing_[automaton.transitions()[t].source.value()].push_back(t);
+  }
   Classify();
 }
 
@@ -224,9 +228,7 @@ z3::expr SmtEncoding::TakeDefinitions() {
   return out;
 }
 
-z3::expr SmtEncoding::Fresh(const std::string& prefix) {
-  return ctx_.real_const((prefix + "#" + std::to_string(fresh_++)).c_str());
-}
+z3::expr SmtEncoding::Fresh() { return ctx_.real_const(ConstantName("aux", fresh_++, -1).c_str()); }
 
 Expression SmtEncoding::Fold(const Expression& e) const {
   return e
@@ -383,38 +385,64 @@ void SmtEncoding::Classify() {
   }
 }
 
+std::string SmtEncoding::ConstantName(std::string_view kind, int index, int step) {
+  std::string out(kind);
+  if (index >= 0) out += "." + std::to_string(index);
+  if (step >= 0) out += "@" + std::to_string(step);
+  return out;
+}
+
 SmtEncoding::StepVars& SmtEncoding::Vars(int k) {
   while (static_cast<int>(steps_.size()) <= k) {
-    const std::string s = std::to_string(steps_.size());
-    StepVars v{
-        {}, {}, {}, {}, ctx_.real_const(("d@" + s).c_str()), ctx_.bool_const(("flow@" + s).c_str()),
-        {}};
-    for (const Mode& m : automaton_.modes()) {
-      v.mode.push_back(ctx_.bool_const(("mode:" + m.name + "@" + s).c_str()));
+    const int s = static_cast<int>(steps_.size());
+    auto real = [&](std::string_view kind, int index) {
+      return ctx_.real_const(ConstantName(kind, index, s).c_str());
+    };
+    auto boolean = [&](std::string_view kind, int index) {
+      return ctx_.bool_const(ConstantName(kind, index, s).c_str());
+    };
+    StepVars v{{}, {}, {}, {}, real("d", -1), boolean("flow", -1), {}, {}};
+    for (int m = 0; m < automaton_.num_modes(); ++m) {
+      v.mode.push_back(boolean("mode", m));
+      v.amo.push_back(boolean("amo", m));
     }
-    for (int slot : var_slots_) {
-      v.x.push_back(ctx_.real_const((automaton_.symbols()[slot].name + "@" + s).c_str()));
+    for (std::size_t i = 0; i < var_slots_.size(); ++i) v.x.push_back(real("x", i));
+    for (std::size_t i = 0; i < input_slots_.size(); ++i) {
+      v.u.push_back(real("u", i));
+      v.v.push_back(real("V", i));
     }
-    for (int slot : input_slots_) {
-      const std::string& n = automaton_.symbols()[slot].name;
-      v.u.push_back(ctx_.real_const((n + "@" + s).c_str()));
-      v.v.push_back(ctx_.real_const(("int:" + n + "@" + s).c_str()));
-    }
-    for (const hybrid::Transition& t : automaton_.transitions()) {
-      v.jump.push_back(ctx_.bool_const(("jump:" + t.name + "@" + s).c_str()));
-    }
+    for (int t = 0; t < automaton_.num_transitions(); ++t) v.jump.push_back(boolean("jump", t));
     steps_.push_back(std::move(v));
   }
   return steps_[k];
 }
 
-std::vector<std::optional<z3::expr>> SmtEncoding::Env(int k) {
-  StepVars& v = Vars(k);
-  std::vector<std::optional<z3::expr>> env = params_;
-  for (std::size_t i = 0; i < var_slots_.size(); ++i) env[var_slots_[i]] = v.x[i];
-  for (std::size_t i = 0; i < input_slots_.size(); ++i) env[input_slots_[i]] = v.u[i];
-  for (int slot : automaton_.discrete_variables()) env[slot] = Discrete(k, slot);
-  return env;
+const std::vector<std::optional<z3::expr>>& SmtEncoding::Env(int k) {
+  while (static_cast<int>(envs_.size()) <= k) {
+    const int s = static_cast<int>(envs_.size());
+    StepVars& v = Vars(s);
+    std::vector<std::optional<z3::expr>> env = params_;
+    for (std::size_t i = 0; i < var_slots_.size(); ++i) env[var_slots_[i]] = v.x[i];
+    for (std::size_t i = 0; i < input_slots_.size(); ++i) env[input_slots_[i]] = v.u[i];
+    for (int slot : automaton_.discrete_variables()) env[slot] = Discrete(s, slot);
+    envs_.push_back(std::move(env));
+  }
+  return envs_[k];
+}
+
+z3::expr SmtEncoding::Reuse(std::deque<std::optional<Built>>& cache, int k,
+                            const std::function<z3::expr()>& build) {
+  while (static_cast<int>(cache.size()) <= k) cache.emplace_back();
+  if (!cache[k]) {
+    // Build with the pending definitions set aside: the cache keeps exactly this formula's.
+    std::vector<z3::expr> pending = std::move(definitions_);
+    definitions_.clear();
+    z3::expr formula = build();
+    cache[k] = Built{formula, std::move(definitions_)};
+    definitions_ = std::move(pending);
+  }
+  for (const z3::expr& d : cache[k]->definitions) definitions_.push_back(d);
+  return cache[k]->formula;
 }
 
 z3::expr SmtEncoding::Discrete(int k, int slot) {
@@ -440,7 +468,7 @@ z3::expr SmtEncoding::Translate(const Expression& e,
         break;
       case Op::kSymbol:
         if (!env.at(x.slot())) {
-          throw std::logic_error("SmtEncoding: no value for '" + x.symbol_name() + "'");
+          throw std::logic_error("verification: no value for '" + x.symbol_name() + "'");
         }
         out = *env[x.slot()];
         break;
@@ -463,7 +491,7 @@ z3::expr SmtEncoding::Translate(const Expression& e,
         } else {
           // q = num / den as the polynomial definition den q = num (den != 0), so that the
           // formulas stay polynomial (nlsat); q is unconstrained where den = 0 (undefined).
-          out = Fresh("div");
+          out = Fresh();
           definitions_.push_back(z3::implies(den != 0, out * den == num));
         }
         break;
@@ -478,7 +506,7 @@ z3::expr SmtEncoding::Translate(const Expression& e,
           for (int i = 0; i < std::abs(n); ++i) p = i == 0 ? b : p * b;
           out = n >= 0 ? p : Num(ctx_, 1.0) / p;
         } else {
-          out = Fresh("pow");
+          out = Fresh();
         }
         break;
       }
@@ -504,7 +532,7 @@ z3::expr SmtEncoding::Translate(const Expression& e,
       }
       default:
         // Transcendental functions: an unconstrained value (a sound over-approximation).
-        out = Fresh(std::string(FunctionName(x.op()).value_or("f")));
+        out = Fresh();
         break;
     }
     memo.emplace(x.node_id(), out);
@@ -541,7 +569,6 @@ z3::expr SmtEncoding::Conjunction(const Constraint& c,
 
 z3::expr SmtEncoding::Initial() {
   StepVars& v = Vars(0);
-  const auto env = Env(0);
   z3::expr out = ctx_.bool_val(true);
   for (const auto& [slot, value] : automaton_.parameters()) {
     if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
@@ -566,41 +593,48 @@ z3::expr SmtEncoding::Initial() {
 }
 
 z3::expr SmtEncoding::State(int k) {
-  StepVars& v = Vars(k);
-  const auto env = Env(k);
-  z3::expr_vector modes(ctx_);
-  for (const auto& b : v.mode) modes.push_back(b);
-  // Exactly one mode (pairwise at-most-one: plain clauses, which every Z3 tactic accepts).
-  // Built as one flat conjunction: a long chain of binary `&&` is slow for Z3 to free.
-  z3::expr_vector clauses(ctx_);
-  clauses.push_back(z3::mk_or(modes));
-  for (std::size_t i = 0; i < v.mode.size(); ++i) {
-    for (std::size_t j = i + 1; j < v.mode.size(); ++j) clauses.push_back(!v.mode[i] || !v.mode[j]);
-  }
-  z3::expr out = z3::mk_and(clauses);
-  for (const z3::expr& d : parameter_definitions_) out = out && d;
-  // Uncertain parameters stay in their ranges in every state (also in induction steps, which
-  // do not start from an initial state).
-  for (const auto& [slot, value] : automaton_.parameters()) {
-    if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
-      out = out && Translate(range->lo, params_) <= *params_[slot] &&
-            *params_[slot] <= Translate(range->hi, params_);
+  return Reuse(states_, k, [&] {
+    StepVars& v = Vars(k);
+    const auto& env = Env(k);
+    // One flat conjunction of plain clauses (which every Z3 tactic accepts; a long chain of
+    // binary `&&` is slow for Z3 to free).
+    z3::expr_vector clauses(ctx_);
+    // Exactly one mode: at least one, and at most one by a ladder (amo[m]: some mode <= m),
+    // linear in the number of modes.
+    z3::expr_vector modes(ctx_);
+    for (const auto& b : v.mode) modes.push_back(b);
+    clauses.push_back(z3::mk_or(modes));
+    for (std::size_t m = 0; m < v.mode.size(); ++m) {
+      clauses.push_back(!v.mode[m] || v.amo[m]);
+      if (m == 0) continue;
+      clauses.push_back(!v.amo[m - 1] || v.amo[m]);
+      clauses.push_back(!v.amo[m - 1] || !v.mode[m]);
     }
-  }
-  for (int m = 0; m < automaton_.num_modes(); ++m) {
-    const Constraint& inv = automaton_.modes()[m].invariant;
-    if (!inv.empty()) out = out && z3::implies(v.mode[m], Conjunction(inv, env));
-  }
-  for (std::size_t i = 0; i < input_slots_.size(); ++i) {
-    out = out && Num(ctx_, input_lo_[i]) <= v.u[i] && v.u[i] <= Num(ctx_, input_hi_[i]);
-  }
-  return out;
+    for (const z3::expr& d : parameter_definitions_) clauses.push_back(d);
+    // Uncertain parameters stay in their ranges in every state (also in induction steps, which
+    // do not start from an initial state).
+    for (const auto& [slot, value] : automaton_.parameters()) {
+      if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
+        clauses.push_back(Translate(range->lo, params_) <= *params_[slot]);
+        clauses.push_back(*params_[slot] <= Translate(range->hi, params_));
+      }
+    }
+    for (int m = 0; m < automaton_.num_modes(); ++m) {
+      const Constraint& inv = automaton_.modes()[m].invariant;
+      if (!inv.empty()) clauses.push_back(z3::implies(v.mode[m], Conjunction(inv, env)));
+    }
+    for (std::size_t i = 0; i < input_slots_.size(); ++i) {
+      clauses.push_back(Num(ctx_, input_lo_[i]) <= v.u[i]);
+      clauses.push_back(v.u[i] <= Num(ctx_, input_hi_[i]));
+    }
+    return z3::mk_and(clauses);
+  });
 }
 
 z3::expr SmtEncoding::InMode(int k, ModeId m) { return Vars(k).mode.at(m.value()); }
 
 z3::expr SmtEncoding::Holds(const Predicate& p, int k, double tolerance) {
-  const auto env = Env(k);
+  const auto& env = Env(k);
   std::function<z3::expr(const Predicate&, bool)> go = [&](const Predicate& q,
                                                            bool positive) -> z3::expr {
     switch (q.kind()) {
@@ -660,8 +694,8 @@ z3::expr SmtEncoding::Flow(int k, int mode) {
       out = out && link(i);
       const int w = info.driver;
       out = out && b.x[w] == a.x[w] + Num(ctx_, info.driver_rate) * a.v[i];
-      const auto env0 = Env(k);
-      const auto env1 = Env(k + 1);
+      const auto& env0 = Env(k);
+      const auto& env1 = Env(k + 1);
       for (const SeparableFlow& sf : info.separable) {
         const z3::expr K = Translate(sf.k, env0);
         const z3::expr dv = b.x[sf.var] - a.x[sf.var];
@@ -769,13 +803,11 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   }
   std::vector<bool> moving(var_slots_.size(), false);
   for (int v : info.moving) moving[v] = true;
-  const auto env = Env(k);
+  const auto& env = Env(k);
   z3::expr out = ctx_.bool_val(true);
-  const Mode& m = automaton_.modes()[mode];
-  (void)m;
-  for (int t = 0; t < automaton_.num_transitions(); ++t) {
+  for (int t : outgoing_[mode]) {
     const hybrid::Transition& tr = automaton_.transitions()[t];
-    if (tr.source.value() != mode || tr.urgency != Urgency::kUrgent) continue;
+    if (tr.urgency != Urgency::kUrgent) continue;
     struct Atom {
       z3::expr alpha;
       double beta;      // sign and magnitude (for the case split)
@@ -886,7 +918,7 @@ z3::expr SmtEncoding::Jump(int k, int t) {
   const hybrid::Transition& tr = automaton_.transitions()[t];
   StepVars& a = Vars(k);
   StepVars& b = Vars(k + 1);
-  const auto env = Env(k);
+  const auto& env = Env(k);
   z3::expr out =
       a.mode[tr.source.value()] && b.mode[tr.target.value()] && Conjunction(tr.guard, env);
   std::vector<bool> reset(var_slots_.size(), false);
@@ -907,25 +939,27 @@ z3::expr SmtEncoding::TransitionFrom(int k, ModeId m) {
   const int mode = m.value();
   z3::expr_vector options(ctx_);
   options.push_back(a.flow && b.mode[mode] && Flow(k, mode));
-  for (int t = 0; t < automaton_.num_transitions(); ++t) {
-    if (automaton_.transitions()[t].source == m) options.push_back(a.jump[t] && Jump(k, t));
-  }
+  for (int t : outgoing_[mode]) options.push_back(a.jump[t] && Jump(k, t));
   return a.mode[mode] && z3::mk_or(options);
 }
 
 z3::expr SmtEncoding::Transition(int k) {
-  StepVars& a = Vars(k);
-  StepVars& b = Vars(k + 1);
-  z3::expr flow = a.flow;
-  for (int m = 0; m < automaton_.num_modes(); ++m) {
-    flow = flow && (a.mode[m] == b.mode[m]) && z3::implies(a.mode[m], Flow(k, m));
-  }
-  z3::expr_vector options(ctx_);
-  options.push_back(flow);
-  for (int t = 0; t < automaton_.num_transitions(); ++t) {
-    options.push_back(a.jump[t] && Jump(k, t));
-  }
-  return z3::mk_or(options);
+  return Reuse(transitions_, k, [&] {
+    StepVars& a = Vars(k);
+    StepVars& b = Vars(k + 1);
+    z3::expr_vector flow(ctx_);
+    flow.push_back(a.flow);
+    for (int m = 0; m < automaton_.num_modes(); ++m) {
+      flow.push_back(a.mode[m] == b.mode[m]);
+      flow.push_back(z3::implies(a.mode[m], Flow(k, m)));
+    }
+    z3::expr_vector options(ctx_);
+    options.push_back(z3::mk_and(flow));
+    for (int t = 0; t < automaton_.num_transitions(); ++t) {
+      options.push_back(a.jump[t] && Jump(k, t));
+    }
+    return z3::mk_or(options);
+  });
 }
 
 std::vector<SmtEncoding::PathStep> SmtEncoding::ReadPath(const z3::model& model, int n) {
@@ -945,7 +979,7 @@ std::vector<SmtEncoding::PathStep> SmtEncoding::ReadPath(const z3::model& model,
       // Which step was taken: a jump whose selector and constraints hold, else the flow.
       s.flow = model.eval(v.flow, true).is_true();
       if (!s.flow) {
-        for (int t = 0; t < automaton_.num_transitions(); ++t) {
+        for (int t : outgoing_[s.mode]) {
           if (model.eval(v.jump[t], true).is_true() && model.eval(Jump(k, t), true).is_true()) {
             s.transition = t;
             break;
@@ -953,24 +987,52 @@ std::vector<SmtEncoding::PathStep> SmtEncoding::ReadPath(const z3::model& model,
         }
         if (s.transition < 0) s.flow = true;
       }
-      if (s.flow) {
-        // Duration for the representative input: |V| / |u| for the input that moves, else d.
-        s.duration = ValueOf(model, v.d);
-        for (std::size_t i = 0; i < v.u.size(); ++i) {
-          const double V = ValueOf(model, v.v[i]);
-          if (V == 0.0) continue;
-          // The representative input: the model's, unless it is so slow that the segment would
-          // last absurdly long; then full speed in its direction.
-          double& u = s.input[i];
-          const double full = V > 0 ? input_hi_[i] : input_lo_[i];
-          if (!(u * V > 0) || std::abs(u) < 1e-3 * std::abs(full)) u = full;
-          s.duration = V / u;
-        }
-      }
+      if (s.flow) ReadFlow(model, v, s);
     }
     out.push_back(std::move(s));
   }
   return out;
+}
+
+void SmtEncoding::ReadFlow(const z3::model& model, const StepVars& v, PathStep& s) {
+  const ModeInfo& info = modes_[s.mode];
+  const int ni = static_cast<int>(input_slots_.size());
+  s.duration = ValueOf(model, v.d);
+  // The inputs the flow reads, with their integrals V_i over the segment.
+  std::vector<int> read;
+  bool drift = false;
+  if (info.flow_class == FlowClass::kConstantRate) {
+    for (int i = 0; i < ni; ++i) {
+      bool rated = false;
+      for (int x : info.moving) rated = rated || info.rate[x][i] != 0.0;
+      if (rated) read.push_back(i);
+    }
+    for (int x : info.moving) drift = drift || info.drift[x] != 0.0;
+  } else if (info.flow_class == FlowClass::kSeparable) {
+    read.push_back(info.input);
+  }
+  // Inputs the flow does not read keep the model's value (the one its guards were evaluated
+  // with); so do all inputs of a kGeneral flow, whose endpoints the encoding does not follow.
+  if (read.empty()) return;
+  if (!drift && read.size() == 1) {
+    // The path depends only on V: any speed of V's sign follows it. The model's input (what
+    // guards reading the input saw), unless it is so slow that the segment would last absurdly
+    // long; then full speed in its direction.
+    const int i = read[0];
+    const double V = ValueOf(model, v.v[i]);
+    double& u = s.input[i];
+    if (V == 0.0) {
+      u = 0.0;  // nothing moves: the input is off for the segment's duration
+      return;
+    }
+    const double full = V > 0 ? input_hi_[i] : input_lo_[i];
+    if (!(u * V > 0) || std::abs(u) < 1e-3 * std::abs(full)) u = full;
+    s.duration = V / u;
+    return;
+  }
+  // Drift or several inputs: the segment lasts d and each input is held at its mean V_i / d,
+  // which reaches the encoded endpoint exactly (x1 = x0 + r0 d + sum_i r_i V_i).
+  for (int i : read) s.input[i] = s.duration > 0 ? ValueOf(model, v.v[i]) / s.duration : 0.0;
 }
 
 std::vector<std::pair<std::string, double>> SmtEncoding::ReadParameters(const z3::model& model) {

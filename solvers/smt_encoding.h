@@ -5,9 +5,11 @@
 #include <z3++.h>
 
 #include <deque>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <vector>
 
@@ -55,6 +57,17 @@ std::string FlowClassName(FlowClass c);
 ///   or drift and no input; kSeparable when the comparisons read one moving variable); other
 ///   urgent transitions are not encoded (sound: more paths);
 /// - lazy transitions, declaration-order priority and Zeno limits are not encoded (more paths).
+///
+/// Names: every Z3 constant is named from a fixed kind and indices only ("x.3@2": continuous
+/// variable 3 at s_2; "u.", "V." inputs and their integrals, "d@", "flow@", "mode.", "jump.",
+/// "amo." at-most-one auxiliaries, "p." parameters by slot, "aux." auxiliaries), never from a
+/// name of the model: no model name can meet one of the encoding's, whatever it is called. The
+/// names are unique within one encoding, so `ctx` must not hold the constants of another
+/// SmtEncoding (one context per encoding).
+///
+/// Size: linear in the numbers of modes and transitions per step (exactly-one-mode by a ladder
+/// of auxiliary Booleans, transitions indexed by source mode); State(k) and Transition(k) are
+/// built once and reused.
 class SmtEncoding {
  public:
   /// Throws std::invalid_argument if `automaton` has no initial state.
@@ -99,6 +112,11 @@ class SmtEncoding {
   /// Values of the uncertain parameters in `model`.
   std::vector<std::pair<std::string, double>> ReadParameters(const z3::model& model);
 
+  /// The Z3 name of a constant of the encoding: `kind` (one of the fixed kinds listed in the
+  /// class comment), `index` (>= 0, or -1 for none) and `step` (>= 0, or -1 for none), e.g.
+  /// ConstantName("x", 3, 2) == "x.3@2". Exposed for tests.
+  static std::string ConstantName(std::string_view kind, int index, int step);
+
  private:
   struct StepVars {
     std::vector<z3::expr> mode;  // one Bool per mode
@@ -108,6 +126,12 @@ class SmtEncoding {
     z3::expr d;                  // duration of the flow from this state
     z3::expr flow;               // Bool: the step from here is a flow
     std::vector<z3::expr> jump;  // Bool per transition: the step from here is that jump
+    std::vector<z3::expr> amo;   // ladder: amo[m] = some mode <= m holds (at most one mode)
+  };
+  // A formula built once, with the definitions of the auxiliaries it introduced.
+  struct Built {
+    z3::expr formula;
+    std::vector<z3::expr> definitions;
   };
   struct SeparableFlow {
     int var = -1;                              // variable index
@@ -132,7 +156,11 @@ class SmtEncoding {
   };
 
   StepVars& Vars(int k);
-  std::vector<std::optional<z3::expr>> Env(int k);
+  // The duration and representative inputs of the flow from `v` (s.mode, s.input set).
+  void ReadFlow(const z3::model& model, const StepVars& v, PathStep& s);
+  const std::vector<std::optional<z3::expr>>& Env(int k);
+  z3::expr Reuse(std::deque<std::optional<Built>>& cache, int k,
+                 const std::function<z3::expr()>& build);
   z3::expr Translate(const Expression& e, const std::vector<std::optional<z3::expr>>& env);
   z3::expr Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
                    double margin);
@@ -143,7 +171,7 @@ class SmtEncoding {
   z3::expr Discrete(int k, int slot);
   Expression Fold(const Expression& e) const;
   void Classify();
-  z3::expr Fresh(const std::string& prefix);
+  z3::expr Fresh();
 
   z3::context& ctx_;
   const Automaton& automaton_;
@@ -160,6 +188,9 @@ class SmtEncoding {
   std::vector<z3::expr> definitions_;
   std::vector<z3::expr> parameter_definitions_;  // asserted with every State
   std::deque<StepVars> steps_;                   // deque: references stay valid as steps are added
+  std::deque<std::vector<std::optional<z3::expr>>> envs_;  // Env(k), per step
+  std::deque<std::optional<Built>> states_, transitions_;  // State(k), Transition(k)
+  std::vector<std::vector<int>> outgoing_;                 // per mode: transitions from it
   int fresh_ = 0;
 };
 

@@ -122,7 +122,7 @@ bool ReplayTrace(const System& system, const Property& property, Trace& trace,
   for (const auto& [name, value] : trace.parameters) copy.SetParameter(name, value);
   for (const auto& [name, value] : trace.initial_values) copy.SetInitialValue(name, value);
   if (!(trace.inputs.until > 0.0) || !std::isfinite(trace.inputs.until)) {
-    throw std::invalid_argument("ReplayTrace: the trace's horizon must be positive and finite");
+    throw std::invalid_argument("replay: the trace's horizon must be positive and finite");
   }
   const Simulator simulator(copy);
   SimulationOptions sim;

@@ -127,8 +127,8 @@ int RunCheck(const CheckArgs& args) {
     throw std::invalid_argument("--induction must be in [1, 100]");
   }
   if (args.runs < 1) throw std::invalid_argument("--runs must be positive");
-  if (!(args.budget > 0) || !std::isfinite(args.budget)) {
-    throw std::invalid_argument("--budget must be a positive number of seconds");
+  if (!(args.budget > 0) || !(args.budget <= 1e6)) {
+    throw std::invalid_argument("--budget must be a number of budget seconds in (0, 1e6]");
   }
   const auto start = std::chrono::steady_clock::now();
   const System system = ParseModelFile(args.model);
@@ -150,13 +150,14 @@ int RunCheck(const CheckArgs& args) {
       chosen.push_back(*it);
     }
   }
+  // One solver budget for the whole command: the properties, then --modes, draw from it.
+  SolverBudget budget(args.budget);
+  PropertyProver::Options prove;
+  prove.max_depth = args.depth;
+  prove.max_induction = args.induction;
   std::vector<CheckResult> results;
   if (args.method == "prove") {
-    PropertyProver::Options options;
-    options.max_depth = args.depth;
-    options.max_induction = args.induction;
-    options.search_seconds = args.budget;
-    results = PropertyProver(options).Check(system, chosen);
+    results = PropertyProver(prove).Check(system, chosen, budget);
   } else {
     PropertySampler::Options options;
     options.runs = args.runs;
@@ -166,12 +167,8 @@ int RunCheck(const CheckArgs& args) {
   }
   std::vector<std::vector<PropertyProver::ModeReachability>> modes;
   if (args.modes) {
-    PropertyProver::Options options;
-    options.max_depth = args.depth;
-    options.max_induction = args.induction;
-    options.search_seconds = args.budget;
     for (std::size_t c = 0; c < system.components().size(); ++c) {
-      modes.push_back(PropertyProver(options).ReachableModes(system, static_cast<int>(c)));
+      modes.push_back(PropertyProver(prove).ReachableModes(system, static_cast<int>(c), budget));
     }
   }
   const double seconds =

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -92,7 +94,7 @@ PropertyProver::Options Small() {
   PropertyProver::Options o;
   o.max_depth = 4;
   o.max_induction = 2;
-  o.search_seconds = 5.0;
+  o.budget = 5.0;
   return o;
 }
 
@@ -276,8 +278,225 @@ TEST(PropertyProver, PropertyReadingAnInputThrows) {
     PropertyProver(Small()).Check(system, std::vector<Property>{bad});
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("PropertyProver"), std::string::npos) << e.what();
+    // A message for the user: the property and the input, no C++ names.
+    const std::string what = e.what();
+    EXPECT_NE(what.find("property 'reads_u' reads input 'u'"), std::string::npos) << what;
+    EXPECT_EQ(what.find("::"), std::string::npos) << what;
+    EXPECT_EQ(what.find("PropertyProver"), std::string::npos) << what;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Soundness by construction: the encoding's own names never meet the model's.
+
+// The tank of issue 12: h starts at 5 and rises at 0.5 + d in [0.3, 0.5] per second (d in
+// [-0.2, 0]) up to the invariant h <= 8. By hand: h = 6 after at most 1 / 0.3 s and h = 7 after
+// at most 2 / 0.3 s, both below 8, whatever the input: `always h <= 6` is violated and
+// `reach h >= 7` reachable. An input named d once shared its Z3 constant with the duration of a
+// flow step ("d@0"): the duration was then the input's value, at most 0, no flow could move h,
+// and the prover said `proved` and `unreachable`.
+constexpr std::string_view kTankModel = R"(
+automaton tank {
+  var h in [0, 10];
+  input d in [-0.2, 0];
+  mode fill { h' = 0.5 + d; inv h <= 8; }
+  init fill { h = 5; }
+  property stays_below_6: always h <= 6;
+  property reaches_7: reach h >= 7;
+}
+)";
+
+// The tank's verdicts with the hand-derived truth: violated at h > 6, reachable at h >= 7, each
+// with a trace that replays independently. `label` names the variant in failures.
+void ExpectTankVerdicts(const System& tank, const std::string& h, const std::string& label) {
+  const std::vector<CheckResult> results = PropertyProver(Small()).Check(tank, tank.properties());
+  ASSERT_EQ(results.size(), 2u) << label;
+  for (const CheckResult& r : results) {
+    EXPECT_NE(r.verdict, Verdict::kProved) << label << ": " << r.reason;
+    EXPECT_NE(r.verdict, Verdict::kUnreachable) << label << ": " << r.reason;
+  }
+  ASSERT_EQ(results[0].verdict, Verdict::kViolated) << label << ": " << results[0].reason;
+  const Trace below = Replayed(tank, Named(tank, "stays_below_6"), results[0]);
+  EXPECT_GT(AtTarget(tank, below, h), 6.0) << label;
+  ASSERT_EQ(results[1].verdict, Verdict::kReachable) << label << ": " << results[1].reason;
+  const Trace reach = Replayed(tank, Named(tank, "reaches_7"), results[1]);
+  EXPECT_GE(AtTarget(tank, reach, h), 7.0 - 1e-6) << label;
+}
+
+TEST(PropertyProverNames, TankOfTheIssueIsViolatedAndReachable) {
+  ExpectTankVerdicts(Parse(kTankModel), "h", "input d");
+}
+
+// Names a model may use that look like the encoding's own (durations d, flags flow, integrals,
+// parameters, auxiliaries, modes, jumps, steps) or like common short names.
+const std::vector<std::string> kInternalLookingNames = {
+    "d",   "t",   "s",    "dt",    "u",      "v",   "V",   "x",   "p",    "q",      "k",
+    "n",   "f",   "flow", "int",   "jump",   "amo", "aux", "div", "pow",  "d0",     "x0",
+    "d_0", "p_d", "u_0",  "mode_", "flow_0", "_",   "_d",  "D",   "Flow", "jump_0", "aux_1"};
+
+// The tank with its input, its variable, its mode, or an uncertain parameter of its invariant
+// named `name` (the other names are fresh: w, level, run). The truth is the tank's in every
+// variant: the rate stays in [0.35, 0.5] and the invariant at 8 or above (the parameter ranges
+// over [3, 3.5]: level <= name + 5).
+std::string TankNamed(const std::string& role, const std::string& name) {
+  const std::string input = role == "input" ? name : "w";
+  const std::string var = role == "variable" ? name : "level";
+  const std::string mode = role == "mode" ? name : "run";
+  std::string text = "automaton tank {\n";
+  if (role == "parameter") text += "  param " + name + " = 3 in [3, 3.5];\n";
+  const std::string top = role == "parameter" ? name + " + 5" : "8";
+  text += "  var " + var + " in [0, 10];\n";
+  text += "  input " + input + " in [-0.15, 0];\n";
+  text += "  mode " + mode + " { " + var + "' = 0.5 + " + input + "; inv " + var + " <= " + top +
+          "; }\n";
+  text += "  init " + mode + " { " + var + " = 5; }\n";
+  text += "  property stays_below_6: always " + var + " <= 6;\n";
+  text += "  property reaches_7: reach " + var + " >= 7;\n}\n";
+  return text;
+}
+
+TEST(PropertyProverNames, NoModelNameCapturesAnEncodingName) {
+  for (const std::string& role : {"input", "variable", "mode", "parameter"}) {
+    for (const std::string& name : kInternalLookingNames) {
+      if (role != "input" && name == "w") continue;
+      if (role != "variable" && name == "level") continue;
+      const std::string text = TankNamed(role, name);
+      const System tank = Parse(text);
+      ExpectTankVerdicts(tank, role == "variable" ? name : "level", role + " " + name);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The base case of k-induction covers every depth the induction needs, whatever max_depth is.
+
+// x = 0 in `a`, where an urgent jump (its guard holds in every state of a, so no flow leaves a
+// state of a) sets x = 5 in `b` at once; nothing enters `a` and nothing moves in `b`. So
+// `always x <= 1` fails after one step, yet it is 2-inductive: two steps that keep x <= 1 cannot
+// go through `a` (no state of a has a predecessor), and `b` keeps x.
+constexpr std::string_view kTwoInductiveModel = R"(
+automaton late {
+  var x;
+  mode a { x' = 1; inv x >= 0; }
+  mode b { }
+  transition j: a -> b { guard x >= -100; reset x := 5; }
+  init a { x = 0; }
+  property small: always x <= 1;
+}
+)";
+
+TEST(PropertyProver, BaseCaseCoversTheInductionDepthEvenAtDepthZero) {
+  const System system = Parse(kTwoInductiveModel);
+  PropertyProver::Options options = Small();
+  options.max_depth = 0;      // no counterexample search beyond the base case
+  options.max_induction = 2;  // whose base case needs paths of 0 and 1 steps
+  const CheckResult r = CheckOne(system, "small", options);
+  EXPECT_NE(r.verdict, Verdict::kProved) << r.reason;
+  ASSERT_EQ(r.verdict, Verdict::kViolated) << r.reason;
+  const Trace copy = Replayed(system, Named(system, "small"), r);
+  EXPECT_DOUBLE_EQ(AtTarget(system, copy, "x"), 5.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The budget: deterministic verdicts, and `unknown` (never a false proof) when it runs out.
+
+// x rises at 1 from 0; `starts_at_0` holds in the initial state only (x never comes back), and
+// its negation x > 0... is not initial: a prover that skipped the check of the initial state
+// would call it unreachable by induction (x > 0 stays x > 0).
+constexpr std::string_view kRisingModel = R"(
+automaton rising {
+  var x;
+  mode up { x' = 1; inv x <= 10; }
+  init up { x = 0; }
+  property starts_at_0: reach x <= 0;
+  property bounded: always x <= 10;
+}
+)";
+
+TEST(PropertyProverBudget, ExhaustedBudgetNeverProves) {
+  const System system = Parse(kRisingModel);
+  PropertyProver::Options options = Small();
+  options.budget = 1e-6;  // 3 resource units: no query can run
+  const std::vector<CheckResult> results =
+      PropertyProver(options).Check(system, system.properties());
+  ASSERT_EQ(results.size(), 2u);
+  for (const CheckResult& r : results) {
+    EXPECT_EQ(r.verdict, Verdict::kUnknown) << r.property << ": " << r.reason;
+    EXPECT_NE(r.reason.find("budget"), std::string::npos) << r.reason;
+  }
+  // With a budget, the truth: x = 0 at the start; x <= 10 is the invariant.
+  const std::vector<CheckResult> full = PropertyProver(Small()).Check(system, system.properties());
+  EXPECT_EQ(full[0].verdict, Verdict::kReachable) << full[0].reason;
+  EXPECT_EQ(full[1].verdict, Verdict::kProved) << full[1].reason;
+}
+
+TEST(PropertyProverBudget, FormerSearchSecondsOptionIsTheBudget) {
+  const System system = Parse(kRisingModel);
+  PropertyProver::Options options = Small();
+  options.search_seconds = 1e-6;
+  for (const CheckResult& r : PropertyProver(options).Check(system, system.properties())) {
+    EXPECT_EQ(r.verdict, Verdict::kUnknown) << r.property << ": " << r.reason;
+  }
+}
+
+// A chain of `n` constant-rate modes: x' = 1 in m_i (x <= i + 1), m_i -> m_(i+1) at x >= i + 1.
+std::string Chain(int n) {
+  std::string text = "automaton chain {\n  var x;\n";
+  for (int i = 0; i < n; ++i) {
+    text +=
+        "  mode m" + std::to_string(i) + " { x' = 1; inv x <= " + std::to_string(i + 1) + "; }\n";
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    text += "  transition t" + std::to_string(i) + ": m" + std::to_string(i) + " -> m" +
+            std::to_string(i + 1) + " { guard x >= " + std::to_string(i + 1) + "; }\n";
+  }
+  text += "  init m0 { x = 0; }\n";
+  text += "  property bounded: always x <= " + std::to_string(n) + ";\n";
+  text += "  property too_low: always x <= " + std::to_string(n - 1) + ";\n";
+  text += "  property far: reach x >= " + std::to_string(n) + " - 0.5;\n}\n";
+  return text;
+}
+
+// The same check twice gives the same verdicts and reasons (the budget counts Z3's resource
+// units, not seconds); small budgets leave properties unknown, never wrongly decided.
+TEST(PropertyProverBudget, VerdictsAreRepeatableAndSound) {
+  const System chain = Parse(Chain(40));
+  for (double budget : {0.05, 0.3, 2.0}) {
+    PropertyProver::Options options = Small();
+    options.max_depth = 6;
+    options.budget = budget;
+    const auto first = PropertyProver(options).Check(chain, chain.properties());
+    const auto second = PropertyProver(options).Check(chain, chain.properties());
+    ASSERT_EQ(first.size(), 3u);
+    for (std::size_t i = 0; i < first.size(); ++i) {
+      EXPECT_EQ(first[i].verdict, second[i].verdict) << budget << " " << first[i].property;
+      EXPECT_EQ(first[i].reason, second[i].reason) << budget << " " << first[i].property;
+    }
+    // The truth, by hand: x <= 40 everywhere (the last invariant), x = 40 only after 79 steps.
+    EXPECT_TRUE(first[0].verdict == Verdict::kProved || first[0].verdict == Verdict::kUnknown)
+        << first[0].reason;
+    EXPECT_TRUE(first[1].verdict == Verdict::kUnknown) << first[1].reason;  // needs 79 steps
+    EXPECT_TRUE(first[2].verdict == Verdict::kUnknown) << first[2].reason;  // too deep
+  }
+}
+
+// One budget across calls: what the first call leaves is all the second gets.
+TEST(PropertyProverBudget, SharedBudgetIsDrawnDown) {
+  const System system = Parse(kRisingModel);
+  SolverBudget budget(2.0);
+  EXPECT_EQ(budget.total(), 2 * kResourceUnitsPerBudgetSecond);
+  const auto first = PropertyProver(Small()).Check(system, system.properties(), budget);
+  EXPECT_GT(budget.used(), 0u);
+  const std::uint64_t after_first = budget.used();
+  EXPECT_EQ(first[1].verdict, Verdict::kProved) << first[1].reason;
+  const auto modes = PropertyProver(Small()).ReachableModes(system, 0, budget);
+  EXPECT_GT(budget.used(), after_first);
+  ASSERT_EQ(modes.size(), 1u);
+  EXPECT_EQ(modes[0].verdict, Verdict::kReachable) << modes[0].reason;
+  EXPECT_THROW(SolverBudget(0.0), std::invalid_argument);
+  EXPECT_THROW(SolverBudget(-1.0), std::invalid_argument);
+  EXPECT_THROW(SolverBudget(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(SolverBudget(1e7), std::invalid_argument);
 }
 
 System Finger() { return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha"); }
@@ -324,7 +543,7 @@ TEST(PropertyProverFinger, ReachableModes) {
   const System finger = Finger();
   PropertyProver::Options options;
   options.max_depth = 2;
-  options.search_seconds = 300;  // never the limit: the search is complete
+  options.budget = 300;  // never the limit: the search is complete
   const std::vector<PropertyProver::ModeReachability> modes =
       PropertyProver(options).ReachableModes(finger, 0);
   const Automaton& a = finger.components()[0].automaton;

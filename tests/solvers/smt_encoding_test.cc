@@ -12,6 +12,8 @@
 #include <z3++.h>
 
 #include <algorithm>
+#include <regex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -101,6 +103,9 @@ class StepChecker {
     solver_.add(enc_.State(0) && enc_.State(1) && enc_.Transition(0));
     solver_.add(enc_.TakeDefinitions());
   }
+
+  SmtEncoding& encoding() { return enc_; }
+  z3::solver& solver() { return solver_; }
 
   // Whether s_0 in mode `from` with `values0` can step to s_1 in mode `to` with `values1`
   // (pinned within `tolerance`).
@@ -308,6 +313,185 @@ TEST(SmtEncoding, SeparableFlowStopsAtAnUrgentGuard) {
   // The same segment is allowed when the release is lazy.
   static StepChecker lazy(FingerWithLazyRelease());
   EXPECT_EQ(lazy.Check("c010_l000", start, "c010_l000", end(-20 - 630.0 / 165, 90), 1e-9), z3::sat);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Names: the encoding's constants are named by kind and index, never by a model name.
+
+// The tank of issue 12 (h rises at 0.5 + d, d in [-0.2, 0]): its input is named d.
+constexpr std::string_view kTankModel = R"(
+automaton tank {
+  var h in [0, 10];
+  input d in [-0.2, 0];
+  mode fill { h' = 0.5 + d; inv h <= 8; }
+  init fill { h = 5; }
+}
+)";
+
+// With the input's constant at s_0 named "d@0", as the duration of the flow from s_0 once was,
+// the duration equalled the input (at most 0) and no flow could move h.
+TEST(SmtEncodingNames, AnInputNamedDIsNotTheDuration) {
+  StepChecker step(ParseAutomaton(kTankModel, "tank.ha"));
+  // h from 5 to 7: 4 s at d = 0, 2 / 0.3 s at d = -0.2.
+  EXPECT_EQ(step.Check("fill", {{"h", 5}}, "fill", {{"h", 7}}), z3::sat);
+  EXPECT_EQ(step.Check("fill", {{"h", 5}, {"d", -0.2}}, "fill", {{"h", 7}}), z3::sat);
+  // h never falls.
+  EXPECT_EQ(step.Check("fill", {{"h", 5}}, "fill", {{"h", 4.9}}), z3::unsat);
+}
+
+// Every constant in the formulas of an encoding whose model uses the encoding's own words as
+// names is named KIND[.INDEX][@STEP] with KIND one of the encoding's fixed kinds.
+TEST(SmtEncodingNames, ConstantsAreNamedByKindAndIndexOnly) {
+  const Automaton a = ParseAutomaton(R"(
+automaton flow {
+  param p = 1 in [0, 2];
+  param aux = 2;
+  var d, x, amo;
+  input u in [-1, 1];
+  input V in [0, 1];
+  mode mode_ { d' = p * u + V; x' = d / (amo + 2); amo' = sin(x); inv d <= 10; }
+  mode jump { d' = 1; }
+  transition flow: mode_ -> jump { guard d >= aux; reset x := d / amo; }
+  transition d: jump -> mode_ { guard d >= 3; reset d := 0; }
+  init mode_ { d = 0; x in [0, 1]; amo = 1; }
+}
+)",
+                                     "names.ha");
+  z3::context ctx;
+  SmtEncoding enc(ctx, a);
+  z3::expr_vector all(ctx);
+  all.push_back(enc.Initial());
+  for (int k = 0; k <= 2; ++k) all.push_back(enc.State(k));
+  for (int k = 0; k < 2; ++k) all.push_back(enc.Transition(k));
+  all.push_back(enc.TakeDefinitions());
+  const std::regex pattern(R"((x|u|V|d|flow|mode|jump|amo|p|aux)(\.[0-9]+)?(@[0-9]+)?)");
+  std::set<std::string> names;
+  std::vector<z3::expr> todo;
+  for (unsigned i = 0; i < all.size(); ++i) todo.push_back(all[i]);
+  std::set<unsigned> seen;
+  while (!todo.empty()) {
+    const z3::expr e = todo.back();
+    todo.pop_back();
+    if (!seen.insert(e.id()).second) continue;
+    if (e.is_const() && !e.is_numeral() && !e.is_true() && !e.is_false()) {
+      names.insert(e.decl().name().str());
+    }
+    if (e.is_app()) {
+      for (unsigned i = 0; i < e.num_args(); ++i) todo.push_back(e.arg(i));
+    }
+  }
+  EXPECT_GT(names.size(), 20u);
+  for (const std::string& name : names) {
+    EXPECT_TRUE(std::regex_match(name, pattern)) << name;
+  }
+  // Distinct roles, distinct constants: the variable d, the input u and the duration at s_0.
+  EXPECT_TRUE(names.count("x.0@0") && names.count("u.0@0") && names.count("d@0"));
+  EXPECT_EQ(SmtEncoding::ConstantName("x", 3, 2), "x.3@2");
+  EXPECT_EQ(SmtEncoding::ConstantName("d", -1, 0), "d@0");
+  EXPECT_EQ(SmtEncoding::ConstantName("p", 4, -1), "p.4");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Size: linear in the number of modes.
+
+// A chain of `n` modes x' = 1, each left at x >= i + 1.
+Automaton Chain(int n) {
+  std::string text = "automaton chain {\n  var x;\n";
+  for (int i = 0; i < n; ++i) {
+    text +=
+        "  mode m" + std::to_string(i) + " { x' = 1; inv x <= " + std::to_string(i + 1) + "; }\n";
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    text += "  transition m" + std::to_string(i) + " -> m" + std::to_string(i + 1) +
+            " { guard x >= " + std::to_string(i + 1) + "; }\n";
+  }
+  text += "  init m0 { x = 0; }\n}\n";
+  return ParseAutomaton(text, "chain.ha");
+}
+
+// The number of distinct subterms of `e`.
+std::size_t Size(const z3::expr& e) {
+  std::vector<z3::expr> todo = {e};
+  std::set<unsigned> seen;
+  while (!todo.empty()) {
+    const z3::expr x = todo.back();
+    todo.pop_back();
+    if (!seen.insert(x.id()).second || !x.is_app()) continue;
+    for (unsigned i = 0; i < x.num_args(); ++i) todo.push_back(x.arg(i));
+  }
+  return seen.size();
+}
+
+// Exactly one mode per state once took a clause per pair of modes (n^2 / 2: 5 * 10^7 for
+// 10^4 modes, gigabytes); a ladder takes 3 per mode.
+TEST(SmtEncodingSize, StatesAndTransitionsAreLinearInTheModes) {
+  std::vector<double> per_mode;
+  for (int n : {100, 400, 1600}) {
+    const Automaton a = Chain(n);
+    z3::context ctx;
+    SmtEncoding enc(ctx, a);
+    const std::size_t state = Size(enc.State(0));
+    const std::size_t step = Size(enc.State(0) && enc.State(1) && enc.Transition(0));
+    EXPECT_LT(state, 16u * n) << n;
+    EXPECT_LT(step, 60u * n) << n;
+    per_mode.push_back(static_cast<double>(step) / n);
+  }
+  // Linear: the size per mode does not grow with the number of modes.
+  EXPECT_LT(per_mode.back(), 1.1 * per_mode.front());
+}
+
+// Exactly one mode: the ladder forbids two modes at once and allows each one alone.
+TEST(SmtEncodingSize, ExactlyOneModeHolds) {
+  const Automaton a = Chain(5);
+  z3::context ctx;
+  SmtEncoding enc(ctx, a);
+  z3::solver s(ctx);
+  s.add(enc.State(0));
+  s.add(enc.TakeDefinitions());
+  for (int i = 0; i < 5; ++i) {
+    s.push();
+    s.add(enc.InMode(0, ModeId(i)));
+    EXPECT_EQ(s.check(), z3::sat) << i;
+    for (int j = 0; j < 5; ++j) {
+      if (j == i) continue;
+      s.push();
+      s.add(enc.InMode(0, ModeId(j)));
+      EXPECT_EQ(s.check(), z3::unsat) << i << " " << j;
+      s.pop();
+    }
+    s.pop();
+  }
+  z3::expr_vector none(ctx);
+  for (int i = 0; i < 5; ++i) none.push_back(!enc.InMode(0, ModeId(i)));
+  s.add(z3::mk_and(none));
+  EXPECT_EQ(s.check(), z3::unsat);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading a path back: the representative input reaches the encoded endpoint.
+
+// A flow with drift (h' = 0.5 + d) from h = 5 to h = 7 with the model's input at -0.2: the
+// segment's input integral decides the endpoint, so the path read back holds the mean input
+// V / duration over the duration (5 + (0.5 + u) T = 7), not the model's -0.2 (which with the
+// model's duration missed the endpoint, and the witness did not replay).
+TEST(SmtEncodingReadPath, DriftSegmentHoldsTheMeanInput) {
+  StepChecker step(ParseAutomaton(kTankModel, "tank.ha"));
+  SmtEncoding& enc = step.encoding();
+  z3::solver& s = step.solver();
+  s.push();
+  s.add(enc.InMode(0, ModeId(0)) && enc.InMode(1, ModeId(0)));
+  s.add(Pin(enc, 0, "h", 5) && Pin(enc, 1, "h", 7) && Pin(enc, 0, "d", -0.2));
+  s.add(enc.TakeDefinitions());
+  ASSERT_EQ(s.check(), z3::sat);
+  const auto path = enc.ReadPath(s.get_model(), 1);
+  s.pop();
+  ASSERT_EQ(path.size(), 2u);
+  ASSERT_TRUE(path[0].flow);
+  const double u = path[0].input.at(0), T = path[0].duration;
+  EXPECT_GE(u, -0.2);
+  EXPECT_LE(u, 0.0);
+  EXPECT_GT(T, 0.0);
+  EXPECT_NEAR(5 + (0.5 + u) * T, 7.0, 1e-9) << "u = " << u << ", T = " << T;
 }
 
 }  // namespace
