@@ -8,8 +8,10 @@
 // always name one property and give a small --budget.
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -342,6 +344,128 @@ TEST(CheckCommand, ModesListsEveryModeWithAVerdict) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Soundness: the tank of issue 12, which was `proved` and `unreachable`.
+
+// h from 5 at 0.5 + d per second, d in [-0.2, 0], up to h <= 8: by hand, h passes 6 and reaches
+// 7 whatever the input (at 0.3 per second at the slowest).
+constexpr const char* kTank =
+    "automaton tank {\n"
+    "  var h in [0, 10];\n"
+    "  input d in [-0.2, 0];\n"
+    "  mode fill { h' = 0.5 + d; inv h <= 8; }\n"
+    "  init fill { h = 5; }\n"
+    "  property stays_below_6: always h <= 6;\n"
+    "  property reaches_7: reach h >= 7;\n"
+    "}\n";
+
+TEST(CheckCommand, TankOfTheIssueIsViolatedAndReachableByBothMethods) {
+  TempDir dir;
+  const std::string model = dir.Write("tank.ha", kTank).string();
+  for (const std::string method : {"prove", "sample"}) {
+    const json report = RunHybridJson("check " + Quote(model) + " --method " + method, 6);
+    const json below = Property(report, "stays_below_6");
+    const json reach = Property(report, "reaches_7");
+    EXPECT_EQ(below.value("verdict", ""), "violated") << method << below.dump(2);
+    EXPECT_EQ(reach.value("verdict", ""), "reachable") << method << reach.dump(2);
+    // The counterexample replays in `hybrid simulate`: h passes 6 by its end.
+    ASSERT_TRUE(below.contains("trace")) << below.dump(2);
+    const json& trace = Field(below, "trace");
+    const double at = Field(trace, "state").value("time", -1.0);
+    ASSERT_GT(at, 0.0) << trace.dump(2);
+    const json sim = RunHybridJson("simulate " + Quote(model) + ReplayArguments(trace, at), 0);
+    EXPECT_GT(Field(sim, "final", "state").value("h", 0.0), 6.0) << sim.dump(2);
+  }
+  const Result text = RunHybrid("check " + Quote(model));
+  EXPECT_EQ(text.out.find("proved"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("unreachable"), std::string::npos) << text.out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The budget: one for the whole command, in Z3 resource units.
+
+// A chain of `n` constant-rate modes: x' = 1 in m_i (x <= i + 1), m_i -> m_(i+1) at x >= i + 1.
+std::string Chain(int n) {
+  std::ostringstream text;
+  text << "automaton chain {\n  var x;\n";
+  for (int i = 0; i < n; ++i) text << "  mode m" << i << " { x' = 1; inv x <= " << i + 1 << "; }\n";
+  for (int i = 0; i + 1 < n; ++i) {
+    text << "  transition t" << i << ": m" << i << " -> m" << i + 1 << " { guard x >= " << i + 1
+         << "; }\n";
+  }
+  text << "  init m0 { x = 0; }\n";
+  text << "  property bounded: always x <= " << n << ";\n";
+  text << "  property far: reach x >= " << n << " - 0.5;\n}\n";
+  return text.str();
+}
+
+// Every verdict of `report` is proved or unknown (the chain's truth: x <= n holds, and x = n - 0.5
+// needs 2n - 1 steps, beyond any depth searched), with a reason.
+void ExpectChainVerdicts(const json& report) {
+  for (const json& p : Field(report, "properties")) {
+    const std::string verdict = p.value("verdict", "");
+    EXPECT_TRUE(verdict == "unknown" || (verdict == "proved" && p.value("name", "") == "bounded"))
+        << p.dump(2);
+    EXPECT_FALSE(p.value("reason", "").empty()) << p.dump(2);
+  }
+}
+
+TEST(CheckCommand, BudgetFiveBoundsAThreeHundredModeChainToTenSeconds) {
+  TempDir dir;
+  const std::string model = dir.Write("chain300.ha", Chain(300)).string();
+  const auto start = std::chrono::steady_clock::now();
+  const json report = RunHybridJson("check " + Quote(model) + " --budget 5", 7);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 10.0);
+  ExpectChainVerdicts(report);
+  EXPECT_NE(Property(report, "far").value("reason", "").find("budget"), std::string::npos)
+      << report.dump(2);
+}
+
+TEST(CheckCommand, TenThousandModesEndWithVerdictsUnderTwoGigabytes) {
+  TempDir dir;
+  const std::string model = dir.Write("chain10000.ha", Chain(10000)).string();
+  const Result r = RunHybrid("check " + Quote(model) + " --budget 5 --json");
+  EXPECT_EQ(r.exit_code, 7) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  const json report = json::parse(r.out, nullptr, false);
+  ASSERT_FALSE(report.is_discarded()) << r.out;
+  ExpectChainVerdicts(report);
+  for (const json& p : Field(report, "properties")) {
+    EXPECT_NE(p.value("reason", "").find("budget"), std::string::npos) << p.dump(2);
+  }
+  // The largest resident set of the children run so far (this one is the largest).
+  rusage usage{};
+  ASSERT_EQ(getrusage(RUSAGE_CHILDREN, &usage), 0);
+  if (!testing::kAddressSanitizer) EXPECT_LT(usage.ru_maxrss, 2L * 1024 * 1024);  // kilobytes
+}
+
+// The same command twice gives the same verdicts and reasons, also when the budget runs out, and
+// --modes draws from the same budget.
+TEST(CheckCommand, SameCommandSameVerdicts) {
+  TempDir dir;
+  const std::string model = dir.Write("chain60.ha", Chain(60)).string();
+  for (const std::string budget : {"0.2", "1.5"}) {
+    auto verdicts = [&] {
+      const json report =
+          RunHybridJson("check " + Quote(model) + " --modes --depth 4 --budget " + budget, 7);
+      std::vector<std::string> out;
+      for (const json& p : Field(report, "properties")) {
+        out.push_back(p.value("verdict", "") + ": " + p.value("reason", ""));
+      }
+      for (const json& m : Field(report, "modes")) {
+        out.push_back(m.value("mode", "") + " " + m.value("verdict", "") + ": " +
+                      m.value("reason", ""));
+      }
+      return out;
+    };
+    const std::vector<std::string> first = verdicts();
+    EXPECT_EQ(first.size(), 62u);
+    EXPECT_EQ(first, verdicts()) << "--budget " << budget;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Bad input: nothing on standard output, a message on standard error.
 
 TEST(CheckCommand, BadOptionsExitTwo) {
@@ -356,6 +480,7 @@ TEST(CheckCommand, BadOptionsExitTwo) {
            finger + " --budget -3",
            finger + " --budget nan",
            finger + " --budget inf",
+           finger + " --budget 1e7",
            finger + " --induction 0",
            finger + " --runs 0",
            finger + " --no-such-option",
