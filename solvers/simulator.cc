@@ -560,9 +560,9 @@ void TruncateUnresolved(SimulationResult& result, size_t index, std::string mess
   result.samples.push_back(std::move(end));
 }
 
-// Throws std::invalid_argument for a setting out of its range, or for a run that would record
-// more than options.max_samples samples at sample times (until > 0 and finite).
-void CheckOptions(const SimulationOptions& o, double until) {
+}  // namespace
+
+void ValidateSimulationOptions(const SimulationOptions& o, double until) {
   auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
   auto positive = [&](double v, const char* what) {
     if (!(v > 0.0) || !std::isfinite(v)) {
@@ -574,6 +574,7 @@ void CheckOptions(const SimulationOptions& o, double until) {
       fail(std::string("the ") + what + " must be finite and >= 0, got " + FormatNumber(v));
     }
   };
+  positive(until, "horizon (--until)");
   positive(o.relative_tolerance, "relative tolerance");
   positive(o.absolute_tolerance, "absolute tolerance");
   non_negative(o.event_tolerance, "event tolerance");
@@ -607,8 +608,6 @@ void CheckOptions(const SimulationOptions& o, double until) {
   }
 }
 
-}  // namespace
-
 SimulationResult Simulator::Run(const SimulationOptions& options,
                                 std::span<const InputSignal> signals) const {
   const System& system = *c_->system;
@@ -624,10 +623,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   } else {
     fail("no horizon: give one (--until) or declare a scenario in the model");
   }
-  if (!std::isfinite(until) || !(until > 0.0)) {
-    fail("the horizon must be positive and finite, got " + FormatNumber(until));
-  }
-  CheckOptions(options, until);
+  ValidateSimulationOptions(options, until);
   for (size_t i = 0; i < options.sample_times.size(); ++i) {
     const double ts = options.sample_times[i];
     if (!std::isfinite(ts) || ts < 0.0 || ts > until) {

@@ -67,7 +67,7 @@ struct SimulationOptions {
   double zeno_window = 1e-6;
   double zeno_horizon = 1e-4;
   /// Total number of events allowed (kEventLimit beyond). Each event records two states.
-  long max_events = 500000;
+  long max_events = 200000;
   /// Most states recorded at sample times: the uniform samples (about until / sample_step) plus
   /// `sample_times`. A run that would record more is refused before it starts.
   long max_samples = 1000000;
@@ -75,6 +75,13 @@ struct SimulationOptions {
   /// and steps over short gaps, each a pass (kStepLimit beyond).
   long max_steps = 10000000;
 };
+
+/// Throws std::invalid_argument, with a message for the user, if the horizon `until` (the one the
+/// run will use) is not positive and finite, if a setting of `options` is out of its range, or if
+/// the run would record more than options.max_samples samples at sample times; the messages name
+/// the command-line option where there is one ("--sample", "--until"). Simulator::Run calls it; a
+/// command line may call it first to tell a bad option from a bad model.
+void ValidateSimulationOptions(const SimulationOptions& options, double until);
 
 /// How a run ended. Only kCompleted reaches the horizon, and a kCompleted run has every recorded
 /// state inside its modes' invariants (within the resolution tolerance) and every event located.
@@ -203,6 +210,20 @@ struct SimulationResult {
 /// that cross on it cross at the stop time. The main loop never spins: more than a hundred passes
 /// at one instant without a jump (CVODE steps that continue without a restart aside, which its
 /// max_steps bounds) end the run with kSolverFailure. CVODE never prints (see CvodeIntegrator).
+///
+/// Resolution. CVODE sizes its first step after every restart near the current time
+/// (InitialStepTarget), never by the horizon. At every event, each root function that crossed
+/// must lie within the resolution tolerance of its boundary at the state reached (see
+/// SimulationOptions::resolution_tolerance); otherwise the run ends as kUnresolved at the start of
+/// that pass. After the run, every recorded state is checked against its modes' invariants
+/// (FirstStateOutsideInvariant, with the exemptions stated there, and the final instant of a
+/// kInvariantViolated run); the first state outside ends the run as kUnresolved at that state:
+/// the states and events from its time on are dropped and the last state kept is repeated as the
+/// end. So whatever the status, the recorded states can be trusted.
+///
+/// Input jumps. A step input that jumps so that the state lies outside an invariant (beyond
+/// event_tolerance) has reached that invariant's boundary at that instant: lazy transitions whose
+/// guards hold may fire; if none does, the run stops with kInvariantViolated.
 class Simulator {
  public:
   /// Compiles every flow, guard, reset and invariant of `system`. Throws std::invalid_argument
@@ -225,11 +246,13 @@ class Simulator {
   /// The general guard of every run: the first state of `result.samples` that lies outside its
   /// modes' invariants by more than the resolution tolerance (SimulationOptions), as a message
   /// naming its time, the invariant and the mode; nullopt if none. The inputs are those of a run
-  /// with `signals`. A state followed, at the same time and in the same modes, by a kBeforeEvent
-  /// sample is exempt (a jump leaves it at once). Run applies it to every run that reached its
-  /// horizon, and reports kUnresolved instead of kCompleted when it finds a state; callers that
-  /// replay or doctor a result may apply it too. Throws std::invalid_argument if a state does
-  /// not fit the model (mode indices, number of variables) or a signal drives a non-input.
+  /// with `signals`. A state that a jump leaves at its own instant (a kBeforeEvent sample in the
+  /// same modes at the same time, itself or later) is exempt if it was entered at that instant (a
+  /// kAfterEvent sample in the same modes at the same time, itself or earlier) or lay inside with
+  /// the inputs just before that instant (an input jump put it outside). Run applies it to every
+  /// result; callers that replay or doctor a result may apply it too. Throws std::invalid_argument
+  /// if a state does not fit the model (mode indices, number of variables) or a signal drives a
+  /// non-input.
   std::optional<std::string> FirstStateOutsideInvariant(
       const SimulationResult& result, const SimulationOptions& options,
       std::span<const InputSignal> signals = {}) const;

@@ -1703,6 +1703,14 @@ TEST(SimulatorTest, OptionsOutOfRangeAreRefused) {
   refused([](SimulationOptions& o) { o.max_event_iterations = 0; });
   refused([](SimulationOptions& o) { o.max_events = -1; });
   refused([](SimulationOptions& o) { o.max_steps = 0; });
+  // The same check on its own, for a command line that tells bad options from bad models.
+  EXPECT_NO_THROW(ValidateSimulationOptions({}, 120.0));
+  EXPECT_THROW(ValidateSimulationOptions({}, kInf), std::invalid_argument);
+  EXPECT_THROW(ValidateSimulationOptions({}, 0.0), std::invalid_argument);
+  SimulationOptions dense;
+  dense.sample_step = 1e-4;
+  EXPECT_NO_THROW(ValidateSimulationOptions(dense, 100.0));  // 1e6 samples
+  EXPECT_THROW(ValidateSimulationOptions(dense, 101.0), std::invalid_argument);
 }
 
 TEST(SimulatorTest, RunTimeMessagesNameNoCxxSymbols) {
