@@ -22,8 +22,8 @@ namespace hybrid {
 /// `max_event_iterations` at one instant (kZeno), at most CvodeIntegrator::Options::max_steps
 /// solver steps towards one stop time (kSolverFailure), and at most `max_samples` samples
 /// recorded at sample times (refused before the run). So a run records at most
-/// max_samples + 2 max_events + 2 states; with the defaults its result stays below about 350 MB
-/// for a model of a few variables.
+/// max_samples + 2 max_events + 2 states; with the defaults its result stays below about 250 MB
+/// for a model of a few variables (docs/simulation.md, "Bounds").
 struct SimulationOptions {
   /// Horizon; nullopt uses the model's scenario (Run throws if there is none).
   std::optional<double> until;
