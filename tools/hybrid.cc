@@ -392,7 +392,8 @@ int main(int argc, char** argv) {
                   "and jumps)");
   AddNumberOption(check, "--induction", &check_args.induction, "prove: largest k of k-induction");
   AddNumberOption(check, "--budget", &check_args.budget,
-                  "prove: seconds for the counterexample and witness search per automaton");
+                  "prove: one solver budget for the whole command (properties, then --modes), "
+                  "in budget seconds of Z3 resource units (docs/verification.md)");
   AddNumberOption(check, "--runs", &check_args.runs, "sample: random runs per property");
   AddNumberOption(check, "--seed", &check_args.seed, "sample: random seed");
 

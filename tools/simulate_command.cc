@@ -298,15 +298,14 @@ int RunSimulate(const SimulateArgs& args) {
   SimulationOptions options;
   options.until = args.until;
   options.sample_step = args.sample;
-  // The cap on recorded samples, checked by the simulator too, is an option error here.
-  const double horizon =
-      args.until ? *args.until : (system.scenario() ? system.scenario()->until : 0.0);
-  if (args.sample > 0.0 && horizon / args.sample > static_cast<double>(options.max_samples)) {
-    throw UsageError("--sample " + FormatNumber(args.sample) +
-                     " up to t = " + FormatNumber(horizon) + " would record about " +
-                     FormatNumber(horizon / args.sample) + " states, more than the limit of " +
-                     std::to_string(options.max_samples) +
-                     ": give a larger --sample or a shorter --until");
+  // The simulator's own checks of the options (the cap on recorded samples, ...): option errors
+  // here, told apart from the model's before the run.
+  if (args.until || system.scenario()) {
+    try {
+      ValidateSimulationOptions(options, args.until ? *args.until : system.scenario()->until);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(UserMessage(e.what()));
+    }
   }
   const Simulator sim(system);
   const SimulationResult result = sim.Run(options, signals);

@@ -243,7 +243,9 @@ TEST(HybridSimulate, RefusesBadOptions) {
   ExpectRefused(thermostat + " --until nan", "--until: 'nan' is not a decimal number", 2);
   ExpectRefused(thermostat + " --sample -1", "--sample", 2);
   // Too many recorded states (it grew to 3.6 GB): refused before the run, naming the option.
-  ExpectRefused(thermostat + " --sample 1e-9", "--sample 1e-09 up to t = 120 would record", 2);
+  ExpectRefused(thermostat + " --sample 1e-9",
+                "recording the state every 1e-09 (--sample) up to t = 120 (--until) would record",
+                2);
   ExpectRefused(thermostat + " --input-csv x.csv --csv-shape cubic", "--csv-shape", 2);
   // Values the model refuses: exit 1.
   ExpectRefused(thermostat + " --input u=50", "outside its bounds [-20, 30]");
