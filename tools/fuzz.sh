@@ -106,12 +106,10 @@ run_one() {
 }
 
 # Runs the harnesses, at most $jobs at a time.
-pids=()
 for h in "${harnesses[@]}"; do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
   echo "fuzz.sh: running $h for at most ${seconds}s${runs:+ or $runs executions}"
   run_one "$h" &
-  pids+=($!)
 done
 wait || true
 
