@@ -1018,8 +1018,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       result.status = SimulationStatus::kStepLimit;
       result.message =
           "more than " + std::to_string(options.max_steps) +
-          " integration steps (solver steps and exact segments) before t = " + FormatNumber(t) +
-          " (step limit)";
+          " integration steps (solver steps and exact segments) before t = " + FormatNumber(t);
       break;
     }
     while (next_break < breakpoints.size() && breakpoints[next_break] <= t) ++next_break;
