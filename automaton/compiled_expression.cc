@@ -253,6 +253,12 @@ double CompiledExpression::Evaluate(const double* env) const {
   return Run(env, buffer.data(), buffer.data() + max_depth_);
 }
 
+// Direct threading takes the addresses of labels, a GCC/Clang extension that -Wpedantic reports.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wgnu-label-as-value"
+#endif
 double CompiledExpression::Run(const double* env, double* stack, double* registers) const {
   // Direct threading (GCC/Clang "labels as values"): each handler jumps straight to the next.
   static const void* const kDispatch[] = {
@@ -366,5 +372,6 @@ end:
 #undef BINARY
 #undef NEXT
 }
+#pragma GCC diagnostic pop
 
 }  // namespace hybrid

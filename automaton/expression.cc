@@ -248,9 +248,6 @@ Expression SDiv(const Expression& a, const Expression& b) {
   return a / b;
 }
 Expression Call(Op op, const Expression& a) { return Expression::Unary(op, a); }
-Expression Call(Op op, const Expression& a, const Expression& b) {
-  return Expression::Binary(op, a, b);
-}
 
 AffineForm Scale(AffineForm f, double k) {
   f.constant *= k;

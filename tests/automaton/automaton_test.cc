@@ -311,6 +311,50 @@ TEST_F(AutomatonTest, ScenarioSignalsStayInBoundsAndIncrease) {
   EXPECT_NO_THROW(a_.SetScenario(s));
 }
 
+// Expressions and predicates built in C++ are held to the model language's depth limit, like
+// parsed ones: the solvers' recursive walks of them are sized for kMaxExpressionDepth.
+TEST_F(AutomatonTest, ExpressionsDeeperThanTheModelLimitAreRefused) {
+  const Expression h = Sym(a_, "h"), C0 = Expression::Constant(0);
+  // h + h + ... with `levels` levels.
+  auto sum = [&](const Expression& term, int levels) {
+    Expression e = term;
+    while (e.depth() < levels) e = e + term;
+    return e;
+  };
+  const std::string too_deep = "expression too long or nested too deeply (" +
+                               std::to_string(kMaxExpressionDepth + 1) + " levels, more than " +
+                               std::to_string(kMaxExpressionDepth) + ")";
+  Mode m;
+  m.name = "deep";
+  m.flows = {{Slot("h"), sum(h, kMaxExpressionDepth + 1)}};
+  ExpectInvalid([&] { a_.AddMode(m); }, "flow of 'h' in mode 'deep': " + too_deep);
+  m.flows = {};
+  m.invariant.comparisons = {{sum(h, kMaxExpressionDepth), Relation::kLessEqual, C0}};
+  ExpectInvalid([&] { a_.AddMode(m); }, "invariant of mode 'deep': " + too_deep);
+  m.invariant.comparisons = {{sum(h, kMaxExpressionDepth - 1), Relation::kLessEqual, C0}};
+  m.flows = {{Slot("h"), sum(h, kMaxExpressionDepth)}};
+  EXPECT_NO_THROW(a_.AddMode(m));  // at the limit
+
+  Transition t{"t", falling_, falling_, "", {}, {}, Urgency::kUrgent};
+  t.guard.comparisons = {{C0, Relation::kLessEqual, sum(h, kMaxExpressionDepth)}};
+  ExpectInvalid([&] { a_.AddTransition(t); }, "guard of 't': " + too_deep);
+  t.guard.comparisons = {};
+  t.resets = {{Slot("h"), sum(h, kMaxExpressionDepth + 1)}};
+  ExpectInvalid([&] { a_.AddTransition(t); }, "reset of 'h' in 't': " + too_deep);
+  ExpectInvalid(
+      [&] { a_.AddParameter("k", sum(Expression::Constant(1), kMaxExpressionDepth + 1)); },
+      "value of k: " + too_deep);
+
+  Predicate deep = Predicate::Compare({h, Relation::kGreaterEqual, C0});  // 2 levels
+  while (deep.depth() < kMaxExpressionDepth + 1) deep = Predicate::Not(deep);
+  ExpectInvalid(
+      [&] {
+        a_.AddProperty({"p", Property::Kind::kAlways, deep, {}});
+      },
+      "property 'p': " + too_deep);
+  EXPECT_NO_THROW(a_.AddProperty({"q", Property::Kind::kAlways, deep.operands()[0], {}}));
+}
+
 TEST_F(AutomatonTest, EqualityIsStructural) {
   Automaton copy = a_;
   EXPECT_EQ(copy, a_);

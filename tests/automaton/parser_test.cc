@@ -142,7 +142,21 @@ bool ParsesOrFailsCleanly(const std::string& text, double limit) {
   return parsed;
 }
 
-constexpr double kTimeLimit = 5.0;  // seconds, for every 10 MB input below
+// Sanitizers slow every instruction down by a roughly constant factor; these limits are about
+// how parsing grows with the input, not about the speed of one build.
+constexpr double SanitizerSlowdown() {
+#if defined(__SANITIZE_ADDRESS__)
+  return 10.0;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return 10.0;
+#endif
+#endif
+  return 1.0;
+}
+
+// Seconds, for every 10 MB input below.
+constexpr double kTimeLimit = 5.0 * SanitizerSlowdown();
 constexpr size_t kTenMegabytes = 10u << 20;
 
 const char* const kSmallModel = R"(automaton a {
@@ -548,6 +562,33 @@ TEST(ParseErrors, SecondAutomatonWithoutSystemFromALongAbsolutePath) {
     EXPECT_EQ(e.message(),
               "the file declares 2 automata and no system: add 'system NAME { instance A = a; ... "
               "}'");
+  }
+}
+
+// Each import nests a parse: a chain of kMaxImportDepth imports is fine, one more is an error in
+// the file whose import goes too deep.
+TEST(ParseErrors, ImportsNestAtMostTheLimitDeep) {
+  TempDir dir;
+  auto chain = [&](int imports) {
+    // f0 imports f1, ..., f(imports - 1) imports f(imports), which declares the automaton.
+    for (int i = 0; i < imports; ++i) {
+      dir.Write("f" + std::to_string(i) + ".ha",
+                "import \"f" + std::to_string(i + 1) + ".ha\";\n" +
+                    (i == 0 ? "system s { instance A = a; }\n" : ""));
+    }
+    dir.Write("f" + std::to_string(imports) + ".ha", kSmallModel);
+    return dir.path() / "f0.ha";
+  };
+  EXPECT_EQ(ParseModelFile(chain(kMaxImportDepth)).components().size(), 1u);
+  try {
+    ParseModelFile(chain(kMaxImportDepth + 1));
+    FAIL() << "parsed";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), (dir.path() / ("f" + std::to_string(kMaxImportDepth) + ".ha")).string());
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_EQ(e.column(), 1);
+    EXPECT_EQ(e.message(),
+              "imports nested more than " + std::to_string(kMaxImportDepth) + " files deep");
   }
 }
 

@@ -671,6 +671,18 @@ TEST(System, AddPropertyChecksModesAndInputs) {
   Property good{"r", Property::Kind::kReach, Predicate::InMode("A.high"), std::nullopt};
   s.AddProperty(good);
   EXPECT_EQ(InvalidArgument([&] { s.AddProperty(good); }), "duplicate property 'r'");
+  // Deeper than a model may be (an `or` of kMaxExpressionDepth + 1 levels): refused like a parsed
+  // one; at the limit it is accepted.
+  Predicate deep = Predicate::InMode("A.high");
+  while (deep.depth() < kMaxExpressionDepth) deep = Predicate::Or(deep, Predicate::InMode("A.low"));
+  s.AddProperty({"at_limit", Property::Kind::kReach, deep, std::nullopt});
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddProperty({"too_deep", Property::Kind::kReach,
+                             Predicate::Or(deep, Predicate::True()), std::nullopt});
+            }),
+            "property 'too_deep': expression too long or nested too deeply (" +
+                std::to_string(kMaxExpressionDepth + 1) + " levels, more than " +
+                std::to_string(kMaxExpressionDepth) + ")");
 }
 
 TEST(System, InputBounds) {
