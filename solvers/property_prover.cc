@@ -90,13 +90,18 @@ void DebugPath(SmtEncoding& enc, const z3::model& model, int n) {
 z3::solver MakeSolver(z3::context& ctx) { return z3::tactic(ctx, "qfnra-nlsat").mk_solver(); }
 
 // Z3's default solver, for bounded model checking (incremental) and the one-query induction
-// step: without its calls to nlsat from the arithmetic core (`arith.nl.nra`), whose algebraic
-// number work Z3 neither counts in the resource limit nor interrupts on time (a query of the
-// finger's search ran for minutes on 600,000 units); its other nonlinear reasoning is counted.
+// step: always its SMT core (`ignore_solver1`, and `solver2_unknown` = 0: an `unknown` stays
+// unknown), never the tactic portfolio it otherwise tries first or falls back to, whose
+// strategies for nonlinear arithmetic switch on wall-clock time (`try_for`), so that the same
+// query gave different answers and resource counts from run to run; and without the core's calls
+// to nlsat (`arith.nl.nra`), whose algebraic number work Z3 neither counts in the resource limit
+// nor interrupts on time (a query of the finger's search ran for minutes on 600,000 units).
 // Incomplete for nonlinear problems: such a query may come back `unknown`.
 z3::solver MakeIncremental(z3::context& ctx) {
   z3::solver s(ctx);
   z3::params p(ctx);
+  p.set("ignore_solver1", true);
+  p.set("solver2_unknown", 0u);
   p.set("arith.nl.nra", false);
   s.set(p);
   return s;
@@ -131,10 +136,11 @@ class Meter {
  public:
   explicit Meter(SolverBudget& budget) : budget_(budget) {}
 
-  // s.check() with at most `cap` resource units and never past `ceiling` (a level of
+  // s.check() (for `what`, in HYBRID_CHECK_TIMING's report) with at most `cap` resource units
+  // and never past `ceiling` (a level of
   // budget.used()): z3::unknown without a query once the ceiling is reached (counted in
   // starved(), as a query that the budget, not `cap`, cut short).
-  z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling) {
+  z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling, const char* what) {
     if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
       ++starved_;
       return z3::unknown;
@@ -148,7 +154,9 @@ class Meter {
       allowed = 1;
       while (allowed * 2 <= left) allowed *= 2;
     }
-    const unsigned safety = budget_.SafetyMilliseconds(allowed);
+    // The wall-clock limit of every query: the length of the safety deadline (a constant, so that
+    // the solvers see the same calls in every run).
+    const unsigned safety = budget_.SafetyMilliseconds();
     const bool same =
         last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
     if (!same || last_allowed_ != allowed) {
@@ -176,7 +184,8 @@ class Meter {
       if (allowed < cap) ++starved_;
     }
     if (std::getenv("HYBRID_CHECK_TIMING")) {
-      std::cerr << "query: " << r << ", " << spent << " units, " << seconds << " s\n";
+      std::cerr << "query: " << r << ", " << spent << " units, " << seconds << " s (" << what
+                << ")\n";
     }
     return r;
   }
@@ -252,9 +261,24 @@ class JobRun {
     return kUnitsPerEncodedElement *
            static_cast<std::uint64_t>(a_.num_modes() + a_.num_transitions() + 1);
   }
+  // What a path of k steps whose last step leaves mode m (any mode: m < 0) puts in a new solver:
+  // k + 1 states (each linear in the modes), k - 1 full steps and the last step (from m: its flow
+  // and its outgoing transitions only).
+  std::uint64_t PathUnits(int k, int m) const {
+    std::uint64_t last = static_cast<std::uint64_t>(a_.num_modes() + a_.num_transitions() + 1);
+    if (m >= 0) {
+      last = 1;
+      for (const Transition& t : a_.transitions()) last += t.source.value() == m ? 1 : 0;
+    }
+    const auto steps = static_cast<std::uint64_t>(std::max(k - 1, 0));
+    return kUnitsPerEncodedElement *
+           (static_cast<std::uint64_t>(k + 1) * static_cast<std::uint64_t>(a_.num_modes() + 1) +
+            steps * static_cast<std::uint64_t>(a_.num_modes() + a_.num_transitions() + 1) + last);
+  }
   z3::expr Bad(const Candidate& c, int n, double margin);
   void Search(int n, bool invariants_only, std::initializer_list<bool> passes,
               std::uint64_t ceiling);
+  void One(Candidate& c, int n, bool pinned, std::uint64_t ceiling);
   void Induction(int k);
   void DeepSearch();
   bool Unreachable(const Candidate& c);
@@ -405,9 +429,10 @@ z3::expr JobRun::Bad(const Candidate& c, int n, double margin) {
 }
 
 // Paths of exactly n steps: parameters at their nominal values first (fewer ties between
-// events, which the simulator breaks by declaration order), then over their ranges; per pass,
-// one query for all candidates, then one per candidate (robust violations first: they replay
-// clear of rounding; then exact ones).
+// events, which the simulator breaks by declaration order), then over their ranges. Per pass, one
+// query for the candidates not yet tried: unsat settles them all; a model names those it breaks
+// (or reaches), which are tried alone (One) and the rest asked again; a query that runs out
+// leaves every remaining candidate to One.
 void JobRun::Search(int n, bool invariants_only, std::initializer_list<bool> passes,
                     std::uint64_t ceiling) {
   if (!Extend(n, ceiling)) {
@@ -420,36 +445,61 @@ void JobRun::Search(int n, bool invariants_only, std::initializer_list<bool> pas
   };
   for (bool pinned : passes) {
     if (pinned && enc_.uncertain().empty()) continue;
-    z3::expr_vector any(ctx_);
-    for (const Candidate& c : cands_) {
-      if (wanted(c)) any.push_back(Bad(c, n, 0.0));
-    }
-    if (any.empty()) return;
-    bmc_.push();
-    Add(bmc_, enc_, z3::mk_or(any));
-    if (pinned) bmc_.add(enc_.NominalParameters());
-    const z3::check_result r = meter_.Check(bmc_, options_.resource_limit, ceiling);
-    bmc_.pop();
-    if (r == z3::unknown && !pinned) bmc_complete_ = false;
-    if (r == z3::unsat) continue;
-    for (Candidate& c : cands_) {
-      if (!wanted(c)) continue;
-      for (double margin : {options_.robust_margin, 0.0}) {
-        if (!Pending(c) || (!c.invariant && margin > 0)) continue;
-        bmc_.push();
-        Add(bmc_, enc_, Bad(c, n, margin));
-        if (pinned) bmc_.add(enc_.NominalParameters());
-        const z3::check_result rc = meter_.Check(bmc_, options_.resource_limit, ceiling);
-        if (rc == z3::sat) {
-          c.refuted = c.refuted || c.invariant;
-          TryTrace(bmc_.get_model(), n, c);
-        } else if (rc == z3::unknown && !pinned) {
-          bmc_complete_ = false;
+    std::vector<bool> tried(cands_.size(), false);
+    for (bool more = true; more;) {
+      z3::expr_vector any(ctx_);
+      std::vector<std::size_t> asked;
+      for (std::size_t i = 0; i < cands_.size(); ++i) {
+        if (!wanted(cands_[i]) || tried[i]) continue;
+        any.push_back(Bad(cands_[i], n, 0.0));
+        asked.push_back(i);
+      }
+      if (asked.empty()) break;
+      bmc_.push();
+      Add(bmc_, enc_, z3::mk_or(any));
+      if (pinned) bmc_.add(enc_.NominalParameters());
+      const z3::check_result r = meter_.Check(bmc_, options_.resource_limit, ceiling, "search");
+      std::vector<std::size_t> hit;
+      std::optional<z3::model> model;
+      if (r == z3::sat) {
+        model = bmc_.get_model();
+        for (std::size_t j = 0; j < asked.size(); ++j) {
+          if (model->eval(any[static_cast<int>(j)], true).is_true()) hit.push_back(asked[j]);
         }
-        bmc_.pop();
-        if (rc == z3::sat) break;
+      }
+      bmc_.pop();
+      if (r == z3::unsat) break;
+      if (r == z3::unknown) {
+        if (!pinned) bmc_complete_ = false;
+        more = false;
+      }
+      if (hit.empty()) hit = asked;  // cannot tell which: each alone
+      for (std::size_t i : hit) {
+        tried[i] = true;
+        One(cands_[i], n, pinned, ceiling);
       }
     }
+  }
+}
+
+// Candidate `c` alone on paths of exactly n steps: robust violations first (they replay clear of
+// rounding), then exact ones; a path found is replayed (TryTrace).
+void JobRun::One(Candidate& c, int n, bool pinned, std::uint64_t ceiling) {
+  for (double margin : {options_.robust_margin, 0.0}) {
+    if (!Pending(c) || (!c.invariant && margin > 0)) continue;
+    bmc_.push();
+    Add(bmc_, enc_, Bad(c, n, margin));
+    if (pinned) bmc_.add(enc_.NominalParameters());
+    const z3::check_result rc =
+        meter_.Check(bmc_, options_.resource_limit, ceiling, "search, one property");
+    if (rc == z3::sat) {
+      c.refuted = c.refuted || c.invariant;
+      TryTrace(bmc_.get_model(), n, c);
+    } else if (rc == z3::unknown && !pinned) {
+      bmc_complete_ = false;
+    }
+    bmc_.pop();
+    if (rc == z3::sat) break;
   }
 }
 
@@ -471,7 +521,7 @@ void JobRun::Induction(int k) {
   auto check = [&](int m, const std::vector<std::size_t>& goals, unsigned limit,
                    std::vector<std::size_t>& failed) {
     // A path of k steps (k + 1 states) asserted in a new solver.
-    if (!meter_.Afford(StepUnits() * (k + 1), ceiling)) return z3::unknown;
+    if (!meter_.Afford(PathUnits(k, m), ceiling)) return z3::unknown;
     z3::solver s = m < 0 ? MakeIncremental(ctx_) : MakeSolver(ctx_);
     std::optional<z3::expr>& path = m < 0 ? path_any : path_from[m];
     if (!path) {
@@ -500,7 +550,8 @@ void JobRun::Induction(int k) {
       bad.push_back(at_k.back());
     }
     Add(s, enc_, z3::mk_or(bad));
-    const z3::check_result r = meter_.Check(s, limit, ceiling);
+    const z3::check_result r =
+        meter_.Check(s, limit, ceiling, m < 0 ? "induction" : "induction, one mode");
     if (r == z3::sat) {
       const z3::model model = s.get_model();
       for (std::size_t g = 0; g < goals.size(); ++g) {
@@ -555,10 +606,14 @@ void JobRun::Induction(int k) {
         proof_cut_ = true;  // nothing left to prove with: every candidate is dropped
         failed = goals;
       } else if (check(m, goals, options_.resource_limit / 25, failed) == z3::unknown) {
-        // Split per candidate with a larger limit.
+        // Split per candidate with a larger limit, then the full one (a candidate dropped for
+        // want of resources takes with it every candidate that needs it as a lemma).
         for (std::size_t j : goals) {
           std::vector<std::size_t> f;
-          if (check(m, {j}, options_.resource_limit / 5, f) == z3::unknown) f.push_back(j);
+          if (check(m, {j}, options_.resource_limit / 5, f) == z3::unknown &&
+              check(m, {j}, options_.resource_limit, f) == z3::unknown) {
+            f.push_back(j);
+          }
           failed.insert(failed.end(), f.begin(), f.end());
         }
       }
@@ -622,9 +677,12 @@ bool JobRun::Unreachable(const Candidate& c) {
   if (!meter_.Afford(StepUnits(), ceiling)) return false;
   z3::solver base = MakeSolver(ctx_);
   Add(base, enc_, enc_.Initial() && enc_.State(0) && enc_.Holds(c.bad, 0, 0.0));
-  if (meter_.Check(base, options_.resource_limit, ceiling) != z3::unsat) return false;
+  if (meter_.Check(base, options_.resource_limit, ceiling, "unreachability, initial") !=
+      z3::unsat) {
+    return false;
+  }
   for (int m = 0; m < a_.num_modes(); ++m) {
-    if (!meter_.Afford(StepUnits() * 2, ceiling)) return false;
+    if (!meter_.Afford(PathUnits(1, m), ceiling)) return false;
     z3::solver s = MakeSolver(ctx_);
     z3::expr_vector e(ctx_);
     e.push_back(enc_.State(0));
@@ -636,7 +694,10 @@ bool JobRun::Unreachable(const Candidate& c) {
       if (lemma.invariant && lemma.proved) e.push_back(!enc_.Holds(lemma.bad, 0, 0.0));
     }
     Add(s, enc_, z3::mk_and(e));
-    if (meter_.Check(s, options_.resource_limit, ceiling) != z3::unsat) return false;
+    if (meter_.Check(s, options_.resource_limit, ceiling, "unreachability, one mode") !=
+        z3::unsat) {
+      return false;
+    }
   }
   return true;
 }
@@ -976,13 +1037,13 @@ SolverBudget::SolverBudget(double seconds) : seconds_(seconds) {
   start_ = std::chrono::steady_clock::now();
 }
 
-unsigned SolverBudget::SafetyMilliseconds(std::uint64_t units) const {
-  const double ms =
-      10000.0 * static_cast<double>(units) / static_cast<double>(kResourceUnitsPerBudgetSecond);
-  return static_cast<unsigned>(std::clamp(ms, 10000.0, 4.0e9));
+double SolverBudget::SafetySeconds() const { return std::max(60.0, 20.0 * seconds_); }
+
+unsigned SolverBudget::SafetyMilliseconds() const {
+  return static_cast<unsigned>(std::min(1000.0 * SafetySeconds(), 4.0e9));
 }
 
-bool SolverBudget::SafetyExpired() const { return Since(start_) > std::max(60.0, 10.0 * seconds_); }
+bool SolverBudget::SafetyExpired() const { return Since(start_) > SafetySeconds(); }
 
 double PropertyProver::BudgetSeconds() const {
   return options_.search_seconds > 0 ? options_.search_seconds : options_.budget;

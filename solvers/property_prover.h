@@ -27,10 +27,10 @@ inline constexpr std::uint64_t kResourceUnitsPerBudgetSecond = 2'500'000;
 /// the same check with the same budget always gives the same verdicts. A query is given at most
 /// what is left; once nothing is left, no query runs and what is undecided stays `unknown`.
 ///
-/// A safety net bounds wall-clock time where Z3 does not count resources (some nonlinear
-/// arithmetic): a query may run for at most max(10 s, 10 s per budget second it was given), and
-/// the queries of a check start within max(60 s, 10 s per budget second) of its start. Only then
-/// can a verdict depend on the machine: what the net stops is `unknown`, and the reasons say so.
+/// A safety net bounds wall-clock time where Z3 does not count its work (some nonlinear
+/// arithmetic): with T = max(60 s, 20 s per budget second), no query starts later than T after
+/// the budget's creation, and none runs longer than T. Only when it fires can a verdict depend
+/// on the machine: what it stops is `unknown`, and the reasons say so.
 class SolverBudget {
  public:
   /// A budget of `seconds` budget seconds (positive and finite, at most 10^6), i.e. seconds *
@@ -44,9 +44,11 @@ class SolverBudget {
   /// Records `units` spent (the budget may be overdrawn by the last query's overshoot).
   void Charge(std::uint64_t units) { used_ += units; }
 
-  /// Wall-clock limit of a query given `units` resource units, in milliseconds.
-  unsigned SafetyMilliseconds(std::uint64_t units) const;
-  /// Whether the whole check has run past its wall-clock safety limit.
+  /// The safety net's deadline, in seconds from the budget's creation: max(60, 20 * seconds()).
+  double SafetySeconds() const;
+  /// SafetySeconds() in milliseconds: the time limit of every query.
+  unsigned SafetyMilliseconds() const;
+  /// Whether the deadline has passed (no query may start).
   bool SafetyExpired() const;
   /// Records that the safety net stopped a query; safety_stopped() tells.
   void NoteSafetyStop() { safety_stopped_ = true; }
@@ -97,7 +99,7 @@ class PropertyProver {
     double robust_margin = 1e-3;
     /// The solver budget of a whole Check (or ReachableModes) call without an explicit
     /// SolverBudget, in budget seconds (see SolverBudget).
-    double budget = 30.0;
+    double budget = 60.0;
     /// Former name of `budget`, kept for older callers: when positive, it is used instead.
     double search_seconds = 0.0;
     /// Most resource units one SMT query may use (less when less is left of the budget). A query

@@ -107,7 +107,13 @@ class SmtEncoding {
     double duration = 0.0;      // of that flow
     int transition = -1;        // or the jump taken
   };
-  /// States s_0 .. s_n of a model of a path of length n.
+  /// States s_0 .. s_n of a model of a path of length n. For a flow step, `input` and
+  /// `duration` give a constant input that follows the encoded segment: where the flow has a
+  /// drift or reads several inputs, each read input at its mean V_i / d for the model's d (the
+  /// exact endpoint); where it reads one input and has no drift (the path depends only on V),
+  /// the model's input if it has V's sign and is not very slow, else full speed towards V, for
+  /// V / u; inputs the flow does not read (and all inputs of a kGeneral flow) keep the model's
+  /// values.
   std::vector<PathStep> ReadPath(const z3::model& model, int n);
   /// Values of the uncertain parameters in `model`.
   std::vector<std::pair<std::string, double>> ReadParameters(const z3::model& model);
