@@ -291,6 +291,15 @@ void Automaton::SetInitialValue(int slot, const InitialValue& value) {
   }
 }
 
+void Automaton::KeepInitialState(int index) {
+  if (index < 0 || index >= static_cast<int>(initial_states_.size())) {
+    Fail("automaton '" + name_ + "' has no initial state number " + std::to_string(index + 1));
+  }
+  InitialState kept = std::move(initial_states_[static_cast<std::size_t>(index)]);
+  initial_states_.clear();
+  initial_states_.push_back(std::move(kept));
+}
+
 void Automaton::AddInitialState(InitialState state) {
   if (!state.mode.is_valid() || state.mode.value() >= num_modes()) {
     Fail("initial state in a mode that automaton '" + name_ + "' does not have");

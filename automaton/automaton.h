@@ -104,6 +104,9 @@ class Automaton {
   void SetInitialValue(int slot, const InitialValue& value);
   /// Every continuous variable must get exactly one value; bounds read parameters only.
   void AddInitialState(InitialState state);
+  /// Keeps initial state `index` (declaration order) as the only one: the start a replayed
+  /// trace names. Throws std::invalid_argument if there is no such initial state.
+  void KeepInitialState(int index);
   /// Comparisons may read variables, discrete variables and parameters, not inputs; `in` atoms
   /// must name modes of this automaton; the property name must be new.
   void AddProperty(Property property);

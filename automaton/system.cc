@@ -344,6 +344,19 @@ void System::SetInitialValue(std::string_view variable, double value) {
   }
 }
 
+void System::SelectInitialState(int component, int index) {
+  if (component < 0 || component >= static_cast<int>(components_.size())) {
+    Fail("no component number " + std::to_string(component + 1));
+  }
+  Component& c = components_[static_cast<std::size_t>(component)];
+  try {
+    c.automaton.KeepInitialState(index);
+    c.source.KeepInitialState(index);
+  } catch (const std::invalid_argument& e) {
+    Fail(e.what());
+  }
+}
+
 void System::SetScenario(Scenario scenario) {
   if (!(scenario.until > 0.0) || !std::isfinite(scenario.until)) {
     Fail("'until' must be positive and finite");

@@ -73,6 +73,10 @@ class System {
   /// Throws std::invalid_argument ("System::SetInitialValue: ...") if `value` is not finite or no
   /// component has such a continuous variable.
   void SetInitialValue(std::string_view variable, double value);
+  /// Makes initial state `index` (declaration order) of component `component` its only one, in
+  /// both `automaton` and `source` (Automaton::KeepInitialState). Throws std::invalid_argument if
+  /// there is no such component or initial state.
+  void SelectInitialState(int component, int index);
 
   const SymbolTable& symbols() const { return symbols_; }
   std::span<const Component> components() const { return components_; }

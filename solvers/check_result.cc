@@ -30,6 +30,7 @@ void ConfirmTrace(const System& system, const Property& property, CheckResult& r
   } else {
     Trace fresh;
     fresh.parameters = result.trace->parameters;
+    fresh.initial_states = result.trace->initial_states;
     fresh.initial_values = result.trace->initial_values;
     fresh.inputs = result.trace->inputs;
     try {

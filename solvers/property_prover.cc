@@ -56,6 +56,8 @@ struct Goal {
 
 struct Job {
   const Automaton* automaton = nullptr;
+  // Its component's index in the System, or -1 for a product of components.
+  int component = -1;
   // automaton slot -> System slot
   std::vector<int> to_system;
   std::vector<Goal> goals;
@@ -335,9 +337,12 @@ bool JobRun::TryTrace(const z3::model& model, int depth, Candidate& c) {
   const auto path = enc_.ReadPath(model, depth);
   Trace trace;
   trace.parameters = enc_.ReadParameters(model);
-  // Initial values where the model's initial state is a box.
-  for (const InitialState& init : a_.initial_states()) {
-    if (init.mode.value() != path[0].mode) continue;
+  // The initial state the path starts from, and its values where that state is a box.
+  const int start = enc_.InitialIndex(model);
+  if (start < 0) return false;
+  if (job_.component >= 0) trace.initial_states.emplace_back(job_.component, start);
+  {
+    const InitialState& init = a_.initial_states()[static_cast<std::size_t>(start)];
     for (const InitialValue& iv : init.values) {
       if (iv.is_point) continue;
       int index = 0;
@@ -999,6 +1004,9 @@ void CopyShared(const System& system, const std::vector<Job>& jobs, int c, int s
         Trace t = *r.trace;
         for (auto& [name, v] : t.parameters) name = rename(name);
         for (auto& [name, v] : t.initial_values) name = rename(name);
+        for (auto& [component, index] : t.initial_states) {
+          if (component == same) component = c;
+        }
         for (InputSignal& in : t.inputs.inputs) {
           const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
           if (slot) in.slot = *slot;
@@ -1071,6 +1079,7 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
     Job& job = jobs[c];
     if (job.goals.empty()) continue;
     job.automaton = &components[c].automaton;
+    job.component = c;
     job.to_system = components[c].global_slot;
     AddLemmas(system, c, job);
     same[c] = SameInstance(system, jobs, c);

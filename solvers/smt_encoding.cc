@@ -577,19 +577,32 @@ z3::expr SmtEncoding::Initial() {
     }
   }
   z3::expr any = ctx_.bool_val(false);
-  for (const InitialState& init : automaton_.initial_states()) {
-    z3::expr one = v.mode[init.mode.value()];
-    for (const InitialValue& iv : init.values) {
-      const z3::expr& x = v.x[var_index_[iv.slot]];
-      if (iv.is_point) {
-        one = one && x == Translate(iv.range.lo, params_);
-      } else {
-        one = one && Translate(iv.range.lo, params_) <= x && x <= Translate(iv.range.hi, params_);
-      }
-    }
-    any = any || one;
+  for (int j = 0; j < static_cast<int>(automaton_.initial_states().size()); ++j) {
+    any = any || InitialState(j);
   }
   return out && any;
+}
+
+z3::expr SmtEncoding::InitialState(int index) {
+  StepVars& v = Vars(0);
+  const hybrid::InitialState& init = automaton_.initial_states()[static_cast<std::size_t>(index)];
+  z3::expr one = v.mode[init.mode.value()];
+  for (const InitialValue& iv : init.values) {
+    const z3::expr& x = v.x[var_index_[iv.slot]];
+    if (iv.is_point) {
+      one = one && x == Translate(iv.range.lo, params_);
+    } else {
+      one = one && Translate(iv.range.lo, params_) <= x && x <= Translate(iv.range.hi, params_);
+    }
+  }
+  return one;
+}
+
+int SmtEncoding::InitialIndex(const z3::model& model) {
+  for (int j = 0; j < static_cast<int>(automaton_.initial_states().size()); ++j) {
+    if (model.eval(InitialState(j), true).is_true()) return j;
+  }
+  return -1;
 }
 
 z3::expr SmtEncoding::State(int k) {
@@ -914,13 +927,38 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   return out;
 }
 
+bool SmtEncoding::ReadsMovingVariable(const Comparison& c, int mode) const {
+  const std::vector<int>& moving = modes_[static_cast<std::size_t>(mode)].moving;
+  for (const Expression* side : {&c.lhs, &c.rhs}) {
+    for (int slot : side->Slots()) {
+      if (slot < 0 || slot >= static_cast<int>(var_index_.size())) continue;
+      const int v = var_index_[slot];
+      if (v >= 0 && std::find(moving.begin(), moving.end(), v) != moving.end()) return true;
+    }
+  }
+  return false;
+}
+
 z3::expr SmtEncoding::Jump(int k, int t) {
   const hybrid::Transition& tr = automaton_.transitions()[t];
   StepVars& a = Vars(k);
   StepVars& b = Vars(k + 1);
   const auto& env = Env(k);
-  z3::expr out =
-      a.mode[tr.source.value()] && b.mode[tr.target.value()] && Conjunction(tr.guard, env);
+  // A strict comparison that reads a variable moving in the source mode (a flow) is taken in its
+  // closure (`<` as `<=`, `>` as `>=`): the simulator fires a transition where the guard's
+  // residual crosses 0, which for a strict guard is a point where the guard itself is still
+  // false (`x > 1` reached by x' = 1 fires at x = 1). Comparisons of inputs, parameters and
+  // variables that do not move in the mode only change their truth at input breakpoints and
+  // jumps, where they are evaluated as they are: they stay strict. Every jump the simulator
+  // takes meets this guard (more jumps: sound for proofs).
+  z3::expr out = a.mode[tr.source.value()] && b.mode[tr.target.value()];
+  for (Comparison c : tr.guard.comparisons) {
+    if (ReadsMovingVariable(c, tr.source.value())) {
+      if (c.relation == Relation::kLess) c.relation = Relation::kLessEqual;
+      if (c.relation == Relation::kGreater) c.relation = Relation::kGreaterEqual;
+    }
+    out = out && Compare(c, env, 0.0);
+  }
   std::vector<bool> reset(var_slots_.size(), false);
   for (const Reset& r : tr.resets) {
     const int v = var_index_[r.slot];

@@ -76,8 +76,14 @@ class SmtEncoding {
   const Automaton& automaton() const { return automaton_; }
   FlowClass flow_class(ModeId m) const { return modes_[m.value()].flow_class; }
 
-  /// s_0 is an initial state.
+  /// s_0 is an initial state (parameters in their ranges, and s_0 in some InitialState(j)).
   z3::expr Initial();
+  /// s_0 is in the automaton's initial state number `index` (declaration order): its mode, its
+  /// points and boxes.
+  z3::expr InitialState(int index);
+  /// The first initial state whose InitialState holds at s_0 in `model`, or -1 if none (a path
+  /// not from an initial state, e.g. of an induction step).
+  int InitialIndex(const z3::model& model);
   /// Well-formedness of s_k: exactly one mode, its invariant, inputs within bounds.
   z3::expr State(int k);
   /// T(s_k, s_k+1).
@@ -174,6 +180,8 @@ class SmtEncoding {
   z3::expr Flow(int k, int mode);
   z3::expr NoUrgentGuardOnSegment(int k, int mode);
   z3::expr Jump(int k, int t);
+  // Whether `c` reads a continuous variable with a flow in mode `mode`.
+  bool ReadsMovingVariable(const Comparison& c, int mode) const;
   z3::expr Discrete(int k, int slot);
   Expression Fold(const Expression& e) const;
   void Classify();

@@ -116,11 +116,54 @@ bool IsTarget(const Simulator& simulator, const Property& property, const StateS
   return false;
 }
 
+namespace {
+
+// Moves `value` of variable `name` (a System name, slot `slot` of `c`) onto the range of c's first
+// initial state, which it may miss by rounding only (1e-9 relative); throws otherwise.
+double IntoInitialRange(const Component& c, int slot, const std::string& name, double value) {
+  const Automaton& a = c.automaton;
+  if (a.initial_states().empty()) return value;  // the simulator rejects the component
+  const InitialState& init = a.initial_states().front();
+  const std::vector<double> env = a.ParameterEnvironment();
+  for (const InitialValue& iv : init.values) {
+    if (iv.slot != slot) continue;
+    const double lo = iv.range.lo.Evaluate(env), hi = iv.range.hi.Evaluate(env);
+    const double tol = 1e-9 * std::max({1.0, std::abs(lo), std::abs(hi)});
+    if (!(value >= lo - tol && value <= hi + tol)) {
+      throw std::invalid_argument("replay: initial value " + name + " = " + FormatNumber(value) +
+                                  " is not in the initial state's range [" + FormatNumber(lo) +
+                                  ", " + FormatNumber(hi) + "] (mode " +
+                                  a.modes()[init.mode.value()].name + ")");
+    }
+    return std::clamp(value, lo, hi);
+  }
+  return value;
+}
+
+// Applies the trace's choice of initial states, then its initial values, each checked against
+// (and moved onto) the chosen initial state's range: no start outside every `init` is simulated.
+void ApplyStart(System& copy, const Trace& trace) {
+  for (const auto& [component, index] : trace.initial_states) {
+    copy.SelectInitialState(component, index);
+  }
+  for (const auto& [name, given] : trace.initial_values) {
+    double value = given;
+    for (const Component& c : copy.components()) {
+      const std::optional<int> slot = c.automaton.symbols().Find(name);
+      if (!slot || c.automaton.symbols()[*slot].kind != SymbolKind::kVariable) continue;
+      value = IntoInitialRange(c, *slot, name, value);
+    }
+    copy.SetInitialValue(name, value);
+  }
+}
+
+}  // namespace
+
 bool ReplayTrace(const System& system, const Property& property, Trace& trace,
                  const ReplayOptions& options) {
   System copy = system;
   for (const auto& [name, value] : trace.parameters) copy.SetParameter(name, value);
-  for (const auto& [name, value] : trace.initial_values) copy.SetInitialValue(name, value);
+  ApplyStart(copy, trace);
   if (!(trace.inputs.until > 0.0) || !std::isfinite(trace.inputs.until)) {
     throw std::invalid_argument("replay: the trace's horizon must be positive and finite");
   }

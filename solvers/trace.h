@@ -32,8 +32,11 @@ std::vector<UncertainParameter> UncertainParameters(const System& system);
 struct Trace {
   /// Values for uncertain parameters (System names); others keep their nominal values.
   std::vector<std::pair<std::string, double>> parameters;
+  /// Which `init` declaration a component starts from: (component index in the System,
+  /// initial state index in declaration order). Components not listed start from their first.
+  std::vector<std::pair<int, int>> initial_states;
   /// Initial values of continuous variables (System names) where the model's initial state is a
-  /// box; others keep the model's.
+  /// box; others keep the model's. Each must lie in its component's chosen initial state.
   std::vector<std::pair<std::string, double>> initial_values;
   /// Horizon and input signals (System input slots). Checkers produce step signals: the input
   /// is piecewise constant.
@@ -61,7 +64,9 @@ struct ReplayOptions {
 /// (start, samples, both sides of every event, end) that violates `property` (for `always` and
 /// `never`) or satisfies it (for `reach`). Returns whether there is one. The horizon of a
 /// bounded property (`within T`) caps the states considered. Throws std::invalid_argument for a
-/// trace naming unknown parameters or variables or inputs out of bounds (misuse).
+/// trace naming unknown parameters, variables or initial states, inputs out of bounds, or an
+/// initial value outside the chosen initial state's range (beyond 1e-9 relative; within it, the
+/// value is moved onto the range): a start that no `init` of the model admits is never replayed.
 bool ReplayTrace(const System& system, const Property& property, Trace& trace,
                  const ReplayOptions& options = {});
 

@@ -397,6 +397,64 @@ TEST(PropertyProver, BaseCaseCoversTheInductionDepthEvenAtDepthZero) {
   EXPECT_DOUBLE_EQ(AtTarget(system, copy, "x"), 5.0);
 }
 
+// An urgent transition with a strict guard: x' = 1 from 0 reaches x = 1, where the residual of
+// `x > 1` crosses 0 and the simulator fires `go` (the guard itself is still false there). The
+// encoding once required the strict guard at the jump, so no jump was possible at x = 1, flowing
+// on was forbidden by urgency, and `always in run` was falsely proved (soundness test, model 153).
+constexpr std::string_view kStrictUrgentModel = R"(
+automaton a {
+  var x;
+  mode run { x' = 1; }
+  mode stop { }
+  transition go: run -> stop { guard x > 1; }
+  init run { x = 0; }
+  property stays: always in run;
+  property stops: reach in stop;
+}
+)";
+
+TEST(PropertyProver, StrictUrgentGuardFiresOnItsBoundary) {
+  const System system = Parse(kStrictUrgentModel);
+  const CheckResult stays = CheckOne(system, "stays");
+  EXPECT_NE(stays.verdict, Verdict::kProved) << stays.reason;
+  ASSERT_EQ(stays.verdict, Verdict::kViolated) << stays.reason;
+  Replayed(system, Named(system, "stays"), stays);
+  const CheckResult stops = CheckOne(system, "stops");
+  ASSERT_EQ(stops.verdict, Verdict::kReachable) << stops.reason;
+  const Trace copy = Replayed(system, Named(system, "stops"), stops);
+  EXPECT_DOUBLE_EQ(AtTarget(system, copy, "x"), 1.0);
+}
+
+// Two initial states: the property holds from each (in mode a, x <= 1; in mode b, y = 10 and x
+// decays from [5, 6]), but a path mixing them (mode a with y = 10, or x from b's box in a) breaks
+// it. Traces once carried values without saying which `init` they start from, and the replay
+// started from the first: a false `violated` (soundness test).
+constexpr std::string_view kTwoInitModel = R"(
+automaton mix {
+  var x, y;
+  mode a { }
+  mode b { x' = -0.5*x; }
+  init a { x in [0, 1]; y = 0; }
+  init b { x in [5, 6]; y = 10; }
+  property p: always (y >= 10 or x <= 1) and x <= 6.5;
+  property from_b: always x <= 5.5;
+}
+)";
+
+TEST(PropertyProver, TracesStartFromTheInitialStateTheyChose) {
+  const System system = Parse(kTwoInitModel);
+  const CheckResult p = CheckOne(system, "p");
+  EXPECT_NE(p.verdict, Verdict::kViolated) << p.reason;
+  EXPECT_NE(p.verdict, Verdict::kReachable) << p.reason;
+  // Violated only from the second `init` (x in [5, 6] in mode b): the trace names it.
+  const CheckResult from_b = CheckOne(system, "from_b");
+  ASSERT_EQ(from_b.verdict, Verdict::kViolated) << from_b.reason;
+  ASSERT_TRUE(from_b.trace.has_value());
+  EXPECT_EQ(from_b.trace->initial_states, (std::vector<std::pair<int, int>>{{0, 1}}));
+  const Trace copy = Replayed(system, Named(system, "from_b"), from_b);
+  EXPECT_GT(AtTarget(system, copy, "x"), 5.5);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The budget: deterministic verdicts, and `unknown` (never a false proof) when it runs out.
 

@@ -238,6 +238,54 @@ TEST(ReplayTrace, AppliesParameterAndInitialValues) {
   EXPECT_FALSE(ReplayTrace(system, below_c, again));
 }
 
+// Two initial states in different modes with different boxes.
+constexpr std::string_view kTwoInitModel = R"(
+automaton two {
+  var x;
+  input u in [0, 1];
+  mode a { x' = u; }
+  mode b { x' = 2 * u; }
+  init a { x in [0, 1]; }
+  init b { x in [5, 6]; }
+  property small: always x <= 5.5;
+}
+)";
+
+TEST(ReplayTrace, StartsFromTheChosenInitialState) {
+  const System system = Parse(kTwoInitModel);
+  const Property& small = Named(system, "small");
+  // From the first (mode a, x = 0.5 by default), x stays below 5.5 within 4 s.
+  Trace first = ConstantInput(system, "u", 1.0, 4.0);
+  EXPECT_FALSE(ReplayTrace(system, small, first));
+  // From the second, in mode b, x = 5 + 2t passes 5.5 at t = 0.25.
+  Trace second = ConstantInput(system, "u", 1.0, 4.0);
+  second.initial_states = {{0, 1}};
+  second.initial_values = {{"x", 5.0}};
+  ASSERT_TRUE(ReplayTrace(system, small, second));
+  EXPECT_NEAR(second.run.samples[second.state_index].time, 0.25, 0.01);
+  EXPECT_DOUBLE_EQ(ValueAt(system, second, "x", 0), 5.0);
+}
+
+TEST(ReplayTrace, RejectsAStartNoInitialStateAdmits) {
+  const System system = Parse(kTwoInitModel);
+  const Property& small = Named(system, "small");
+  // x = 5 lies in the second init's box, not in the first's, which the trace starts from.
+  Trace mixed = ConstantInput(system, "u", 1.0, 4.0);
+  mixed.initial_values = {{"x", 5.0}};
+  EXPECT_THROW(ReplayTrace(system, small, mixed), std::invalid_argument);
+  // A value off the box by rounding only is moved onto it.
+  Trace rounded = ConstantInput(system, "u", 0.0, 1.0);
+  rounded.initial_values = {{"x", 1.0 + 1e-12}};
+  EXPECT_FALSE(ReplayTrace(system, small, rounded));
+  EXPECT_DOUBLE_EQ(ValueAt(system, rounded, "x", 0), 1.0);
+  // No such initial state or component.
+  Trace third = ConstantInput(system, "u", 1.0, 4.0);
+  third.initial_states = {{0, 2}};
+  EXPECT_THROW(ReplayTrace(system, small, third), std::invalid_argument);
+  third.initial_states = {{1, 0}};
+  EXPECT_THROW(ReplayTrace(system, small, third), std::invalid_argument);
+}
+
 TEST(ReplayTrace, QualifiedNamesInASystem) {
   const System system = Parse(kComposedModel);
   Trace trace = ConstantInput(system, "A.u", 1.0, 5.0);
