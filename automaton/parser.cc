@@ -422,10 +422,18 @@ SourcePosition Where(const Node& n) {
 // ---------------------------------------------------------------------------------------------
 // Building the model from the parse tree.
 
+// The imports of one model: the files being imported (a chain from the top-level file, to find
+// cycles), the files imported so far with the automata they define (each file is read once,
+// however many imports reach it), and the bytes read, which the model's size limit bounds.
+struct Imports {
+  std::set<std::filesystem::path> active;
+  std::map<std::filesystem::path, std::map<std::string, Automaton>> done;
+  std::size_t bytes = 0;
+};
+
 class Builder {
  public:
-  Builder(std::string file, std::set<std::filesystem::path>* active_imports)
-      : file_(std::move(file)), active_imports_(active_imports) {}
+  Builder(std::string file, Imports* imports) : file_(std::move(file)), imports_(imports) {}
 
   [[noreturn]] void Fail(const Node& n, const std::string& message) const {
     Fail(Where(n), message);
@@ -1005,9 +1013,11 @@ class Builder {
   }
 
   void Import(const Node& n);
+  // Adds the automata an import defines (the same automaton reached twice is fine).
+  void Merge(const Node& n, const std::map<std::string, Automaton>& automata);
 
   std::string file_;
-  std::set<std::filesystem::path>* active_imports_;
+  Imports* imports_;
   std::map<std::string, Automaton> automata_;
   std::vector<std::string> local_automata_;
   // Where each of local_automata_ is declared (its name), as plain numbers: nothing taken from the
@@ -1121,11 +1131,17 @@ void Builder::Import(const Node& n) {
   if (ec || !std::filesystem::is_regular_file(canonical)) {
     Fail(n, "cannot import '" + relative + "': no such file");
   }
-  if (!active_imports_->insert(canonical).second) {
+  if (imports_->active.count(canonical) != 0) {
     Fail(n, "import cycle through '" + relative + "'");
   }
+  // A file imported before (by another import) is not read again: what it defines is known.
+  if (const auto done = imports_->done.find(canonical); done != imports_->done.end()) {
+    Merge(n, done->second);
+    return;
+  }
+  imports_->active.insert(canonical);
   // The top-level file is in the set too.
-  if (static_cast<int>(active_imports_->size()) > kMaxImportDepth + 1) {
+  if (static_cast<int>(imports_->active.size()) > kMaxImportDepth + 1) {
     Fail(n, "imports nested more than " + std::to_string(kMaxImportDepth) + " files deep");
   }
   std::string text;
@@ -1134,12 +1150,22 @@ void Builder::Import(const Node& n) {
   } catch (const ParseError& e) {
     Fail(n, "cannot import '" + relative + "': " + e.message());
   }
+  imports_->bytes += text.size();
+  if (imports_->bytes > kMaxModelFileBytes) {
+    Fail(n, "cannot import '" + relative + "': the model and its imports are larger than the " +
+                std::to_string(kMaxModelFileBytes) + "-byte limit for models");
+  }
   const std::string imported_name = path.string();
-  Builder imported(imported_name, active_imports_);
+  Builder imported(imported_name, imports_);
   ParsedText parsed;
   ParseInto(text, imported_name, &imported, &parsed);  // errors point into the imported file
-  active_imports_->erase(canonical);
-  for (const auto& [name, automaton] : imported.automata()) {
+  imports_->active.erase(canonical);
+  const auto& automata = imports_->done.emplace(canonical, imported.automata()).first->second;
+  Merge(n, automata);
+}
+
+void Builder::Merge(const Node& n, const std::map<std::string, Automaton>& automata) {
+  for (const auto& [name, automaton] : automata) {
     if (auto it = automata_.find(name); it != automata_.end()) {
       // The same automaton reached twice (a file imported by two imports) is fine.
       if (!(it->second == automaton)) Fail(n, "import redefines automaton '" + name + "'");
@@ -1189,20 +1215,24 @@ auto OnParserStack(F f) -> decltype(f()) {
   return std::move(*call.result);
 }
 
-// The import stack of a top-level file: the file itself, so that importing it is a cycle.
-std::set<std::filesystem::path> TopLevelImports(const std::string& file_name) {
+// The imports of a top-level file of `bytes` bytes: the file itself is active, so that
+// importing it is a cycle.
+Imports TopLevelImports(const std::string& file_name, std::size_t bytes) {
+  Imports imports;
+  imports.bytes = bytes;
   std::error_code ec;
   const auto canonical = std::filesystem::weakly_canonical(file_name, ec);
-  if (ec || !std::filesystem::is_regular_file(canonical, ec)) return {};
-  return {canonical};
+  if (ec || !std::filesystem::is_regular_file(canonical, ec)) return imports;
+  imports.active.insert(canonical);
+  return imports;
 }
 
 }  // namespace
 
 System ParseModel(std::string_view text, const std::string& file_name) {
   return OnParserStack([&] {
-    std::set<std::filesystem::path> active = TopLevelImports(file_name);
-    Builder builder(file_name, &active);
+    Imports imports = TopLevelImports(file_name, text.size());
+    Builder builder(file_name, &imports);
     ParsedText parsed;
     ParseInto(text, file_name, &builder, &parsed);
     return builder.Result(*parsed.tree);
@@ -1215,8 +1245,8 @@ System ParseModelFile(const std::filesystem::path& path) {
 
 Automaton ParseAutomaton(std::string_view text, const std::string& file_name) {
   return OnParserStack([&] {
-    std::set<std::filesystem::path> active = TopLevelImports(file_name);
-    Builder builder(file_name, &active);
+    Imports imports = TopLevelImports(file_name, text.size());
+    Builder builder(file_name, &imports);
     ParsedText parsed;
     ParseInto(text, file_name, &builder, &parsed);
     if (builder.has_system() || builder.local_automata().size() != 1) {
@@ -1229,7 +1259,7 @@ Automaton ParseAutomaton(std::string_view text, const std::string& file_name) {
 InputSignal ParseSignal(std::string_view text, const std::string& source_name) {
   return OnParserStack([&] {
     const ParsedText parsed = ParseTree<grammar::signal_text>(text, source_name);
-    std::set<std::filesystem::path> none;
+    Imports none;
     const Builder builder(source_name, &none);
     return builder.StandaloneSignal(*parsed.tree);
   });

@@ -28,8 +28,10 @@ class ParseError : public std::runtime_error {
   std::string message_;
 };
 
-/// Largest model file accepted (bytes); larger files are rejected before parsing.
-inline constexpr std::size_t kMaxModelFileBytes = 16u << 20;
+/// Largest model accepted (bytes): a larger file is rejected before parsing, and a model whose
+/// file and imports together are larger is rejected at the import that passes the limit. At
+/// 4 MiB, the worst case (a file that is one long sum) parses within about 1 GB of memory.
+inline constexpr std::size_t kMaxModelFileBytes = 4u << 20;
 
 /// Deepest chain of imports (a file importing a file importing ...) accepted.
 inline constexpr int kMaxImportDepth = 64;

@@ -592,6 +592,44 @@ TEST(ParseErrors, ImportsNestAtMostTheLimitDeep) {
   }
 }
 
+// Each file imports the next one twice, 40 files deep: every file used to be read and parsed
+// once per path that reaches it (2^40 times for the last), a hang. Each is now read once.
+TEST(ParseErrors, ImportsReachingAFileTwiceReadItOnce) {
+  TempDir dir;
+  constexpr int kDepth = 40;
+  for (int i = 0; i < kDepth; ++i) {
+    const std::string next = "\"f" + std::to_string(i + 1) + ".ha\";\n";
+    dir.Write(
+        "f" + std::to_string(i) + ".ha",
+        "import " + next + "import " + next + (i == 0 ? "system s { instance A = a; }\n" : ""));
+  }
+  dir.Write("f" + std::to_string(kDepth) + ".ha", kSmallModel);
+  EXPECT_EQ(ParseModelFile(dir.path() / "f0.ha").components().size(), 1u);
+}
+
+// The size limit bounds a model with its imports: five files of a fifth of the limit each pass
+// it together, at the import that passes it.
+TEST(ParseErrors, ImportsCountTowardsTheModelSizeLimit) {
+  TempDir dir;
+  const std::string padding((kMaxModelFileBytes / 5) + 1, '#');
+  std::string main;
+  for (int i = 0; i < 5; ++i) {
+    dir.Write("part" + std::to_string(i) + ".ha", padding + "\n");
+    main += "import \"part" + std::to_string(i) + ".ha\";\n";
+  }
+  const fs::path path = dir.Write("main.ha", main + std::string(kSmallModel));
+  try {
+    ParseModelFile(path);
+    FAIL() << "parsed";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), path.string());
+    EXPECT_EQ(e.line(), 5);
+    EXPECT_EQ(e.message(),
+              "cannot import 'part4.ha': the model and its imports are larger than the " +
+                  std::to_string(kMaxModelFileBytes) + "-byte limit for models");
+  }
+}
+
 // A UTF-8 byte-order mark, which some editors write, used to be "expected 'automaton', ...".
 TEST(Parser, LeadingByteOrderMarkIsSkipped) {
   const std::string bom = "\xEF\xBB\xBF";
