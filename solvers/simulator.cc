@@ -963,6 +963,14 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   std::optional<CvodeIntegrator> integrator;
   bool stale = true;  // the integrator must be restarted at (t, x) before its next step
   Eigen::VectorXd rate = Eigen::VectorXd::Zero(std::max(n, 1));
+  // Exact segments are computed from an anchor, the state where the current constant rates took
+  // over (after a jump, an input breakpoint, a restart or a solver pass), not from the last stop:
+  // a recorded sample stops the loop, and computing on from its rounded state made the state at
+  // a later event (a guard reached exactly at an input breakpoint) depend on --sample.
+  bool anchored = false;
+  double anchor_t = 0.0;
+  Eigen::VectorXd anchor_x, anchor_rate;
+  std::vector<double> anchor_g;
 
   bool running = jump_and_iterate(candidates(), EventRecord::Cause::kEnabled);
   if (running && zeno_check()) running = false;
@@ -1043,26 +1051,44 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     bool exact = run.exact();
     if (exact) {
       run.Derivatives(t, x.data(), rate.data());
+      // On the anchor's line, a root function is exactly on its boundary where its line says
+      // so, not where a stop's rounded state happens to give 0.
+      const bool on_line = anchored && rate == anchor_rate;
       for (size_t i = 0; i < g_prev.size() && exact; ++i) {
-        exact = !(on_boundary(i) &&
-                  run.roots()[i].direction * run.Slope(static_cast<int>(i), rate) > 0.0);
+        const double slope = run.Slope(static_cast<int>(i), rate);
+        const bool boundary =
+            on_line && g_prev[i] == 0.0 ? anchor_t - anchor_g[i] / slope == t_prev : on_boundary(i);
+        exact = !(boundary && run.roots()[i].direction * slope > 0.0);
       }
     }
     CvodeIntegrator::Status status;
     bool short_gap = false;  // stepped over a gap too short for CVODE
     bool restarted = false;  // CVODE was restarted for this pass
     if (exact) {
+      if (!anchored || rate != anchor_rate) {
+        anchored = true;
+        anchor_t = t_prev;
+        anchor_x = x;
+        anchor_rate = rate;
+        anchor_g = g_prev;
+      }
       t_new = t_stop;
       for (size_t i = 0; i < g_prev.size(); ++i) {
         const double slope = run.Slope(static_cast<int>(i), rate);
         const int dir = run.roots()[i].direction;
-        const double g0 = g_prev[i];
+        // Where the root function crosses is decided on its line from the anchor, never from
+        // the rounded state of a stop in between (which may already lie a hair past the
+        // boundary, so that the crossing would be missed).
+        const double g0 = anchor_g[i];
         const bool toward =
             (dir <= 0 && g0 > 0.0 && slope < 0.0) || (dir >= 0 && g0 < 0.0 && slope > 0.0);
         if (!toward) continue;
-        const double crossing = t_prev - g0 / slope;
+        const double on_line = anchor_t - g0 / slope;
         const double tie =
             4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
+        // Crossed before this pass: reported by the pass that reached it.
+        if (on_line < t_prev - tie) continue;
+        const double crossing = std::max(on_line, t_prev);
         if (crossing > t_new + tie || crossing > t_stop) continue;
         // Already reported at this instant, and nothing fired: no progress to make here.
         if (crossing <= t_prev + tie && is_settled(i, t_prev)) continue;
@@ -1075,7 +1101,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       }
       status =
           crossed.empty() ? CvodeIntegrator::Status::kReachedTime : CvodeIntegrator::Status::kRoot;
-      x_new = x + rate.head(x.size()) * (t_new - t_prev);
+      x_new = anchor_x + rate.head(x.size()) * (t_new - anchor_t);
       stale = true;
     } else if (stale && t_stop - t <= kShortGap * std::max(std::abs(t), std::abs(t_stop))) {
       // A stop time a few ulps after a restart (a jump one ulp before a sample time or an input
@@ -1260,6 +1286,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
       restart = std::find(g_prev.begin(), g_prev.end(), 0.0) != g_prev.end();
     }
     if (restart) stale = true;
+    if (restart || !exact) anchored = false;
     // Never spin: every pass must advance time or jump, but for a bounded number of passes.
     // CVODE steps that continue without a restart are not counted: steps shorter than the
     // resolution of t (t + h = t, as a solution blows up) are bounded by its max_steps, which

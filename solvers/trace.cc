@@ -91,6 +91,32 @@ std::vector<double> StateEnvironment(const Simulator& simulator, const StateSamp
   return env;
 }
 
+// Whether `sample` lies in its modes' invariants, each comparison within `tol` times (1 + the
+// magnitudes of its sides). Comparisons that read an input (not recorded) are not checked.
+bool InsideInvariants(const Simulator& simulator, const StateSample& sample, double tol) {
+  const System& system = simulator.system();
+  const std::vector<double> env = StateEnvironment(simulator, sample);
+  for (std::size_t ci = 0; ci < system.components().size(); ++ci) {
+    const Component& c = system.components()[ci];
+    const Automaton& a = c.automaton;
+    std::vector<double> local(static_cast<std::size_t>(a.symbols().size()), 0.0);
+    for (std::size_t s = 0; s < local.size(); ++s) local[s] = env[c.global_slot[s]];
+    for (const Comparison& cmp : a.mode(ModeId(sample.modes[ci])).invariant.comparisons) {
+      bool reads_input = false;
+      for (const Expression* side : {&cmp.lhs, &cmp.rhs}) {
+        for (int slot : side->Slots()) {
+          reads_input = reads_input || a.symbols()[slot].kind == SymbolKind::kInput;
+        }
+      }
+      if (reads_input) continue;
+      const double scale =
+          1.0 + std::abs(cmp.lhs.Evaluate(local)) + std::abs(cmp.rhs.Evaluate(local));
+      if (!AtomHolds(cmp, local, tol * scale)) return false;
+    }
+  }
+  return true;
+}
+
 std::vector<std::string> ModeNames(const Simulator& simulator, const StateSample& sample) {
   std::vector<std::string> out;
   for (std::size_t c = 0; c < sample.modes.size(); ++c) {
@@ -177,6 +203,9 @@ bool ReplayTrace(const System& system, const Property& property, Trace& trace,
   for (std::size_t i = 0; i < trace.run.samples.size(); ++i) {
     const StateSample& s = trace.run.samples[i];
     if (s.time > horizon) break;
+    // A state outside its modes' invariants (the simulator records the state a jump leads to
+    // even then) is no state of a run of the model: the run ends before it.
+    if (!InsideInvariants(simulator, s, options.tolerance)) break;
     if (IsTarget(simulator, property, s, options.tolerance)) {
       trace.state_index = static_cast<int>(i);
       return true;

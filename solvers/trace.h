@@ -62,11 +62,14 @@ struct ReplayOptions {
 /// Applies `trace`'s parameters and initial values to a copy of `system`, simulates its inputs
 /// up to its horizon, and fills trace.run and trace.state_index with the first recorded state
 /// (start, samples, both sides of every event, end) that violates `property` (for `always` and
-/// `never`) or satisfies it (for `reach`). Returns whether there is one. The horizon of a
-/// bounded property (`within T`) caps the states considered. Throws std::invalid_argument for a
-/// trace naming unknown parameters, variables or initial states, inputs out of bounds, or an
-/// initial value outside the chosen initial state's range (beyond 1e-9 relative; within it, the
-/// value is moved onto the range): a start that no `init` of the model admits is never replayed.
+/// `never`) or satisfies it (for `reach`). Returns whether there is one. States from the first
+/// that lies outside its modes' invariants (by more than `tolerance` times 1 + the magnitudes of
+/// a comparison's sides) on are not considered: a jump into such a state is no step of a run. The
+/// horizon of a bounded property (`within T`) caps the states considered. Throws
+/// std::invalid_argument for a trace naming unknown parameters, variables or initial states, inputs
+/// out of bounds, or an initial value outside the chosen initial state's range (beyond 1e-9
+/// relative; within it, the value is moved onto the range): a start that no `init` of the model
+/// admits is never replayed.
 bool ReplayTrace(const System& system, const Property& property, Trace& trace,
                  const ReplayOptions& options = {});
 

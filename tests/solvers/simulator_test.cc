@@ -514,6 +514,51 @@ const std::vector<ThermostatCase> kThermostatCases = {
     {{{0, -20}, {17.5, 30}, {90, 0}}, 150.0},
 };
 
+// A guard reached exactly at an input breakpoint: pow - dx = 1.7 + 1.2 t meets 3.7 at t = 5/3,
+// where `lo` drops from 2 to 0 (soundness test, model 4953). Whether the jump fires there turns
+// on the last bit of the state, and that state used to be computed on from the last recorded
+// sample, so the run depended on --sample (the prover's trace replayed with one grid and not with
+// another). Constant-rate segments are now computed from where their rates took over: the same
+// events and end state on every grid.
+constexpr std::string_view kGuardAtBreakpointModel = R"(
+automaton du {
+  var dx;
+  var pow;
+  input lo in [0, 2];
+  mode t0 { pow' = 0.4 - 0.6*lo; }
+  mode dx { dx' = 0.8; pow' = lo; inv pow <= 7; }
+  transition u0: dx -> t0 {
+    guard lo >= 1 and pow - dx >= 3.7;
+    reset pow := -1.1;
+  }
+  init dx { dx = -0.5; pow = 1.2; }
+  scenario {
+    until 26.169192835833336;
+    lo = step(0: 2, 1.6666666666666667: 0);
+  }
+}
+)";
+
+TEST(SimulatorTest, RecordingSamplesDoesNotChangeTheRun) {
+  const Model m(kGuardAtBreakpointModel);
+  SimulationOptions events_only;
+  events_only.sample_step = 0.0;
+  const SimulationResult reference = m.Run(events_only);
+  ASSERT_EQ(reference.status, SimulationStatus::kCompleted) << reference.message;
+  for (double step : {0.10222340951497397, 1e-3 * 26.169192835833336, 0.5, 1.0 / 3.0, 0.01}) {
+    SimulationOptions o;
+    o.sample_step = step;
+    const SimulationResult r = m.Run(o);
+    ASSERT_EQ(r.status, reference.status) << "sample " << step;
+    ASSERT_EQ(r.events.size(), reference.events.size()) << "sample " << step;
+    for (std::size_t e = 0; e < r.events.size(); ++e) {
+      EXPECT_EQ(r.events[e].time, reference.events[e].time) << "sample " << step;
+    }
+    EXPECT_EQ(r.samples.back().x, reference.samples.back().x) << "sample " << step;
+    EXPECT_EQ(r.samples.back().modes, reference.samples.back().modes) << "sample " << step;
+  }
+}
+
 TEST(SimulatorTest, ThermostatSwitchingTimesMatchTheAnalyticSolution) {
   // Default tolerances (relative 1e-10). Event location itself is exact to roundoff, but the
   // switching times drift by the integration error, which accumulates over the ~40 switches of a
