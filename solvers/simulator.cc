@@ -1072,7 +1072,14 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         anchor_rate = rate;
         anchor_g = g_prev;
       }
-      t_new = t_stop;
+      const double tie =
+          4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_stop));
+      // A crossing up to a tie after a recorded sample's time still ends this pass, at its own
+      // time: the sample must not split crossings that the run without it fires together (and
+      // chooses between by priority), nor move one onto its time; the sample is then recorded
+      // at the event's time. Input breakpoints and the horizon are hard stops.
+      const double limit = at_breakpoint || t_stop >= until ? t_stop : t_stop + tie;
+      t_new = limit;  // the earliest crossing so far
       for (size_t i = 0; i < g_prev.size(); ++i) {
         const double slope = run.Slope(static_cast<int>(i), rate);
         const int dir = run.roots()[i].direction;
@@ -1084,12 +1091,10 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
             (dir <= 0 && g0 > 0.0 && slope < 0.0) || (dir >= 0 && g0 < 0.0 && slope > 0.0);
         if (!toward) continue;
         const double on_line = anchor_t - g0 / slope;
-        const double tie =
-            4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_new));
         // Crossed before this pass: reported by the pass that reached it.
         if (on_line < t_prev - tie) continue;
         const double crossing = std::max(on_line, t_prev);
-        if (crossing > t_new + tie || crossing > t_stop) continue;
+        if (crossing > t_new + tie || crossing > limit) continue;
         // Already reported at this instant, and nothing fired: no progress to make here.
         if (crossing <= t_prev + tie && is_settled(i, t_prev)) continue;
         // An invariant boundary reached exactly at an input breakpoint is not left yet: the
@@ -1099,6 +1104,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
         t_new = std::min(t_new, crossing);
         crossed.push_back(static_cast<int>(i));
       }
+      if (crossed.empty()) t_new = t_stop;
       status =
           crossed.empty() ? CvodeIntegrator::Status::kReachedTime : CvodeIntegrator::Status::kRoot;
       x_new = anchor_x + rate.head(x.size()) * (t_new - anchor_t);

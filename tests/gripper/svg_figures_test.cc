@@ -14,6 +14,7 @@
 #include <fstream>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -67,16 +68,23 @@ std::vector<PixelLine> Lines(const std::string& svg, const std::string& prefix) 
   return lines;
 }
 
+// The points of the <polyline class="NAME" ...> element. A plain scan: std::regex matches
+// `[^"]*` by one recursive call per character, which overflows the stack on a long points list
+// under AddressSanitizer's larger frames.
 std::vector<std::array<double, 2>> Polyline(const std::string& svg, const std::string& name) {
-  std::smatch match;
-  const std::regex pattern("<polyline class=\"" + name + "\"[^>]* points=\"([^\"]*)\"/>");
-  if (!std::regex_search(svg, match, pattern)) return {};
+  const std::size_t start = svg.find("<polyline class=\"" + name + "\"");
+  if (start == std::string::npos) return {};
+  const std::size_t end = svg.find("/>", start);
+  const std::size_t attribute = svg.find(" points=\"", start);
+  if (end == std::string::npos || attribute == std::string::npos || attribute > end) return {};
+  const std::size_t from = attribute + std::string(" points=\"").size();
+  const std::size_t to = svg.find('"', from);
+  if (to == std::string::npos || to > end) return {};
   std::vector<std::array<double, 2>> points;
-  const std::string text = match[1];
-  const std::regex pair("([-0-9.]+),([-0-9.]+)");
-  for (std::sregex_iterator it(text.begin(), text.end(), pair), end; it != end; ++it) {
-    points.push_back({std::stod((*it)[1]), std::stod((*it)[2])});
-  }
+  std::istringstream text(svg.substr(from, to - from));
+  double x = 0, y = 0;
+  char comma = 0;
+  while (text >> x >> comma >> y && comma == ',') points.push_back({x, y});
   return points;
 }
 

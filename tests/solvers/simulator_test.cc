@@ -559,6 +559,46 @@ TEST(SimulatorTest, RecordingSamplesDoesNotChangeTheRun) {
   }
 }
 
+// Two guards crossing at one instant, t = 1/0.85 (d0 falls to 3.6 for c, val rises to 4.8 for
+// y; soundness test, seed 20261124, model 4066): the run fires y, declared first. A recorded
+// sample listed at that instant (as a replay records its target) used to split them, the one
+// crossing an ulp before the sample firing alone: c instead of y.
+constexpr std::string_view kSimultaneousCrossingsModel = R"(
+automaton dt {
+  var d0, jump, val;
+  input real in [-1.9, 0.4];
+  mode dt { jump' = -0.6 + 1.7*real; d0' = 0.9; val' = 0.7 + 1.3*real; inv d0 <= 6.5; }
+  mode sum { jump' = 1; d0' = -1.7; val' = 0.4; inv jump <= 7.9 and d0 <= 6.1; }
+  transition y: sum -> dt { guard val > 4.8 and d0 >= 3.1; reset jump := d0; }
+  transition c: sum -> sum { guard d0 < 3.6; reset d0 := 4.6, val := -val; }
+  init sum { jump = 2; d0 = 1.9; val = 4.8; }
+  scenario {
+    until 1.1764717647058824;
+    real = step(0: 0.11764705882352941, 0.5882352941176471: -0.11764705882352941);
+  }
+}
+)";
+
+TEST(SimulatorTest, ASampleDoesNotSplitSimultaneousCrossings) {
+  const Model m(kSimultaneousCrossingsModel);
+  SimulationOptions events_only;
+  events_only.sample_step = 0.0;
+  const SimulationResult reference = m.Run(events_only);
+  ASSERT_EQ(reference.events.size(), 3u) << reference.message;
+  EXPECT_EQ(reference.events.back().transitions, std::vector<std::string>{"y"});
+  for (double listed : {1.1764705882352939, 1.1764705882352937, 1.1764705882352942}) {
+    SimulationOptions o;
+    o.sample_step = 1.1764717647058824 / 256;
+    o.sample_times = {0.5882352941176471, listed};
+    const SimulationResult r = m.Run(o);
+    ASSERT_EQ(r.events.size(), reference.events.size()) << "sample at " << listed;
+    for (std::size_t e = 0; e < r.events.size(); ++e) {
+      EXPECT_EQ(r.events[e].transitions, reference.events[e].transitions) << "sample at " << listed;
+      EXPECT_EQ(r.events[e].time, reference.events[e].time) << "sample at " << listed;
+    }
+  }
+}
+
 TEST(SimulatorTest, ThermostatSwitchingTimesMatchTheAnalyticSolution) {
   // Default tolerances (relative 1e-10). Event location itself is exact to roundoff, but the
   // switching times drift by the integration error, which accumulates over the ~40 switches of a
