@@ -1,17 +1,16 @@
 #!/usr/bin/env bash
 # Installs, builds and runs every test (rapidcheck seeds pinned in tests/CMakeLists.txt). Three
-# stages; `.ci/run` (no argument) runs `release` only until the whole suite has been run clean under
-# the sanitizers (see docs/fuzzing.md for the fuzz stage); `tools/test.sh release sanitized fuzz` runs all:
+# stages, all run by default (`.ci/run`); name some to run only those (docs/fuzzing.md for fuzz):
 #   release    the Release build in build/ and its whole suite (ctest);
 #   sanitized  the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer with leak
 #              detection on (build-asan/, -O1, fewer rapidcheck cases); any finding fails its test;
 #   fuzz       every libFuzzer harness (tests/fuzz/) for a short bounded time (tools/fuzz.sh).
-# Usage: tools/test.sh [release] [sanitized] [fuzz]      (no argument: release)
+# Usage: tools/test.sh [release] [sanitized] [fuzz]      (no argument: all three)
 # Environment: HYBRID_FUZZ_SECONDS (default 20) seconds per harness in the fuzz stage.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 stages=("$@")
-[ ${#stages[@]} -gt 0 ] || stages=(release)
+[ ${#stages[@]} -gt 0 ] || stages=(release sanitized fuzz)
 jobs=$(nproc)
 
 run_release() {

@@ -92,10 +92,10 @@ std::uint64_t ModelSeed(std::uint64_t seed, std::uint64_t index) {
   return z ^ (z >> 31);
 }
 
-/// What `hybrid check --method prove --depth 6 --induction 2` does: Z3 resource units per
-/// query, and the command's default budget for the whole check (`search_seconds`, the name both
-/// the wall-clock budget of old and the solver-resource budget understand). Small models never
-/// use it up.
+/// What `hybrid check --method prove --depth 6 --induction 2 --budget 30` does: Z3 resource
+/// units per query, and a budget for the whole check (`search_seconds`, the name both the
+/// wall-clock budget of old and the solver-resource budget understand). Small models never use
+/// it up.
 PropertyProver::Options ProverOptions() {
   PropertyProver::Options o;
   o.max_depth = 6;
