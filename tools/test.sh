@@ -23,7 +23,7 @@ run_sanitized() {
   cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHYBRID_SANITIZE=ON \
     -DHYBRID_BUILD_BENCHMARKS=OFF \
     -DHYBRID_RC_PARAMS="seed=20261121 max_success=60" \
-    -DHYBRID_RC_PARAMS_SLOW="seed=20261121 max_success=20"
+    -DHYBRID_RC_PARAMS_SLOW="seed=20261121 max_success=20" -DHYBRID_TEST_TIMEOUT=1200
   cmake --build "$root/build-asan" -j "$jobs"
   # Leak detection on; any report aborts the test (non-zero exit); suppressions only for the
   # uninstrumented system libraries' own allocations (tests/sanitizer/lsan.supp says which and why).
