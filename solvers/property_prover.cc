@@ -147,6 +147,7 @@ class Meter {
       ++starved_;
       return z3::unknown;
     }
+    if (std::getenv("HYBRID_CHECK_TIMING")) std::cerr << "query start (" << what << ")\n";
     // What is left, rounded down to a power of two when less than `cap`: setting a solver's
     // parameters costs time on a large incremental solver, so they change only when the
     // rounded value does.
@@ -156,9 +157,10 @@ class Meter {
       allowed = 1;
       while (allowed * 2 <= left) allowed *= 2;
     }
-    // The wall-clock limit of every query: the length of the safety deadline (a constant, so that
-    // the solvers see the same calls in every run).
-    const unsigned safety = budget_.SafetyMilliseconds();
+    // The wall-clock limit of the query, from the units it may use (10 s per budget second, at
+    // least 10 s): work Z3 does not count (a search query of the finger's --modes ran for 20
+    // minutes on a constant limit of the whole deadline) is cut there.
+    const unsigned safety = budget_.SafetyMilliseconds(allowed);
     const bool same =
         last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
     if (!same || last_allowed_ != allowed) {
@@ -1045,10 +1047,12 @@ SolverBudget::SolverBudget(double seconds) : seconds_(seconds) {
   start_ = std::chrono::steady_clock::now();
 }
 
-double SolverBudget::SafetySeconds() const { return std::max(60.0, 20.0 * seconds_); }
+double SolverBudget::SafetySeconds() const { return std::max(60.0, 10.0 * seconds_); }
 
-unsigned SolverBudget::SafetyMilliseconds() const {
-  return static_cast<unsigned>(std::min(1000.0 * SafetySeconds(), 4.0e9));
+unsigned SolverBudget::SafetyMilliseconds(std::uint64_t units) const {
+  const double ms =
+      10000.0 * static_cast<double>(units) / static_cast<double>(kResourceUnitsPerBudgetSecond);
+  return static_cast<unsigned>(std::clamp(ms, 10000.0, std::min(1000.0 * SafetySeconds(), 4.0e9)));
 }
 
 bool SolverBudget::SafetyExpired() const { return Since(start_) > SafetySeconds(); }

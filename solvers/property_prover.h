@@ -28,9 +28,10 @@ inline constexpr std::uint64_t kResourceUnitsPerBudgetSecond = 2'500'000;
 /// what is left; once nothing is left, no query runs and what is undecided stays `unknown`.
 ///
 /// A safety net bounds wall-clock time where Z3 does not count its work (some nonlinear
-/// arithmetic): with T = max(60 s, 20 s per budget second), no query starts later than T after
-/// the budget's creation, and none runs longer than T. Only when it fires can a verdict depend
-/// on the machine: what it stops is `unknown`, and the reasons say so.
+/// arithmetic): with T = max(60 s, 10 s per budget second), no query starts later than T after
+/// the budget's creation, and a query given u units runs at most 10 s per budget second of u
+/// (at least 10 s, at most T). Only when it fires can a verdict depend on the machine: what it
+/// stops is `unknown`, and the reasons say so.
 class SolverBudget {
  public:
   /// A budget of `seconds` budget seconds (positive and finite, at most 10^6), i.e. seconds *
@@ -44,10 +45,11 @@ class SolverBudget {
   /// Records `units` spent (the budget may be overdrawn by the last query's overshoot).
   void Charge(std::uint64_t units) { used_ += units; }
 
-  /// The safety net's deadline, in seconds from the budget's creation: max(60, 20 * seconds()).
+  /// The safety net's deadline, in seconds from the budget's creation: max(60, 10 * seconds()).
   double SafetySeconds() const;
-  /// SafetySeconds() in milliseconds: the time limit of every query.
-  unsigned SafetyMilliseconds() const;
+  /// The time limit of a query given `units` resource units, in milliseconds: 10 s per budget
+  /// second of `units`, at least 10 s, at most SafetySeconds().
+  unsigned SafetyMilliseconds(std::uint64_t units) const;
   /// Whether the deadline has passed (no query may start).
   bool SafetyExpired() const;
   /// Records that the safety net stopped a query; safety_stopped() tells.
