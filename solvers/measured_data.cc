@@ -192,6 +192,17 @@ class Reader {
     }
   }
 
+  // A joint angle in degrees, at most one turn either way: anything larger is no measurement of
+  // the finger, and values near the range of a double overflowed the noise estimate (1e308
+  // squared).
+  double ParseAngle(std::string_view cell, int column, Field field) const {
+    const double value = ParseNumber(cell, column, field);
+    if (value < -360.0 || value > 360.0) {
+      FailCell(column, field, "outside [-360, 360] degrees: " + Quoted(cell));
+    }
+    return value;
+  }
+
   double ParseCounts(std::string_view cell, int column, Field field) const {
     const double value = ParseNumber(cell, column, field);
     if (value < 0.0 || value > kMaxCounts) {
@@ -221,7 +232,7 @@ class Reader {
         case kTheta1:
         case kTheta2:
         case kTheta3:
-          if (!cell.empty()) row.theta[field - kTheta1] = ParseNumber(cell, column, field);
+          if (!cell.empty()) row.theta[field - kTheta1] = ParseAngle(cell, column, field);
           break;
         case kGob:
           if (!cell.empty()) row.gob = ParseCounts(cell, column, field);

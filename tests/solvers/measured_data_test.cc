@@ -340,6 +340,15 @@ TEST(ReadMeasuredDataErrors, GOutsideItsRange) {
   EXPECT_TRUE(FailsAt(WithRow("1,1e3,10,20,30"), 5, 2, "outside [0, 255]: '1e3'"));
 }
 
+// An angle of 1e308 degrees was read, and its square overflowed the noise estimate to NaN (a
+// finding of fuzz_measured_data). Angles are at most one turn either way.
+TEST(ReadMeasuredDataErrors, AngleOutsideOneTurn) {
+  EXPECT_TRUE(FailsAt(WithRow("1,3,1e308,20,30"), 5, 3,
+                      "column 'theta1': outside [-360, 360] degrees: '1e308'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,-360.5,30"), 5, 4, "outside [-360, 360] degrees: '-360.5'"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,10,20,361"), 5, 5, "outside [-360, 360] degrees: '361'"));
+}
+
 TEST(ReadMeasuredDataErrors, EmptyGOrRun) {
   EXPECT_TRUE(FailsAt(WithRow("1, ,10,20,30"), 5, 2, "column 'g': empty"));
   EXPECT_TRUE(FailsAt(WithRow(",3,10,20,30"), 5, 1, "column 'run': empty run label"));
