@@ -11,8 +11,8 @@
 #include <string>
 
 #include "automaton/parser.h"
-#include "solvers/diagnosis.h"
-#include "solvers/synthetic_data.h"
+#include "gripper/finger_diagnosis.h"
+#include "gripper/synthetic_data.h"
 
 namespace {
 

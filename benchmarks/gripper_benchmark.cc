@@ -11,7 +11,7 @@
 #include "gripper/finger_closed_form.h"
 #include "gripper/geometric_finger.h"
 #include "gripper/hand.h"
-#include "solvers/simulator.h"
+#include "solvers/simulation/simulator.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "automaton/parser.h"
-#include "solvers/simulator.h"
+#include "solvers/simulation/simulator.h"
 
 namespace {
 

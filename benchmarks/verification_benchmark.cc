@@ -8,7 +8,7 @@
 #include <string>
 
 #include "automaton/parser.h"
-#include "solvers/property_prover.h"
+#include "solvers/verification/property_prover.h"
 
 namespace {
 

@@ -7,9 +7,9 @@
 #include <stdexcept>
 
 #include "automaton/parser.h"
-#include "solvers/property_prover.h"
-#include "solvers/property_sampler.h"
-#include "solvers/simulator.h"
+#include "solvers/verification/property_prover.h"
+#include "solvers/verification/property_sampler.h"
+#include "solvers/simulation/simulator.h"
 #include "tools/output.h"
 
 namespace hybrid::cli {

@@ -10,7 +10,7 @@
 #include <tuple>
 
 #include "gripper/svg_figures.h"
-#include "solvers/finger_effects.h"
+#include "gripper/finger_effects.h"
 
 namespace hybrid::cli {
 namespace {

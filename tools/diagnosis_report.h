@@ -4,7 +4,7 @@
 #include <utility>
 #include <vector>
 
-#include "solvers/diagnosis.h"
+#include "gripper/finger_diagnosis.h"
 
 namespace hybrid::cli {
 

@@ -14,7 +14,7 @@
 #include "gripper/geometric_finger.h"
 #include "gripper/hand.h"
 #include "gripper/svg_figures.h"
-#include "solvers/simulator.h"
+#include "solvers/simulation/simulator.h"
 #include "tools/options.h"
 #include "tools/output.h"
 #include "tools/user_message.h"

@@ -24,7 +24,7 @@
 #include "automaton/mode_graph.h"
 #include "automaton/parser.h"
 #include "automaton/system.h"
-#include "solvers/measured_data.h"
+#include "gripper/measured_data.h"
 #include "tools/check_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/gripper_command.h"

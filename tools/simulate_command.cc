@@ -10,7 +10,7 @@
 
 #include "automaton/number_syntax.h"
 #include "automaton/parser.h"
-#include "solvers/simulator.h"
+#include "solvers/simulation/simulator.h"
 #include "tools/options.h"
 #include "tools/output.h"
 #include "tools/user_message.h"

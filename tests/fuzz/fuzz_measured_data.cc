@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "solvers/measured_data.h"
+#include "gripper/measured_data.h"
 #include "tests/fuzz/fuzz_utilities.h"
 
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "automaton/parser.h"
-#include "solvers/property_prover.h"
-#include "solvers/simulator.h"
-#include "solvers/trace.h"
+#include "solvers/verification/property_prover.h"
+#include "solvers/simulation/simulator.h"
+#include "solvers/verification/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 

@@ -1,0 +1,219 @@
+#include "gripper/finger_predictor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace hybrid {
+namespace {
+
+constexpr std::string_view kApi = "FingerPredictor";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// gob beyond the motor range: no object (spec/finger.ha's parameter range is [0, 256]).
+constexpr double kNoObject = 256.0;
+constexpr double kMotorMax = 255.0;
+// Simulators kept by FingerPredictor (each holds the compiled model, about 100 kB).
+constexpr size_t kMaxCached = 256;
+
+// Step-signal points with strictly increasing times: of several points at one time the last
+// holds (pieces shorter than the time's rounding vanish), and repeated values are merged.
+void Normalize(std::vector<std::pair<double, double>>& points) {
+  std::vector<std::pair<double, double>> out;
+  for (const auto& pt : points) {
+    if (!out.empty() && out.back().first >= pt.first) out.pop_back();
+    if (!out.empty() && out.back().second == pt.second) continue;
+    out.push_back(pt);
+  }
+  points = std::move(out);
+}
+
+void AppendNumber(std::string& key, double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g;", v);
+  key += buffer;
+}
+
+}  // namespace
+
+FingerPredictor::FingerPredictor(Automaton finger) : FingerPredictor(std::move(finger), {}) {}
+
+FingerPredictor::FingerPredictor(Automaton finger, Options options)
+    : finger_(std::move(finger)), options_(options) {
+  for (const char* name : {"g", "u", "gob1", "gob2", "c1", "c2", "theta3_fraction"}) {
+    if (!finger_.symbols().Find(name)) {
+      throw std::invalid_argument(std::string(kApi) + ": the model has no '" + name +
+                                  "' (expected spec/finger.ha's finger)");
+    }
+  }
+  for (const char* name : {"theta1", "theta2", "theta3"}) {
+    if (!finger_.symbols().Find(name)) {
+      throw std::invalid_argument(std::string(kApi) + ": the model has no '" + name + "'");
+    }
+  }
+  if (finger_.initial_states().empty()) {
+    throw std::invalid_argument(std::string(kApi) + ": the model has no initial state");
+  }
+}
+
+FingerPredictor::~FingerPredictor() = default;
+
+const std::string& FingerPredictor::ModeName(int mode) const { return finger_.modes()[mode].name; }
+
+std::shared_ptr<const FingerPredictor::Entry> FingerPredictor::SimulatorFor(
+    const MeasuredRun& run, const FingerEffects& e) const {
+  std::array<double, 3> gob = {kNoObject, kNoObject, kNoObject};
+  if (run.gob && run.contact_link) {
+    gob[*run.contact_link - 1] = std::clamp(*run.gob - e.motor_offset, 0.0, kNoObject);
+  }
+  std::string key;
+  for (const auto& m : e.joint_max) AppendNumber(key, m ? *m : kNaN);
+  AppendNumber(key, e.theta3_fraction ? *e.theta3_fraction : kNaN);
+  for (double k : e.compliance) AppendNumber(key, k);
+  for (double v : gob) AppendNumber(key, v);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second;
+  }
+  Automaton a = ApplyDynamicEffects(finger_, e);
+  for (int i = 0; i < 3; ++i) {
+    if (gob[i] != kNoObject) a.SetParameter("gob" + std::to_string(i + 1), gob[i]);
+  }
+  auto sim = std::make_shared<const Entry>(System::Of(std::move(a)));
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Bounded: a fit visits many parameter values once (entries in use stay alive through their
+  // shared_ptr).
+  if (cache_.size() >= kMaxCached) cache_.clear();
+  return cache_.emplace(key, std::move(sim)).first->second;
+}
+
+FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEffects& e) const {
+  const size_t n = run.g.size();
+  FingerPrediction p;
+  p.drive = DrivePositions(run.g, e.backlash, e.motor_offset);
+  for (auto& v : p.theta) v.assign(n, kNaN);
+  p.mode.assign(n, -1);
+  p.direction.assign(n, 1);
+  for (size_t k = 0; k < n; ++k) {
+    const double before = k == 0 ? 0.0 : run.g[k - 1];
+    const double step = run.g[k] - before;
+    p.direction[k] = step > 0 ? 1 : step < 0 ? -1 : (k == 0 ? 1 : p.direction[k - 1]);
+  }
+  // Time = path length of the drive; the input is the drive's direction on each piece.
+  SimulationOptions options;
+  options.relative_tolerance = options_.relative_tolerance;
+  options.absolute_tolerance = options_.absolute_tolerance;
+  options.dense_checks = options_.dense_checks;
+  options.sample_times.resize(n);
+  std::vector<std::pair<double, double>> points;
+  // The timeline keeps the drive a hair (1e-9 counts) inside the motor range: the finger's g is
+  // integrated along it, and a rounding-level mismatch between the two must not reach g = 0 or
+  // 255 moving out before the input stops or reverses there.
+  constexpr double kMargin = 1e-9;
+  double t = 0.0, q = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    const double step = std::clamp(p.drive[k], kMargin, kMotorMax - kMargin) - q;
+    if (step != 0.0) {
+      const double sign = step > 0 ? 1.0 : -1.0;
+      if (points.empty() || points.back().second != sign) points.emplace_back(t, sign);
+      t += std::abs(step);
+      q += step;
+    }
+    options.sample_times[k] = t;
+  }
+  // The motor stops after the last sample (a run that ends at g = 0 or 255, moving out, must not
+  // end on the motor range's boundary: an input breakpoint there is decided by the next piece).
+  if (points.empty()) points.emplace_back(0.0, 0.0);
+  points.front().first = 0.0;
+  if (t > 0.0) points.emplace_back(t, 0.0);
+  options.until = t + 1.0;
+  Normalize(points);
+  const std::shared_ptr<const Entry> entry = SimulatorFor(run, e);
+  const Simulator* sim = &entry->simulator;
+  const int u_slot = *sim->system().symbols().Find("u");
+  const int g_index =
+      static_cast<int>(std::find(sim->variable_names().begin(), sim->variable_names().end(), "g") -
+                       sim->variable_names().begin());
+  // Where the finger stopped the motor (phase 4) but the data's g went on, the finger's g lags the
+  // drive and may reach the end of the motor range (0 or 255) before the drive turns: the finger
+  // then stays there (the extended automaton's transmission goes slack) until the drive reverses.
+  // Each pass that ends on the range's boundary, moving out, stops the input there to the end of
+  // that piece.
+  SimulationResult r;
+  for (int pass = 0;; ++pass) {
+    const std::vector<InputSignal> signals = {
+        InputSignal{u_slot, InputSignal::Shape::kStep, points}};
+    r = sim->Run(options, signals);
+    if (r.status != SimulationStatus::kInvariantViolated || pass >= 8) break;
+    const StateSample& last = r.samples.back();
+    const double g_end = last.x[g_index];
+    if (!(std::abs(g_end) < 1e-6 || std::abs(g_end - kMotorMax) < 1e-6)) break;
+    // Stop the piece that moved out (a hair before the violation: it may be reported at the
+    // next breakpoint, within rounding) and keep the pieces after it.
+    const double stop = std::max(0.0, last.time - 1e-7);
+    const double outward = std::abs(g_end) < 1e-6 ? -1.0 : 1.0;
+    size_t i = 0;
+    while (i + 1 < points.size() && points[i + 1].first <= stop) ++i;
+    if (points[i].second != outward) break;
+    if (points[i].first == stop) {
+      points[i].second = 0.0;
+    } else {
+      points.insert(points.begin() + static_cast<long>(i) + 1, {stop, 0.0});
+    }
+    Normalize(points);
+  }
+  p.status = r.status;
+  p.message = r.message;
+  p.model_g.assign(n, kNaN);
+  std::array<int, 3> index{};
+  const std::vector<std::string>& names = sim->variable_names();
+  for (int j = 0; j < 3; ++j) {
+    index[j] = static_cast<int>(
+        std::find(names.begin(), names.end(), "theta" + std::to_string(j + 1)) - names.begin());
+  }
+  size_t k = 0;
+  for (const StateSample& s : r.samples) {
+    if (s.kind != StateSample::Kind::kSample || k >= n) continue;
+    for (int j = 0; j < 3; ++j) p.theta[j][k] = s.x[index[j]] + e.sensor_bias[j];
+    p.mode[k] = s.modes[0];
+    p.model_g[k] = s.x[g_index];
+    ++k;
+  }
+  if (p.status == SimulationStatus::kCompleted && k < n) {
+    p.status = SimulationStatus::kSolverFailure;
+    p.message = "the simulation recorded fewer samples than the run has";
+  }
+  return p;
+}
+
+std::optional<FingerInitialState> FingerPredictor::StartState(const FingerEffects& e) const {
+  MeasuredRun start;
+  start.g = {0.0};
+  start.theta = {{{kNaN}, {kNaN}, {kNaN}}};
+  const double q0 = DrivePositions(start.g, e.backlash, e.motor_offset)[0];
+  if (q0 == 0.0) return std::nullopt;
+  const std::shared_ptr<const Entry> entry = SimulatorFor(start, e);
+  const Simulator* sim = &entry->simulator;
+  SimulationOptions options;
+  options.relative_tolerance = options_.relative_tolerance;
+  options.absolute_tolerance = options_.absolute_tolerance;
+  options.until = q0;
+  const int u_slot = *sim->system().symbols().Find("u");
+  const std::vector<InputSignal> signals = {
+      InputSignal{u_slot, InputSignal::Shape::kStep, {{0.0, 1.0}}}};
+  const SimulationResult r = sim->Run(options, signals);
+  if (r.status != SimulationStatus::kCompleted) {
+    throw std::runtime_error(std::string(kApi) + "::StartState: " + r.message);
+  }
+  const StateSample& end = r.samples.back();
+  FingerInitialState state;
+  state.mode = finger_.modes()[end.modes[0]].name;
+  for (size_t i = 0; i < sim->variable_names().size(); ++i) {
+    state.values.emplace_back(sim->variable_names()[i], end.x[static_cast<int>(i)]);
+  }
+  return state;
+}
+
+}  // namespace hybrid

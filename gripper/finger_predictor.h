@@ -1,0 +1,101 @@
+#pragma once
+
+#include <array>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "automaton/automaton.h"
+#include "gripper/finger_effects.h"
+#include "gripper/measured_data.h"
+#include "solvers/simulation/simulator.h"
+
+namespace hybrid {
+
+/// What the finger model predicts for one measured run.
+struct FingerPrediction {
+  /// Predicted measured angles (deg), sensor biases included; one entry per sample of the run.
+  std::array<std::vector<double>, 3> theta;
+  /// The finger mode (index into the finger automaton's modes) at each sample.
+  std::vector<int> mode;
+  /// Direction of travel of the motor at each sample: +1 closing, -1 opening (a sample where g
+  /// does not change keeps the previous direction; the first one counts as closing).
+  std::vector<int> direction;
+  /// The finger's drive position at each sample (DrivePositions).
+  std::vector<double> drive;
+  /// The model's own motor position g at each sample. It equals `drive` until the finger stops
+  /// the motor (phase 4: the motor stalls); a real motor's measured g stalls there too.
+  std::vector<double> model_g;
+  /// kCompleted, or why the run stopped early (later samples are NaN, mode -1).
+  SimulationStatus status = SimulationStatus::kCompleted;
+  std::string message;
+};
+
+/// Runs the finger automaton driven by a measured run's motor positions, under FingerEffects.
+///
+/// The motor path g_0, g_1, ... (from the open finger at g = 0) is mapped to the finger's drive
+/// positions q_k by DrivePositions (backlash, motor offset); the automaton, with the dynamic
+/// effects applied (ApplyDynamicEffects) and the run's object at gob<link> = gob - d (the object
+/// touches at the same motor position; clipped to [0, 256]), is simulated with input u = +-1
+/// along q, so that time is the drive's path length and each sample is recorded at its position
+/// on the path (the model is rate-independent: every flow is proportional to u). Sensor biases
+/// are added to the angles. This equals simulating ExtendFingerModel's automaton with the motor
+/// path (tests/solvers/finger_predictor_test.cc checks it to 1e-6 deg) whenever the motor does
+/// not travel past a point where the finger stalled it (phase 4), as a physical motor cannot.
+/// Data that do (the motor's g goes on past the stall) are still predicted: the finger stays
+/// stopped, reverses when g does, and stops at the ends of the motor range; the extended
+/// automaton's g_motor instead stalls with the finger, so after such over-travel the two may
+/// differ by the over-travel.
+///
+/// Simulators are built once per distinct (dynamic effects, object) and cached (at most 256;
+/// the cache is emptied when full); Predict is safe to call from several threads.
+class FingerPredictor {
+ public:
+  /// Integration settings (SimulationOptions). The defaults keep the angles within about 1e-7
+  /// deg of the exact solution; Diagnose uses FastOptions().
+  struct Options {
+    double relative_tolerance = 1e-9;
+    double absolute_tolerance = 1e-10;
+    int dense_checks = 4;
+  };
+  /// About 1e-4 deg, four times faster on the phase-3 law (which CVODE integrates): far below
+  /// the measurement noise. No interior double-crossing checks: the finger's guards cross once
+  /// per piece (every flow is monotone along a piece of constant u).
+  static Options FastOptions() { return Options{1e-6, 1e-7, 0}; }
+  /// `finger` must be spec/finger.ha's automaton (names theta1..3, g, u, gob1, gob2, c1, c2);
+  /// throws std::invalid_argument ("FingerPredictor: ...") otherwise.
+  explicit FingerPredictor(Automaton finger);
+  FingerPredictor(Automaton finger, Options options);
+  ~FingerPredictor();
+
+  /// Throws std::invalid_argument for effects out of range (e.g. negative backlash).
+  FingerPrediction Predict(const MeasuredRun& run, const FingerEffects& effects) const;
+
+  /// Where the finger is when the motor is at 0 under `effects`: nullopt when that is the model's
+  /// initial state (drive position 0), else the mode name and continuous values reached by
+  /// closing the finger (no object) to the drive position (motor_offset < 0). What
+  /// ExtendFingerModel needs as `initial_finger`.
+  std::optional<FingerInitialState> StartState(const FingerEffects& effects) const;
+
+  const Automaton& finger() const { return finger_; }
+  /// Name of finger mode `mode`.
+  const std::string& ModeName(int mode) const;
+
+ private:
+  // A simulator with the System it points to.
+  struct Entry {
+    explicit Entry(System s) : system(std::move(s)), simulator(system) {}
+    System system;
+    Simulator simulator;
+  };
+  std::shared_ptr<const Entry> SimulatorFor(const MeasuredRun& run,
+                                            const FingerEffects& effects) const;
+  Automaton finger_;
+  Options options_;
+  mutable std::mutex mutex_;
+  mutable std::map<std::string, std::shared_ptr<const Entry>> cache_;
+};
+
+}  // namespace hybrid
