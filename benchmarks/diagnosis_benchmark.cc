@@ -37,7 +37,7 @@ MeasuredData Data(const HiddenEffects& hidden) {
 void Run(benchmark::State& state, const HiddenEffects& hidden) {
   const MeasuredData data = Data(hidden);
   const Automaton finger = Finger();
-  DiagnosisOptions options;
+  FingerDiagnosisOptions options;
   options.threads = static_cast<int>(state.range(0));
   std::string cause;
   for (auto _ : state) {

@@ -8,33 +8,14 @@
 #include "gripper/finger_effects.h"
 #include "gripper/finger_predictor.h"
 #include "gripper/measured_data.h"
+#include "solvers/diagnosis/diagnosis_engine.h"
 
 namespace hybrid {
 
-/// Settings of Diagnose. The defaults are the documented ones (docs/diagnosis.md).
-struct DiagnosisOptions {
+/// Settings of Diagnose: the engine's (DiagnosisOptions) and the finger data's cleaning.
+struct FingerDiagnosisOptions : DiagnosisOptions {
   /// The report's outlier rule (CleanOutliers): a jump of more than this many degrees.
   double outlier_threshold = 5.0;
-  /// Huber threshold of the robust loss, in noise standard deviations.
-  double huber = 3.0;
-  /// A candidate is significant when its held-out loss (leave-one-run-out, in units of the noise
-  /// variance, i.e. chi-square units) is lower than the reference's by more than this.
-  double significance = 25.0;
-  /// Two held-out losses closer than this (chi-square units) are a tie, broken by BIC.
-  double tie = 2.0;
-  /// A residual is systematic when its held-out mean square exceeds the noise floor by more than
-  /// `systematic_sigmas` standard errors plus `systematic_margin` (relative).
-  double systematic_sigmas = 4.0;
-  double systematic_margin = 0.05;
-  /// Grid points of the first, coarse pass over a parameter's range (a second, fine pass adds as
-  /// many around the best one).
-  int grid_points = 9;
-  /// The same for the second parameter of a pair (the first one fixed).
-  int pair_grid_points = 7;
-  /// Refine the selected parameters with Ceres (robust loss, several starts).
-  bool refine = true;
-  /// Worker threads for the simulations (>= 1).
-  int threads = 2;
 };
 
 /// One candidate extension as judged by cross-validation.
@@ -118,20 +99,17 @@ struct Diagnosis {
   int samples = 0;
 };
 
-/// Diagnoses `data` against the finger model of `predictor`:
-/// 1. cleans outliers (the report's rule) and estimates the noise floor (EstimateNoiseFloor);
-/// 2. runs the model driven by each run's motor positions and analyses the residuals per joint,
-///    mode and direction of travel;
-/// 3. fits every candidate parameter (AllEffectParameters) on a grid of per-run robust losses,
-///    cross-validates it leaving one run out, and names the best one when its held-out gain is
-///    significant (DiagnosisOptions::significance; BIC breaks ties); then tries each other
-///    candidate with it and names a second cause when that adds a significant held-out gain;
-/// 4. refines the named parameters on all runs with Ceres (Huber loss; the grid's best points as
-///    starts);
-/// 5. calls the result "unexplained" (with `where`) when the extended model's held-out residual
-///    is still systematic against the noise floor, and "none" when the baseline's is not.
+/// Diagnoses `data` against the finger model of `predictor` with the general engine
+/// (DiagnoseModel; the candidates are AllEffectParameters, the channels theta1..3, the input g):
+/// 1. cleans outliers (the report's rule, on the residual against the baseline model: a change
+///    of more than `outlier_threshold` degrees from one sample to the next beyond the model's)
+///    and estimates the noise floor (EstimateNoiseFloor);
+/// 2. runs DiagnoseModel on the cleaned runs through FingerDiagnosisModel: residuals per joint,
+///    mode and direction of travel, cross-validated selection of one or two causes, refinement,
+///    verdict ("none", the causes, or "unexplained" with `where`);
+/// 3. turns the named parameters into FingerEffects and records the curves for plots.
 /// Throws std::invalid_argument ("Diagnose: ...") when `data` has no runs or a prediction fails.
 Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
-                   const DiagnosisOptions& options = {});
+                   const FingerDiagnosisOptions& options = {});
 
 }  // namespace hybrid

@@ -211,7 +211,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   MeasuredData data = ReadMeasuredDataFile(args.data);
   const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::FastOptions());
-  DiagnosisOptions options;
+  FingerDiagnosisOptions options;
   options.significance = args.significance;
   options.threads = args.threads;
   const Diagnosis d = Diagnose(predictor, std::move(data), options);

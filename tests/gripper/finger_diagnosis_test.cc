@@ -66,8 +66,8 @@ const Automaton& Finger() {
 }
 
 // The documented defaults, on one thread so that two test processes can share a machine.
-DiagnosisOptions Options() {
-  DiagnosisOptions options;
+FingerDiagnosisOptions Options() {
+  FingerDiagnosisOptions options;
   options.threads = 1;
   return options;
 }
@@ -227,7 +227,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // 5 deg from one sample to the next is clamped), but in phase 3 theta3 moves 2-4 deg per sample
 // in these runs, more with noise, and effects that speed it up get genuine samples clamped:
 // the clamped residual is systematic and the diagnosis says `unexplained` (with
-// DiagnosisOptions::outlier_threshold = 1000 the same data are named correctly).
+// FingerDiagnosisOptions::outlier_threshold = 1000 the same data are named correctly).
 const std::vector<KindSpec>& Kinds() {
   using P = EffectParameter;
   static const std::vector<KindSpec> kinds = {
