@@ -258,7 +258,18 @@ class JobRun {
   // replayed with the horizon.
   static bool Pending(const Candidate& c) { return !c.decided && c.replays < 8; }
   void Decide(Candidate& c, Verdict v, std::string reason, std::optional<Trace> trace = {});
+  // Turns the path of `depth` steps in `model` into a Trace (parameters, initial state and
+  // values, input schedule) and replays it for `c` (ReplayPath); false if it does not replay.
   bool TryTrace(const z3::model& model, int depth, Candidate& c);
+  // Adds to `trace` the values s0 gives the variables that initial state `start` sets in a box.
+  void AddInitialValues(int start, const SmtEncoding::PathStep& s0, Trace& trace) const;
+  // Adds to `trace` the input schedule of `path`: one step piece per flow segment of positive
+  // duration, then a short tail with the last input held.
+  void AddInputSchedule(const std::vector<SmtEncoding::PathStep>& path, int depth,
+                        Trace& trace) const;
+  // Replays `trace` (of the path of `depth` steps in `model`) for `c`: if it replays, decides `c`
+  // violated (reachable for `reach`) with it; false otherwise.
+  bool ReplayPath(const z3::model& model, int depth, Candidate& c, Trace trace);
   bool Extend(int n, std::uint64_t ceiling);
   // The charge for one step of the encoding (a State and a Transition) asserted in a solver.
   std::uint64_t StepUnits() const {
@@ -283,7 +294,40 @@ class JobRun {
   void Search(int n, bool invariants_only, std::initializer_list<bool> passes,
               std::uint64_t ceiling);
   void One(Candidate& c, int n, bool pinned, std::uint64_t ceiling);
+
+  // One round of k-induction (Houdini): the candidates, which are still alive, and the formulas
+  // of the step queries, each built once.
+  struct InductionRound {
+    int k = 1;
+    std::uint64_t ceiling = 0;
+    std::vector<Candidate*> set;
+    std::vector<bool> alive;
+    std::vector<std::optional<z3::expr>> path_from;  // the path of k steps, per last mode
+    std::optional<z3::expr> hypotheses;              // of the alive candidates
+    std::optional<z3::expr> path_any;                // the path of k steps, any last mode
+
+    // The indices of the candidates still alive.
+    std::vector<std::size_t> Living() const;
+    // Drops the candidates `failed`; whether any was alive (then the hypotheses are rebuilt).
+    bool Drop(const std::vector<std::size_t>& failed);
+  };
   void Induction(int k);
+  // The round of k-induction over the invariants neither refuted nor decided, all alive.
+  InductionRound StartInduction(int k);
+  // The step from each mode in turn for the living candidates (split per candidate where a
+  // query runs out); drops those that fail and returns whether any was dropped.
+  bool StepPerMode(InductionRound& round);
+  // The step query from mode m, or from any mode (m = -1, with Z3's default solver): a path of k
+  // steps on which the living candidates hold before s_k and one of `goals` fails at s_k. On sat,
+  // `failed` gets the goals the model breaks (all of them when it cannot tell).
+  z3::check_result StepQuery(InductionRound& round, int m, const std::vector<std::size_t>& goals,
+                             unsigned limit, std::vector<std::size_t>& failed);
+  // The path of the step query from mode m (any: m < 0), built on first use.
+  const z3::expr& StepPath(InductionRound& round, int m);
+  // The living candidates hold at s_0 .. s_k-1: built on first use after each drop.
+  const z3::expr& Hypotheses(InductionRound& round);
+  // The candidates still alive are inductive together: proved.
+  void DecideInductive(const InductionRound& round);
   void DeepSearch();
   bool Unreachable(const Candidate& c);
   void Conclude();
@@ -343,20 +387,26 @@ bool JobRun::TryTrace(const z3::model& model, int depth, Candidate& c) {
   const int start = enc_.InitialIndex(model);
   if (start < 0) return false;
   if (job_.component >= 0) trace.initial_states.emplace_back(job_.component, start);
-  {
-    const InitialState& init = a_.initial_states()[static_cast<std::size_t>(start)];
-    for (const InitialValue& iv : init.values) {
-      if (iv.is_point) continue;
-      int index = 0;
-      for (const VariableInfo& v : a_.variables()) {
-        if (v.slot == iv.slot) break;
-        ++index;
-      }
-      trace.initial_values.emplace_back(system_.symbols()[job_.to_system[iv.slot]].name,
-                                        path[0].x[index]);
+  AddInitialValues(start, path[0], trace);
+  AddInputSchedule(path, depth, trace);
+  return ReplayPath(model, depth, c, std::move(trace));
+}
+
+void JobRun::AddInitialValues(int start, const SmtEncoding::PathStep& s0, Trace& trace) const {
+  const InitialState& init = a_.initial_states()[static_cast<std::size_t>(start)];
+  for (const InitialValue& iv : init.values) {
+    if (iv.is_point) continue;
+    int index = 0;
+    for (const VariableInfo& v : a_.variables()) {
+      if (v.slot == iv.slot) break;
+      ++index;
     }
+    trace.initial_values.emplace_back(system_.symbols()[job_.to_system[iv.slot]].name, s0.x[index]);
   }
-  // The input schedule: one step piece per flow segment of positive duration.
+}
+
+void JobRun::AddInputSchedule(const std::vector<SmtEncoding::PathStep>& path, int depth,
+                              Trace& trace) const {
   const int ni = static_cast<int>(a_.inputs().size());
   std::vector<InputSignal> signals(ni);
   double t = 0.0;
@@ -395,6 +445,9 @@ bool JobRun::TryTrace(const z3::model& model, int depth, Candidate& c) {
     if (s.points.empty()) s.points.emplace_back(0.0, 0.0);
     trace.inputs.inputs.push_back(s);
   }
+}
+
+bool JobRun::ReplayPath(const z3::model& model, int depth, Candidate& c, Trace trace) {
   ++c.replays;
   bool replayed = false;
   try {
@@ -515,125 +568,154 @@ void JobRun::One(Candidate& c, int n, bool pinned, std::uint64_t ceiling) {
 // disjunction. Per mode, all candidates are checked at once; a model names the ones that fail
 // (dropped), a query that runs out splits per candidate, and one that runs out alone is dropped.
 void JobRun::Induction(int k) {
-  std::vector<Candidate*> set;
-  for (Candidate& c : cands_) {
-    if (c.invariant && !c.refuted && !c.decided) set.push_back(&c);
-  }
-  const std::uint64_t ceiling = Ceiling(0.5);
-  std::vector<bool> alive(set.size(), true);
-  std::vector<std::optional<z3::expr>> path_from(a_.num_modes());
-  std::optional<z3::expr> hypotheses;  // of the alive candidates
-  std::optional<z3::expr> path_any;
-  // The step query from mode m, or from any mode (m = -1, with Z3's default solver).
-  auto check = [&](int m, const std::vector<std::size_t>& goals, unsigned limit,
-                   std::vector<std::size_t>& failed) {
-    // A path of k steps (k + 1 states) asserted in a new solver.
-    if (!meter_.Afford(PathUnits(k, m), ceiling)) return z3::unknown;
-    z3::solver s = m < 0 ? MakeIncremental(ctx_) : MakeSolver(ctx_);
-    std::optional<z3::expr>& path = m < 0 ? path_any : path_from[m];
-    if (!path) {
-      z3::expr_vector e(ctx_);
-      for (int i = 0; i <= k; ++i) e.push_back(enc_.State(i));
-      for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
-      e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
-      e.push_back(enc_.TakeDefinitions());
-      path = z3::mk_and(e);
-    }
-    s.add(*path);
-    if (!hypotheses) {
-      z3::expr_vector e(ctx_);
-      for (std::size_t j = 0; j < set.size(); ++j) {
-        if (!alive[j]) continue;
-        for (int i = 0; i < k; ++i) e.push_back(!enc_.Holds(set[j]->bad, i, 0.0));
-      }
-      e.push_back(enc_.TakeDefinitions());
-      hypotheses = z3::mk_and(e);
-    }
-    s.add(*hypotheses);
-    z3::expr_vector bad(ctx_);
-    std::vector<z3::expr> at_k;
-    for (std::size_t j : goals) {
-      at_k.push_back(enc_.Holds(set[j]->bad, k, 0.0));
-      bad.push_back(at_k.back());
-    }
-    Add(s, enc_, z3::mk_or(bad));
-    const z3::check_result r =
-        meter_.Check(s, limit, ceiling, m < 0 ? "induction" : "induction, one mode");
-    if (r == z3::sat) {
-      const z3::model model = s.get_model();
-      for (std::size_t g = 0; g < goals.size(); ++g) {
-        if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
-      }
-      if (std::getenv("HYBRID_CHECK_DEBUG")) {
-        std::cerr << "induction k=" << k << " from mode "
-                  << (m < 0 ? std::string("(any)") : a_.modes()[m].name) << " fails:\n";
-        DebugPath(enc_, model, k);
-      }
-      if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
-    }
-    return r;
-  };
-  auto drop = [&](const std::vector<std::size_t>& failed) {
-    bool changed = false;
-    for (std::size_t j : failed) {
-      changed = changed || alive[j];
-      alive[j] = false;
-    }
-    if (changed) hypotheses.reset();  // weaker now: modes already passed are checked again
-    return changed;
-  };
-  auto living = [&] {
-    std::vector<std::size_t> goals;
-    for (std::size_t j = 0; j < set.size(); ++j) {
-      if (alive[j]) goals.push_back(j);
-    }
-    return goals;
-  };
+  InductionRound round = StartInduction(k);
   // First the step from any mode in one query (cheap where the flows are simple, however many
   // modes), while it decides; then per mode.
   bool whole = true;
   bool changed = true;
   while (changed) {
     changed = false;
-    hypotheses.reset();
-    if (whole && !living().empty() && budget_.used() < ceiling && !budget_.SafetyExpired()) {
+    round.hypotheses.reset();
+    if (whole && !round.Living().empty() && budget_.used() < round.ceiling &&
+        !budget_.SafetyExpired()) {
       std::vector<std::size_t> failed;
-      const z3::check_result r = check(-1, living(), options_.resource_limit / 25, failed);
+      const z3::check_result r =
+          StepQuery(round, -1, round.Living(), options_.resource_limit / 25, failed);
       if (r == z3::unsat) break;
       if (r == z3::sat) {
-        changed = drop(failed);
+        changed = round.Drop(failed);
         continue;
       }
       whole = false;
     }
-    for (int m = 0; m < a_.num_modes(); ++m) {
-      std::vector<std::size_t> goals = living(), failed;
-      if (goals.empty()) break;
-      if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
-        proof_cut_ = true;  // nothing left to prove with: every candidate is dropped
-        failed = goals;
-      } else if (check(m, goals, options_.resource_limit / 25, failed) == z3::unknown) {
-        // Split per candidate with a larger limit, then the full one (a candidate dropped for
-        // want of resources takes with it every candidate that needs it as a lemma).
-        for (std::size_t j : goals) {
-          std::vector<std::size_t> f;
-          if (check(m, {j}, options_.resource_limit / 5, f) == z3::unknown &&
-              check(m, {j}, options_.resource_limit, f) == z3::unknown) {
-            f.push_back(j);
-          }
-          failed.insert(failed.end(), f.begin(), f.end());
-        }
-      }
-      changed = drop(failed) || changed;
-    }
+    changed = StepPerMode(round) || changed;
   }
-  std::size_t lemmas = 0;
-  for (std::size_t j = 0; j < set.size(); ++j) lemmas += alive[j] ? 1 : 0;
+  DecideInductive(round);
+}
+
+JobRun::InductionRound JobRun::StartInduction(int k) {
+  InductionRound round;
+  round.k = k;
+  for (Candidate& c : cands_) {
+    if (c.invariant && !c.refuted && !c.decided) round.set.push_back(&c);
+  }
+  round.ceiling = Ceiling(0.5);
+  round.alive.assign(round.set.size(), true);
+  round.path_from.resize(a_.num_modes());
+  return round;
+}
+
+std::vector<std::size_t> JobRun::InductionRound::Living() const {
+  std::vector<std::size_t> goals;
   for (std::size_t j = 0; j < set.size(); ++j) {
-    if (!alive[j]) continue;
-    Candidate& c = *set[j];
+    if (alive[j]) goals.push_back(j);
+  }
+  return goals;
+}
+
+bool JobRun::InductionRound::Drop(const std::vector<std::size_t>& failed) {
+  bool changed = false;
+  for (std::size_t j : failed) {
+    changed = changed || alive[j];
+    alive[j] = false;
+  }
+  if (changed) hypotheses.reset();  // weaker now: modes already passed are checked again
+  return changed;
+}
+
+bool JobRun::StepPerMode(InductionRound& round) {
+  bool changed = false;
+  for (int m = 0; m < a_.num_modes(); ++m) {
+    std::vector<std::size_t> goals = round.Living(), failed;
+    if (goals.empty()) break;
+    if (budget_.used() >= round.ceiling || budget_.SafetyExpired()) {
+      proof_cut_ = true;  // nothing left to prove with: every candidate is dropped
+      failed = goals;
+    } else if (StepQuery(round, m, goals, options_.resource_limit / 25, failed) == z3::unknown) {
+      // Split per candidate with a larger limit, then the full one (a candidate dropped for
+      // want of resources takes with it every candidate that needs it as a lemma).
+      for (std::size_t j : goals) {
+        std::vector<std::size_t> f;
+        if (StepQuery(round, m, {j}, options_.resource_limit / 5, f) == z3::unknown &&
+            StepQuery(round, m, {j}, options_.resource_limit, f) == z3::unknown) {
+          f.push_back(j);
+        }
+        failed.insert(failed.end(), f.begin(), f.end());
+      }
+    }
+    changed = round.Drop(failed) || changed;
+  }
+  return changed;
+}
+
+z3::check_result JobRun::StepQuery(InductionRound& round, int m,
+                                   const std::vector<std::size_t>& goals, unsigned limit,
+                                   std::vector<std::size_t>& failed) {
+  const int k = round.k;
+  // A path of k steps (k + 1 states) asserted in a new solver.
+  if (!meter_.Afford(PathUnits(k, m), round.ceiling)) return z3::unknown;
+  z3::solver s = m < 0 ? MakeIncremental(ctx_) : MakeSolver(ctx_);
+  s.add(StepPath(round, m));
+  s.add(Hypotheses(round));
+  z3::expr_vector bad(ctx_);
+  std::vector<z3::expr> at_k;
+  for (std::size_t j : goals) {
+    at_k.push_back(enc_.Holds(round.set[j]->bad, k, 0.0));
+    bad.push_back(at_k.back());
+  }
+  Add(s, enc_, z3::mk_or(bad));
+  const z3::check_result r =
+      meter_.Check(s, limit, round.ceiling, m < 0 ? "induction" : "induction, one mode");
+  if (r == z3::sat) {
+    const z3::model model = s.get_model();
+    for (std::size_t g = 0; g < goals.size(); ++g) {
+      if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
+    }
+    if (std::getenv("HYBRID_CHECK_DEBUG")) {
+      std::cerr << "induction k=" << k << " from mode "
+                << (m < 0 ? std::string("(any)") : a_.modes()[m].name) << " fails:\n";
+      DebugPath(enc_, model, k);
+    }
+    if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
+  }
+  return r;
+}
+
+const z3::expr& JobRun::StepPath(InductionRound& round, int m) {
+  const int k = round.k;
+  std::optional<z3::expr>& path = m < 0 ? round.path_any : round.path_from[m];
+  if (!path) {
+    z3::expr_vector e(ctx_);
+    for (int i = 0; i <= k; ++i) e.push_back(enc_.State(i));
+    for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
+    e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
+    e.push_back(enc_.TakeDefinitions());
+    path = z3::mk_and(e);
+  }
+  return *path;
+}
+
+const z3::expr& JobRun::Hypotheses(InductionRound& round) {
+  if (!round.hypotheses) {
+    z3::expr_vector e(ctx_);
+    for (std::size_t j = 0; j < round.set.size(); ++j) {
+      if (!round.alive[j]) continue;
+      for (int i = 0; i < round.k; ++i) e.push_back(!enc_.Holds(round.set[j]->bad, i, 0.0));
+    }
+    e.push_back(enc_.TakeDefinitions());
+    round.hypotheses = z3::mk_and(e);
+  }
+  return *round.hypotheses;
+}
+
+void JobRun::DecideInductive(const InductionRound& round) {
+  std::size_t lemmas = 0;
+  for (std::size_t j = 0; j < round.set.size(); ++j) lemmas += round.alive[j] ? 1 : 0;
+  for (std::size_t j = 0; j < round.set.size(); ++j) {
+    if (!round.alive[j]) continue;
+    Candidate& c = *round.set[j];
     Decide(c, Verdict::kProved,
-           "proved by " + std::to_string(k) + "-induction, together with " +
+           "proved by " + std::to_string(round.k) + "-induction, together with " +
                std::to_string(lemmas - 1) + " other invariant(s) as lemmas");
     c.proved = true;
   }
@@ -809,21 +891,129 @@ void Collect(const Predicate& p, std::set<int>& slots, std::set<std::string>& mo
 
 namespace {
 
-// Sorts `properties` into jobs: one per component for a property that reads only that
-// component's own variables (in its slots and mode names), the product job for the others (made
-// on demand in `product`), or a verdict right away (`unknown`) when neither is possible.
-void PlanJobs(const System& system, std::span<const Property> properties, int max_product_modes,
-              std::vector<CheckResult>& results, std::vector<Job>& jobs,
-              std::optional<Automaton>& product, Job& product_job) {
+// Which components write each System slot (continuous variables).
+std::vector<std::vector<int>> SlotOwners(const System& system) {
   const auto components = system.components();
-  // Which components write each System slot (continuous variables).
   std::vector<std::vector<int>> owners(system.symbols().size());
   for (std::size_t c = 0; c < components.size(); ++c) {
     for (const VariableInfo& v : components[c].automaton.variables()) {
       owners[components[c].global_slot[v.slot]].push_back(static_cast<int>(c));
     }
   }
-  std::map<std::string, std::vector<int>> asked;  // goals by their text (see below)
+  return owners;
+}
+
+// The components that hold the variables (`slots`) and `modes` property `p` reads, or component 0
+// when it reads none. Throws std::invalid_argument for a property that reads an input.
+std::set<int> ComponentsRead(const System& system, const Property& p, const std::set<int>& slots,
+                             const std::set<std::string>& modes) {
+  const auto components = system.components();
+  std::set<int> comps;
+  for (int s : slots) {
+    const SymbolKind kind = system.symbols()[s].kind;
+    if (kind == SymbolKind::kInput) {
+      throw std::invalid_argument("property '" + p.name + "' reads input '" +
+                                  system.symbols()[s].name +
+                                  "': properties may read variables, parameters and modes");
+    }
+    if (kind == SymbolKind::kParameter) continue;
+    for (std::size_t c = 0; c < components.size(); ++c) {
+      const auto& g = components[c].global_slot;
+      if (std::find(g.begin(), g.end(), s) != g.end()) comps.insert(static_cast<int>(c));
+    }
+  }
+  for (const std::string& m : modes) {
+    if (auto found = system.FindMode(m)) comps.insert(found->first);
+  }
+  if (comps.empty()) comps.insert(0);
+  return comps;
+}
+
+// Whether no other component writes a continuous variable of component c.
+bool WritesAlone(const System& system, const std::vector<std::vector<int>>& owners, int c) {
+  const Component& comp = system.components()[c];
+  bool alone = true;
+  for (const VariableInfo& v : comp.automaton.variables()) {
+    if (owners[comp.global_slot[v.slot]].size() > 1) alone = false;
+  }
+  return alone;
+}
+
+// `p` (System slots and mode names) over component c's own slots and mode names.
+Property Localise(const System& system, int c, const Property& p) {
+  const Component& comp = system.components()[c];
+  std::vector<int> local(system.symbols().size(), -1);
+  for (std::size_t s = 0; s < comp.global_slot.size(); ++s) {
+    local[comp.global_slot[s]] = static_cast<int>(s);
+  }
+  Property q = p;
+  q.predicate = Remap(
+      p.predicate,
+      [&](const Expression& e) {
+        return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+          return Expression::Symbol(name, local.at(slot));
+        });
+      },
+      [&](const std::string& m) {
+        auto found = system.FindMode(m);
+        return found ? comp.automaton.mode(found->second).name : m;
+      });
+  return q;
+}
+
+// Adds `q`, the local form of property number i (`p`), to component c's job; the same question
+// asked twice is answered once (`asked`: goals looked up by their text, then compared).
+void AddGoal(int c, const Property& q, int i, const Property& p,
+             std::map<std::string, std::vector<int>>& asked, std::vector<Job>& jobs) {
+  const std::string key = std::to_string(c) + " " + std::string(KindKeyword(q.kind)) + " " +
+                          q.predicate.ToString() + " " +
+                          (q.horizon ? FormatNumber(*q.horizon) : std::string("-"));
+  for (const int g : asked[key]) {
+    Goal& goal = jobs[c].goals[g];
+    if (goal.property.kind == q.kind && goal.property.predicate == q.predicate &&
+        goal.property.horizon == q.horizon) {
+      goal.also.push_back(i);
+      return;
+    }
+  }
+  asked[key].push_back(static_cast<int>(jobs[c].goals.size()));
+  jobs[c].goals.push_back({q, i, p, {}});
+}
+
+// Adds property number i (`p`, which reads `in MODE` atoms if `reads_modes`) to the product job,
+// making the product on first use; or leaves it `unknown` when the product is too large or the
+// property reads modes.
+void AddProductGoal(const System& system, const Property& p, int i, bool reads_modes,
+                    int max_product_modes, std::vector<CheckResult>& results,
+                    std::optional<Automaton>& product, Job& product_job) {
+  if (!product) {
+    try {
+      product = system.Product(max_product_modes);
+    } catch (const std::invalid_argument& e) {
+      results[i].verdict = Verdict::kUnknown;
+      results[i].reason = std::string(
+                              "the property reads several components and their "
+                              "product is too large: ") +
+                          e.what();
+      return;
+    }
+  }
+  if (reads_modes) {
+    results[i].verdict = Verdict::kUnknown;
+    results[i].reason = "`in MODE` atoms over several components are not supported";
+    return;
+  }
+  product_job.goals.push_back({p, i, p, {}});
+}
+
+// Sorts `properties` into jobs: one per component for a property that reads only that
+// component's own variables (in its slots and mode names), the product job for the others (made
+// on demand in `product`), or a verdict right away (`unknown`) when neither is possible.
+void PlanJobs(const System& system, std::span<const Property> properties, int max_product_modes,
+              std::vector<CheckResult>& results, std::vector<Job>& jobs,
+              std::optional<Automaton>& product, Job& product_job) {
+  const std::vector<std::vector<int>> owners = SlotOwners(system);
+  std::map<std::string, std::vector<int>> asked;  // goals by their text (see AddGoal)
   for (std::size_t i = 0; i < properties.size(); ++i) {
     const Property& p = properties[i];
     results[i].property = p.name;
@@ -832,89 +1022,14 @@ void PlanJobs(const System& system, std::span<const Property> properties, int ma
     std::set<int> slots;
     std::set<std::string> modes;
     Collect(p.predicate, slots, modes);
-    std::set<int> comps;
-    for (int s : slots) {
-      const SymbolKind kind = system.symbols()[s].kind;
-      if (kind == SymbolKind::kInput) {
-        throw std::invalid_argument("property '" + p.name + "' reads input '" +
-                                    system.symbols()[s].name +
-                                    "': properties may read variables, parameters and modes");
-      }
-      if (kind == SymbolKind::kParameter) continue;
-      for (std::size_t c = 0; c < components.size(); ++c) {
-        const auto& g = components[c].global_slot;
-        if (std::find(g.begin(), g.end(), s) != g.end()) comps.insert(static_cast<int>(c));
-      }
-    }
-    for (const std::string& m : modes) {
-      if (auto found = system.FindMode(m)) comps.insert(found->first);
-    }
-    if (comps.empty()) comps.insert(0);
-    bool alone = comps.size() == 1;
-    if (alone) {
+    const std::set<int> comps = ComponentsRead(system, p, slots, modes);
+    if (comps.size() == 1 && WritesAlone(system, owners, *comps.begin())) {
       const int c = *comps.begin();
-      for (const VariableInfo& v : components[c].automaton.variables()) {
-        if (owners[components[c].global_slot[v.slot]].size() > 1) alone = false;
-      }
-    }
-    if (alone) {
-      const int c = *comps.begin();
-      const Component& comp = components[c];
-      std::vector<int> local(system.symbols().size(), -1);
-      for (std::size_t s = 0; s < comp.global_slot.size(); ++s) {
-        local[comp.global_slot[s]] = static_cast<int>(s);
-      }
-      Property q = p;
-      q.predicate = Remap(
-          p.predicate,
-          [&](const Expression& e) {
-            return e.Substitute(
-                [&](const std::string& name, int slot) -> std::optional<Expression> {
-                  return Expression::Symbol(name, local.at(slot));
-                });
-          },
-          [&](const std::string& m) {
-            auto found = system.FindMode(m);
-            return found ? comp.automaton.mode(found->second).name : m;
-          });
-      // The same question asked twice is answered once (looked up by its text, then compared).
-      const std::string key = std::to_string(c) + " " + std::string(KindKeyword(q.kind)) + " " +
-                              q.predicate.ToString() + " " +
-                              (q.horizon ? FormatNumber(*q.horizon) : std::string("-"));
-      bool same = false;
-      for (const int g : asked[key]) {
-        Goal& goal = jobs[c].goals[g];
-        if (goal.property.kind == q.kind && goal.property.predicate == q.predicate &&
-            goal.property.horizon == q.horizon) {
-          goal.also.push_back(static_cast<int>(i));
-          same = true;
-          break;
-        }
-      }
-      if (!same) {
-        asked[key].push_back(static_cast<int>(jobs[c].goals.size()));
-        jobs[c].goals.push_back({q, static_cast<int>(i), p, {}});
-      }
+      AddGoal(c, Localise(system, c, p), static_cast<int>(i), p, asked, jobs);
       continue;
     }
-    if (!product) {
-      try {
-        product = system.Product(max_product_modes);
-      } catch (const std::invalid_argument& e) {
-        results[i].verdict = Verdict::kUnknown;
-        results[i].reason = std::string(
-                                "the property reads several components and their "
-                                "product is too large: ") +
-                            e.what();
-        continue;
-      }
-    }
-    if (!modes.empty()) {
-      results[i].verdict = Verdict::kUnknown;
-      results[i].reason = "`in MODE` atoms over several components are not supported";
-      continue;
-    }
-    product_job.goals.push_back({p, static_cast<int>(i), p, {}});
+    AddProductGoal(system, p, static_cast<int>(i), !modes.empty(), max_product_modes, results,
+                   product, product_job);
   }
 }
 

@@ -339,6 +339,123 @@ std::string Plural(int n, const std::string& word) {
   return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
 }
 
+// The horizon of every run: the option, else the property's `within T`, else the system's
+// scenario horizon, else 100. Fails unless it is positive and finite.
+double SampleHorizon(const PropertySampler::Options& options, const System& system,
+                     const Property& property) {
+  double horizon = 100.0;
+  if (options.horizon) {
+    horizon = *options.horizon;
+  } else if (property.horizon) {
+    horizon = *property.horizon;
+  } else if (system.scenario()) {
+    horizon = system.scenario()->until;
+  }
+  if (!(horizon > 0) || !std::isfinite(horizon)) {
+    Fail("the horizon of property '" + property.name + "' must be positive and finite");
+  }
+  return horizon;
+}
+
+// Fails for a system the simulator rejects (e.g. without initial state).
+void RequireSimulable(const System& system) {
+  try {
+    const Simulator probe(system);  // rejects a system without initial state
+  } catch (const std::invalid_argument& e) {
+    Fail(e.what());
+  }
+}
+
+// The rapidcheck size of run `run` of `runs`: sizes ramp up over the first half of the runs, so
+// that early runs have few pieces.
+int RunSize(int run, int runs) {
+  return runs == 1 ? rc::kNominalSize
+                   : std::min(rc::kNominalSize,
+                              static_cast<int>(2LL * rc::kNominalSize * (run + 1) / runs));
+}
+
+// The runs of one property: draws turned into traces and replayed.
+struct Sampling {
+  const System& system;
+  const Property& property;
+  const Space& space;
+  double horizon;
+  std::string first_error;  // the first rejection's message
+
+  // Replays `draw` into `trace`: whether it hits (a counterexample or witness); nullopt when the
+  // model rejects it (message kept in first_error).
+  std::optional<bool> Attempt(const Draw& draw, Trace& trace) {
+    try {
+      trace = ToTrace(system, space, draw, horizon);
+      return ReplayTrace(system, property, trace);
+    } catch (const std::invalid_argument& e) {
+      if (first_error.empty()) first_error = e.what();
+      return std::nullopt;
+    }
+  }
+};
+
+// Greedy shrinking of a hit (`current`, replayed as `best`): moves to the first simpler candidate
+// that still hits, until none does or the options' limits are reached. Returns the number of
+// steps taken (candidates that denote the same run are taken without counting a step).
+int Shrink(Sampling& sampling, const PropertySampler::Options& options,
+           rc::Shrinkable<Draw>& current, Trace& best) {
+  int steps = 0;
+  int examined = 0;
+  bool progress = true;
+  while (progress && steps < options.max_shrink_steps && examined < options.max_shrink_replays) {
+    progress = false;
+    rc::Seq<rc::Shrinkable<Draw>> candidates = current.shrinks();
+    while (examined < options.max_shrink_replays) {
+      rc::Maybe<rc::Shrinkable<Draw>> candidate = candidates.next();
+      if (!candidate) break;
+      ++examined;
+      const Draw draw = candidate->value();
+      Trace trace;
+      try {
+        trace = ToTrace(sampling.system, sampling.space, draw, sampling.horizon);
+      } catch (const std::invalid_argument&) {
+        continue;
+      }
+      if (SameRun(trace, best)) {
+        // Structurally simpler, the same run (e.g. a value at an anchor that coincides with
+        // another): take it without replaying and without counting a step.
+        current = std::move(*candidate);
+        progress = true;
+        break;
+      }
+      const std::optional<bool> still = sampling.Attempt(draw, trace);
+      if (still && *still) {
+        current = std::move(*candidate);
+        best = std::move(trace);
+        ++steps;
+        progress = true;
+        break;
+      }
+    }
+  }
+  return steps;
+}
+
+// The reason of a verdict found in run `run` of `runs` ("counterexample in run 17 of 200, shrunk
+// in 12 steps from 6 to 2 input pieces"); pieces: the hit's input pieces as found and as shrunk.
+std::string FoundReason(const std::string& found_what, int run, int runs, int steps,
+                        int pieces_found, int pieces, bool has_inputs) {
+  std::string reason =
+      found_what + " in run " + std::to_string(run + 1) + " of " + std::to_string(runs);
+  if (steps > 0) {
+    reason += ", shrunk in " + Plural(steps, "step");
+    if (has_inputs) {
+      reason += pieces != pieces_found ? " from " + std::to_string(pieces_found) + " to " +
+                                             Plural(pieces, "input piece")
+                                       : " (" + Plural(pieces, "input piece") + ")";
+    }
+  } else if (has_inputs) {
+    reason += ", " + Plural(pieces, "input piece");
+  }
+  return reason;
+}
+
 }  // namespace
 
 PropertySampler::PropertySampler() : PropertySampler(Options{}) {}
@@ -357,23 +474,8 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
   const auto start = std::chrono::steady_clock::now();
   const bool reach = property.kind == Property::Kind::kReach;
   const std::string found_what = reach ? "witness" : "counterexample";
-
-  double horizon = 100.0;
-  if (options_.horizon) {
-    horizon = *options_.horizon;
-  } else if (property.horizon) {
-    horizon = *property.horizon;
-  } else if (system.scenario()) {
-    horizon = system.scenario()->until;
-  }
-  if (!(horizon > 0) || !std::isfinite(horizon)) {
-    Fail("the horizon of property '" + property.name + "' must be positive and finite");
-  }
-  try {
-    const Simulator probe(system);  // rejects a system without initial state
-  } catch (const std::invalid_argument& e) {
-    Fail(e.what());
-  }
+  const double horizon = SampleHorizon(options_, system, property);
+  RequireSimulable(system);
 
   const Space space = SpaceOf(system);
   const int runs = space.random ? options_.runs : 1;
@@ -388,87 +490,24 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
     return r;
   };
 
-  // Replays `draw`; nullopt when the model rejects it (message in `error`).
-  std::string first_error;
-  auto attempt = [&](const Draw& draw, Trace& trace) -> std::optional<bool> {
-    try {
-      trace = ToTrace(system, space, draw, horizon);
-      return ReplayTrace(system, property, trace);
-    } catch (const std::invalid_argument& e) {
-      if (first_error.empty()) first_error = e.what();
-      return std::nullopt;
-    }
-  };
-
+  Sampling sampling{system, property, space, horizon, {}};
   rc::Random random(options_.seed);
   int rejected = 0;
   for (int run = 0; run < runs; ++run) {
-    // Sizes ramp up over the first half of the runs: early runs have few pieces.
-    const int size = runs == 1
-                         ? rc::kNominalSize
-                         : std::min(rc::kNominalSize,
-                                    static_cast<int>(2LL * rc::kNominalSize * (run + 1) / runs));
+    const int size = RunSize(run, runs);
     rc::Shrinkable<Draw> current = gen(random.split(), size);
     Trace best;
-    const std::optional<bool> hit = attempt(current.value(), best);
+    const std::optional<bool> hit = sampling.Attempt(current.value(), best);
     if (!hit) {
       ++rejected;
       continue;
     }
     if (!*hit) continue;
-
-    // Greedy shrinking: move to the first simpler candidate that still hits, until none does.
     const int pieces_found = InputPieces(best);
-    int steps = 0;
-    int examined = 0;
-    bool progress = true;
-    while (progress && steps < options_.max_shrink_steps &&
-           examined < options_.max_shrink_replays) {
-      progress = false;
-      rc::Seq<rc::Shrinkable<Draw>> candidates = current.shrinks();
-      while (examined < options_.max_shrink_replays) {
-        rc::Maybe<rc::Shrinkable<Draw>> candidate = candidates.next();
-        if (!candidate) break;
-        ++examined;
-        const Draw draw = candidate->value();
-        Trace trace;
-        try {
-          trace = ToTrace(system, space, draw, horizon);
-        } catch (const std::invalid_argument&) {
-          continue;
-        }
-        if (SameRun(trace, best)) {
-          // Structurally simpler, the same run (e.g. a value at an anchor that coincides with
-          // another): take it without replaying and without counting a step.
-          current = std::move(*candidate);
-          progress = true;
-          break;
-        }
-        const std::optional<bool> still = attempt(draw, trace);
-        if (still && *still) {
-          current = std::move(*candidate);
-          best = std::move(trace);
-          ++steps;
-          progress = true;
-          break;
-        }
-      }
-    }
-
+    const int steps = Shrink(sampling, options_, current, best);
     result.verdict = reach ? Verdict::kReachable : Verdict::kViolated;
-    result.reason =
-        found_what + " in run " + std::to_string(run + 1) + " of " + std::to_string(runs);
-    const int pieces = InputPieces(best);
-    if (steps > 0) {
-      result.reason += ", shrunk in " + Plural(steps, "step");
-      if (!space.inputs.empty()) {
-        result.reason += pieces != pieces_found ? " from " + std::to_string(pieces_found) + " to " +
-                                                      Plural(pieces, "input piece")
-                                                : " (" + Plural(pieces, "input piece") + ")";
-      }
-    } else if (!space.inputs.empty()) {
-      result.reason += ", " + Plural(pieces, "input piece");
-    }
+    result.reason = FoundReason(found_what, run, runs, steps, pieces_found, InputPieces(best),
+                                !space.inputs.empty());
     result.trace = std::move(best);
     ConfirmTrace(system, property, result);  // the gate of every reported trace
     return finish(std::move(result));
@@ -476,14 +515,14 @@ CheckResult PropertySampler::Check(const System& system, const Property& propert
 
   if (rejected == runs) {
     Fail("the model rejected every sampled run of property '" + property.name +
-         "': " + first_error);
+         "': " + sampling.first_error);
   }
   result.verdict = Verdict::kUnknown;
   result.reason = "no " + found_what + " in " + Plural(runs - rejected, "sampled run") +
                   " (sampling never proves)";
   if (rejected > 0) {
-    result.reason +=
-        "; " + std::to_string(rejected) + " draws rejected by the model, first: " + first_error;
+    result.reason += "; " + std::to_string(rejected) +
+                     " draws rejected by the model, first: " + sampling.first_error;
   }
   return finish(std::move(result));
 }

@@ -60,39 +60,82 @@ struct Integral {
 };
 
 std::optional<Expression> Integrate(const Expression& phi, int w, const std::string& wname,
+                                    Integral& side);
+
+// (alpha, beta) with `b` = alpha + beta w, where w is the slot `w`; nullopt unless `b` is affine
+// in w alone.
+std::optional<std::pair<double, double>> AffineIn(const Expression& b, int w) {
+  auto a = b.AsAffine();
+  if (!a || a->terms.size() != 1 || a->terms[0].first != w) return std::nullopt;
+  return std::make_pair(a->constant, a->terms[0].second);
+}
+
+// The antiderivative of B^n (B = `base` affine in w, n != -1): B^(n+1) / ((n+1) beta). A negative
+// n records that B must keep one strict sign.
+std::optional<Expression> IntegratePower(const Expression& base, int n, int w, Integral& side) {
+  auto ab = AffineIn(base, w);
+  if (!ab || n == -1) return std::nullopt;
+  if (n < 0) side.same_sign.push_back(base);
+  const double beta = ab->second;
+  Expression up =
+      n + 1 == 1 ? base : Expression::Binary(Op::kPow, base, Expression::Constant(n + 1));
+  return up / Expression::Constant((n + 1) * beta);
+}
+
+// The value of `e` if it is an integer constant of magnitude at most 16.
+std::optional<int> IntegerExponent(const Expression& e) {
+  if (!e.is_constant()) return std::nullopt;
+  const double v = e.constant();
+  if (v != std::round(v) || std::abs(v) > 16) return std::nullopt;
+  return static_cast<int>(v);
+}
+
+// `e` as (base, n) with e = base^n: a power with an integer exponent, or a base affine in w
+// itself (n = 1).
+std::optional<std::pair<Expression, int>> AsPower(const Expression& e, int w) {
+  if (e.op() == Op::kPow) {
+    if (auto n = IntegerExponent(e.args()[1])) return std::make_pair(e.args()[0], *n);
+    return std::nullopt;
+  }
+  if (AffineIn(e, w)) return std::make_pair(e, 1);
+  return std::nullopt;
+}
+
+// Integrate for a quotient `phi` = num / den: a denominator constant in w divides the numerator's
+// antiderivative; otherwise the numerator must be constant in w and the denominator a power B^n
+// (also as max(B^n, eps), whose saturation is recorded in `side`).
+std::optional<Expression> IntegrateQuotient(const Expression& phi, int w, const std::string& wname,
+                                            Integral& side) {
+  const auto args = phi.args();
+  if (!Reads(args[1], w)) {
+    auto a = Integrate(args[0], w, wname, side);
+    if (a) return *a / args[1];
+    return std::nullopt;
+  }
+  if (Reads(args[0], w)) return std::nullopt;
+  Expression den = args[1];
+  if (den.op() == Op::kMax && den.args()[1].is_constant() && den.args()[1].constant() > 0 &&
+      !Reads(den.args()[1], w)) {
+    const double eps = den.args()[1].constant();
+    side.domain.push_back({den.args()[0], Relation::kGreaterEqual, den.args()[1]});
+    den = den.args()[0];
+    auto p = AsPower(den, w);
+    auto ab = p ? AffineIn(p->first, w) : std::nullopt;
+    if (!p || !ab || p->second <= 0) return std::nullopt;
+    side.saturations.push_back({ab->first, ab->second, std::pow(eps, 1.0 / p->second)});
+  }
+  auto p = AsPower(den, w);
+  if (!p) return std::nullopt;
+  if (p->second % 2 == 0) side.same_sign.push_back(p->first);
+  auto prim = IntegratePower(p->first, -p->second, w, side);
+  if (!prim) return std::nullopt;
+  return args[0] * *prim;
+}
+
+std::optional<Expression> Integrate(const Expression& phi, int w, const std::string& wname,
                                     Integral& side) {
   const Expression W = Expression::Symbol(wname, w);
   if (!Reads(phi, w)) return phi * W;
-  auto affine_in_w = [&](const Expression& b) -> std::optional<std::pair<double, double>> {
-    auto a = b.AsAffine();
-    if (!a || a->terms.size() != 1 || a->terms[0].first != w) return std::nullopt;
-    return std::make_pair(a->constant, a->terms[0].second);
-  };
-  // B^n -> B^(n+1) / ((n+1) beta).
-  auto power = [&](const Expression& base, int n) -> std::optional<Expression> {
-    auto ab = affine_in_w(base);
-    if (!ab || n == -1) return std::nullopt;
-    if (n < 0) side.same_sign.push_back(base);
-    const double beta = ab->second;
-    Expression up =
-        n + 1 == 1 ? base : Expression::Binary(Op::kPow, base, Expression::Constant(n + 1));
-    return up / Expression::Constant((n + 1) * beta);
-  };
-  auto integer_exponent = [](const Expression& e) -> std::optional<int> {
-    if (!e.is_constant()) return std::nullopt;
-    const double v = e.constant();
-    if (v != std::round(v) || std::abs(v) > 16) return std::nullopt;
-    return static_cast<int>(v);
-  };
-  // base^n with base affine in w, or base itself.
-  auto as_power = [&](const Expression& e) -> std::optional<std::pair<Expression, int>> {
-    if (e.op() == Op::kPow) {
-      if (auto n = integer_exponent(e.args()[1])) return std::make_pair(e.args()[0], *n);
-      return std::nullopt;
-    }
-    if (affine_in_w(e)) return std::make_pair(e, 1);
-    return std::nullopt;
-  };
   const auto args = phi.args();
   switch (phi.op()) {
     case Op::kAdd:
@@ -116,35 +159,12 @@ std::optional<Expression> Integrate(const Expression& phi, int w, const std::str
         if (a) return *a * args[1];
       }
       return std::nullopt;
-    case Op::kDiv: {
-      if (!Reads(args[1], w)) {
-        auto a = Integrate(args[0], w, wname, side);
-        if (a) return *a / args[1];
-        return std::nullopt;
-      }
-      if (Reads(args[0], w)) return std::nullopt;
-      Expression den = args[1];
-      if (den.op() == Op::kMax && den.args()[1].is_constant() && den.args()[1].constant() > 0 &&
-          !Reads(den.args()[1], w)) {
-        const double eps = den.args()[1].constant();
-        side.domain.push_back({den.args()[0], Relation::kGreaterEqual, den.args()[1]});
-        den = den.args()[0];
-        auto p = as_power(den);
-        auto ab = p ? affine_in_w(p->first) : std::nullopt;
-        if (!p || !ab || p->second <= 0) return std::nullopt;
-        side.saturations.push_back({ab->first, ab->second, std::pow(eps, 1.0 / p->second)});
-      }
-      auto p = as_power(den);
-      if (!p) return std::nullopt;
-      if (p->second % 2 == 0) side.same_sign.push_back(p->first);
-      auto prim = power(p->first, -p->second);
-      if (!prim) return std::nullopt;
-      return args[0] * *prim;
-    }
+    case Op::kDiv:
+      return IntegrateQuotient(phi, w, wname, side);
     default: {
-      auto p = as_power(phi);
+      auto p = AsPower(phi, w);
       if (!p || p->second < 0) return std::nullopt;
-      return power(p->first, p->second);
+      return IntegratePower(p->first, p->second, w, side);
     }
   }
 }
@@ -248,141 +268,177 @@ void SmtEncoding::Classify() {
     ModeInfo info;
     info.drift.assign(nv, 0.0);
     info.rate.assign(nv, std::vector<double>(ni, 0.0));
-    std::vector<std::pair<int, Expression>> flows;
-    for (const auto& [slot, rhs] : mode.flows) {
-      Expression f = Fold(rhs);
-      if (f.is_constant() && f.constant() == 0.0) continue;
-      flows.emplace_back(var_index_[slot], f);
-      info.moving.push_back(var_index_[slot]);
-    }
+    const Flows flows = MovingFlows(mode, info);
     if (flows.empty()) {
       info.flow_class = FlowClass::kStill;
-      modes_.push_back(std::move(info));
-      continue;
-    }
-    bool constant_rate = true;
-    for (const auto& [v, f] : flows) {
-      auto a = f.AsAffine();
-      if (!a) {
-        constant_rate = false;
-        break;
-      }
-      info.drift[v] = a->constant;
-      for (const auto& [slot, coef] : a->terms) {
-        if (input_index_[slot] < 0)
-          constant_rate = false;
-        else
-          info.rate[v][input_index_[slot]] = coef;
-      }
-      if (!constant_rate) break;
-    }
-    if (constant_rate) {
+    } else if (ConstantRates(flows, info)) {
       info.flow_class = FlowClass::kConstantRate;
-      modes_.push_back(std::move(info));
-      continue;
-    }
-    // Separable: one input u, a driver w' = c u, others K(y) phi(w) u.
-    info.flow_class = FlowClass::kGeneral;
-    std::vector<int> inputs_read;
-    for (const auto& [v, f] : flows) {
-      for (int s : f.Slots()) {
-        if (input_index_[s] >= 0 &&
-            std::find(inputs_read.begin(), inputs_read.end(), s) == inputs_read.end()) {
-          inputs_read.push_back(s);
-        }
-      }
-    }
-    if (inputs_read.size() == 1) {
-      const int u = inputs_read[0];
-      for (const auto& [v, f] : flows) {
-        auto a = f.AsAffine();
-        if (a && a->constant == 0.0 && a->terms.size() == 1 && a->terms[0].first == u) {
-          info.driver = v;
-          info.driver_rate = a->terms[0].second;
-          break;
-        }
-      }
-      std::vector<bool> still(automaton_.symbols().size(), true);
-      for (const auto& [v, f] : flows) still[var_slots_[v]] = false;
-      bool ok = info.driver >= 0;
-      const int w = ok ? var_slots_[info.driver] : -1;
-      for (const auto& [v, f] : flows) {
-        if (!ok || v == info.driver) continue;
-        // f = h * u or u * h (or c u: a second driver, e.g. a motor position beside the
-        // finger's drive, is separable with phi = 1).
-        std::optional<Expression> h;
-        const auto affine = f.AsAffine();
-        if (affine && affine->constant == 0.0 && affine->terms.size() == 1 &&
-            affine->terms[0].first == u) {
-          h = Expression::Constant(affine->terms[0].second);
-        } else if (f.op() == Op::kMul) {
-          if (f.args()[1].is_symbol() && f.args()[1].slot() == u)
-            h = f.args()[0];
-          else if (f.args()[0].is_symbol() && f.args()[0].slot() == u)
-            h = f.args()[1];
-        }
-        if (!h || Reads(*h, u)) {
-          ok = false;
-          break;
-        }
-        std::vector<std::pair<Expression, bool>> factors;
-        Factor(*h, true, factors);
-        Expression k = Expression::Constant(1.0), phi = Expression::Constant(1.0);
-        for (const auto& [e, num] : factors) {
-          bool reads_w = false, reads_other = false;
-          for (int s : e.Slots()) {
-            if (s == w)
-              reads_w = true;
-            else if (automaton_.symbols()[s].kind == SymbolKind::kVariable && !still[s])
-              reads_other = true;
-            else if (automaton_.symbols()[s].kind == SymbolKind::kInput)
-              reads_other = true;
-          }
-          if (reads_other) ok = false;
-          if (reads_w) {
-            for (int s : e.Slots()) {
-              if (s != w) ok = false;  // phi may read only w and numbers
-            }
-            phi = num ? phi * e : phi / e;
-          } else {
-            k = num ? k * e : k / e;
-          }
-        }
-        if (!ok) break;
-        SeparableFlow sf;
-        sf.var = v;
-        sf.k = k.FoldConstants();
-        phi = phi.FoldConstants();
-        const VariableInfo& wi = automaton_.variables()[info.driver];
-        if (wi.domain) {
-          const double lo = wi.domain->lo.Evaluate(nominal_), hi = wi.domain->hi.Evaluate(nominal_);
-          std::vector<Interval> env(automaton_.symbols().size(), Interval(0.0, 0.0));
-          env[w] = Interval(lo, hi);
-          const Interval r = phi.EvaluateInterval(env);
-          sf.sign_phi = r.lo() > 0 ? 1.0 : (r.hi() < 0 ? -1.0 : 0.0);
-        }
-        Integral side;
-        sf.antiderivative = Integrate(phi, w, automaton_.symbols()[w].name, side);
-        sf.domain = side.domain;
-        if (side.saturations.size() == 1) {
-          const auto& sat = side.saturations[0];
-          sf.saturation = {sat.alpha, sat.beta, sat.edge};
-        } else if (side.saturations.size() > 1) {
-          sf.antiderivative.reset();
-        }
-        for (const Expression& b : side.same_sign) {
-          // Recorded as a comparison `b != 0` is not expressible; keep as b (checked in Flow).
-          sf.domain.push_back({b, Relation::kEqual, Expression::Constant(0.0)});
-        }
-        info.separable.push_back(std::move(sf));
-      }
-      if (ok) {
-        info.flow_class = FlowClass::kSeparable;
-        info.input = input_index_[u];
-      }
+    } else {
+      info.flow_class = FlowClass::kGeneral;
+      ClassifySeparable(flows, info);
     }
     modes_.push_back(std::move(info));
   }
+}
+
+SmtEncoding::Flows SmtEncoding::MovingFlows(const Mode& mode, ModeInfo& info) const {
+  Flows flows;
+  for (const auto& [slot, rhs] : mode.flows) {
+    Expression f = Fold(rhs);
+    if (f.is_constant() && f.constant() == 0.0) continue;
+    flows.emplace_back(var_index_[slot], f);
+    info.moving.push_back(var_index_[slot]);
+  }
+  return flows;
+}
+
+bool SmtEncoding::ConstantRates(const Flows& flows, ModeInfo& info) const {
+  bool constant_rate = true;
+  for (const auto& [v, f] : flows) {
+    auto a = f.AsAffine();
+    if (!a) {
+      constant_rate = false;
+      break;
+    }
+    info.drift[v] = a->constant;
+    for (const auto& [slot, coef] : a->terms) {
+      if (input_index_[slot] < 0)
+        constant_rate = false;
+      else
+        info.rate[v][input_index_[slot]] = coef;
+    }
+    if (!constant_rate) break;
+  }
+  return constant_rate;
+}
+
+void SmtEncoding::ClassifySeparable(const Flows& flows, ModeInfo& info) const {
+  // Separable: one input u, a driver w' = c u, others K(y) phi(w) u.
+  std::vector<int> inputs_read;
+  for (const auto& [v, f] : flows) {
+    for (int s : f.Slots()) {
+      if (input_index_[s] >= 0 &&
+          std::find(inputs_read.begin(), inputs_read.end(), s) == inputs_read.end()) {
+        inputs_read.push_back(s);
+      }
+    }
+  }
+  if (inputs_read.size() != 1) return;
+  const int u = inputs_read[0];
+  for (const auto& [v, f] : flows) {
+    auto a = f.AsAffine();
+    if (a && a->constant == 0.0 && a->terms.size() == 1 && a->terms[0].first == u) {
+      info.driver = v;
+      info.driver_rate = a->terms[0].second;
+      break;
+    }
+  }
+  std::vector<bool> still(automaton_.symbols().size(), true);
+  for (const auto& [v, f] : flows) still[var_slots_[v]] = false;
+  bool ok = info.driver >= 0;
+  const int w = ok ? var_slots_[info.driver] : -1;
+  for (const auto& [v, f] : flows) {
+    if (!ok || v == info.driver) continue;
+    std::optional<SeparableFlow> sf = Separate(v, f, u, w, still, info.driver);
+    if (!sf) {
+      ok = false;
+      break;
+    }
+    info.separable.push_back(std::move(*sf));
+  }
+  if (ok) {
+    info.flow_class = FlowClass::kSeparable;
+    info.input = input_index_[u];
+  }
+}
+
+namespace {
+
+// The factor h of a flow f = h * u or u * h of the input slot `u`, or the constant c of f = c u
+// (a second driver, e.g. a motor position beside the finger's drive, is separable with phi = 1);
+// nullopt for another form. h may still read u.
+std::optional<Expression> InputFactor(const Expression& f, int u) {
+  std::optional<Expression> h;
+  const auto affine = f.AsAffine();
+  if (affine && affine->constant == 0.0 && affine->terms.size() == 1 &&
+      affine->terms[0].first == u) {
+    h = Expression::Constant(affine->terms[0].second);
+  } else if (f.op() == Op::kMul) {
+    if (f.args()[1].is_symbol() && f.args()[1].slot() == u)
+      h = f.args()[0];
+    else if (f.args()[0].is_symbol() && f.args()[0].slot() == u)
+      h = f.args()[1];
+  }
+  return h;
+}
+
+}  // namespace
+
+std::optional<SmtEncoding::SeparableFlow> SmtEncoding::Separate(int v, const Expression& f, int u,
+                                                                int w,
+                                                                const std::vector<bool>& still,
+                                                                int driver) const {
+  const std::optional<Expression> h = InputFactor(f, u);
+  if (!h || Reads(*h, u)) return std::nullopt;
+  Expression k = Expression::Constant(1.0), phi = Expression::Constant(1.0);
+  if (!SplitFactors(*h, w, still, k, phi)) return std::nullopt;
+  SeparableFlow sf;
+  sf.var = v;
+  sf.k = k.FoldConstants();
+  phi = phi.FoldConstants();
+  sf.sign_phi = SignOnDomain(phi, driver);
+  Integral side;
+  sf.antiderivative = Integrate(phi, w, automaton_.symbols()[w].name, side);
+  sf.domain = side.domain;
+  if (side.saturations.size() == 1) {
+    const auto& sat = side.saturations[0];
+    sf.saturation = {sat.alpha, sat.beta, sat.edge};
+  } else if (side.saturations.size() > 1) {
+    sf.antiderivative.reset();
+  }
+  for (const Expression& b : side.same_sign) {
+    // Recorded as a comparison `b != 0` is not expressible; keep as b (checked in Flow).
+    sf.domain.push_back({b, Relation::kEqual, Expression::Constant(0.0)});
+  }
+  return sf;
+}
+
+bool SmtEncoding::SplitFactors(const Expression& h, int w, const std::vector<bool>& still,
+                               Expression& k, Expression& phi) const {
+  bool ok = true;
+  std::vector<std::pair<Expression, bool>> factors;
+  Factor(h, true, factors);
+  for (const auto& [e, num] : factors) {
+    bool reads_w = false, reads_other = false;
+    for (int s : e.Slots()) {
+      if (s == w)
+        reads_w = true;
+      else if (automaton_.symbols()[s].kind == SymbolKind::kVariable && !still[s])
+        reads_other = true;
+      else if (automaton_.symbols()[s].kind == SymbolKind::kInput)
+        reads_other = true;
+    }
+    if (reads_other) ok = false;
+    if (reads_w) {
+      for (int s : e.Slots()) {
+        if (s != w) ok = false;  // phi may read only w and numbers
+      }
+      phi = num ? phi * e : phi / e;
+    } else {
+      k = num ? k * e : k / e;
+    }
+  }
+  return ok;
+}
+
+double SmtEncoding::SignOnDomain(const Expression& phi, int driver) const {
+  const VariableInfo& wi = automaton_.variables()[driver];
+  if (!wi.domain) return 0.0;
+  const double lo = wi.domain->lo.Evaluate(nominal_), hi = wi.domain->hi.Evaluate(nominal_);
+  std::vector<Interval> env(automaton_.symbols().size(), Interval(0.0, 0.0));
+  env[var_slots_[driver]] = Interval(lo, hi);
+  const Interval r = phi.EvaluateInterval(env);
+  return r.lo() > 0 ? 1.0 : (r.hi() < 0 ? -1.0 : 0.0);
 }
 
 std::string SmtEncoding::ConstantName(std::string_view kind, int index, int step) {
@@ -486,30 +542,12 @@ z3::expr SmtEncoding::Translate(const Expression& e,
         break;
       case Op::kDiv: {
         z3::expr num = go(args[0]), den = go(args[1]);
-        if (den.is_numeral()) {
-          out = num / den;
-        } else {
-          // q = num / den as the polynomial definition den q = num (den != 0), so that the
-          // formulas stay polynomial (nlsat); q is unconstrained where den = 0 (undefined).
-          out = Fresh();
-          definitions_.push_back(z3::implies(den != 0, out * den == num));
-        }
+        out = Quotient(num, den);
         break;
       }
-      case Op::kPow: {
-        const Expression& ex = args[1];
-        if (ex.is_constant() && ex.constant() == std::round(ex.constant()) &&
-            std::abs(ex.constant()) <= 16) {
-          const int n = static_cast<int>(ex.constant());
-          z3::expr b = go(args[0]);
-          z3::expr p = Num(ctx_, 1.0);
-          for (int i = 0; i < std::abs(n); ++i) p = i == 0 ? b : p * b;
-          out = n >= 0 ? p : Num(ctx_, 1.0) / p;
-        } else {
-          out = Fresh();
-        }
+      case Op::kPow:
+        out = Power(args[0], args[1], go);
         break;
-      }
       case Op::kMin: {
         z3::expr a = go(args[0]), b = go(args[1]);
         out = z3::ite(a <= b, a, b);
@@ -539,6 +577,28 @@ z3::expr SmtEncoding::Translate(const Expression& e,
     return out;
   };
   return go(e);
+}
+
+z3::expr SmtEncoding::Quotient(const z3::expr& num, const z3::expr& den) {
+  if (den.is_numeral()) return num / den;
+  // q = num / den as the polynomial definition den q = num (den != 0), so that the formulas stay
+  // polynomial (nlsat); q is unconstrained where den = 0 (undefined).
+  z3::expr out = Fresh();
+  definitions_.push_back(z3::implies(den != 0, out * den == num));
+  return out;
+}
+
+z3::expr SmtEncoding::Power(const Expression& base, const Expression& ex,
+                            const std::function<z3::expr(const Expression&)>& translate) {
+  if (ex.is_constant() && ex.constant() == std::round(ex.constant()) &&
+      std::abs(ex.constant()) <= 16) {
+    const int n = static_cast<int>(ex.constant());
+    z3::expr b = translate(base);
+    z3::expr p = Num(ctx_, 1.0);
+    for (int i = 0; i < std::abs(n); ++i) p = i == 0 ? b : p * b;
+    return n >= 0 ? p : Num(ctx_, 1.0) / p;
+  }
+  return Fresh();
 }
 
 z3::expr SmtEncoding::Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
@@ -684,93 +744,15 @@ z3::expr SmtEncoding::Flow(int k, int mode) {
     if (!moving[v]) out = out && b.x[v] == a.x[v];
   }
   const int ni = static_cast<int>(input_slots_.size());
-  // The representative constant input u_k has the sign of the input's integral.
-  auto link = [&](int i) {
-    return z3::implies(a.v[i] > 0, a.u[i] > 0) && z3::implies(a.v[i] < 0, a.u[i] < 0) &&
-           Num(ctx_, input_lo_[i]) * a.d <= a.v[i] && a.v[i] <= Num(ctx_, input_hi_[i]) * a.d;
-  };
   switch (info.flow_class) {
     case FlowClass::kStill:
       break;
     case FlowClass::kConstantRate:
-      for (int i = 0; i < ni; ++i) out = out && link(i);
-      for (int v : info.moving) {
-        z3::expr rhs = a.x[v] + Num(ctx_, info.drift[v]) * a.d;
-        for (int i = 0; i < ni; ++i) {
-          if (info.rate[v][i] != 0.0) rhs = rhs + Num(ctx_, info.rate[v][i]) * a.v[i];
-        }
-        out = out && b.x[v] == rhs;
-      }
+      ConstantRateFlow(k, info, out);
       break;
-    case FlowClass::kSeparable: {
-      const int i = info.input;
-      out = out && link(i);
-      const int w = info.driver;
-      out = out && b.x[w] == a.x[w] + Num(ctx_, info.driver_rate) * a.v[i];
-      const auto& env0 = Env(k);
-      const auto& env1 = Env(k + 1);
-      for (const SeparableFlow& sf : info.separable) {
-        const z3::expr K = Translate(sf.k, env0);
-        const z3::expr dv = b.x[sf.var] - a.x[sf.var];
-        const double s = sf.sign_phi * (info.driver_rate > 0 ? 1.0 : -1.0);
-        if (s != 0.0) {
-          const z3::expr dw = Num(ctx_, s) * (b.x[w] - a.x[w]);
-          out = out && z3::implies(K >= 0 && dw >= 0, dv >= 0) &&
-                z3::implies(K >= 0 && dw <= 0, dv <= 0) &&
-                z3::implies(K <= 0 && dw >= 0, dv <= 0) && z3::implies(K <= 0 && dw <= 0, dv >= 0);
-        }
-        if (sf.antiderivative) {
-          z3::expr ok = ctx_.bool_val(true);
-          for (const Comparison& c : sf.domain) {
-            if (c.relation == Relation::kEqual) {  // a pole-free factor: one strict sign
-              const z3::expr b0 = Translate(c.lhs, env0), b1 = Translate(c.lhs, env1);
-              ok = ok && ((b0 > 0 && b1 > 0) || (b0 < 0 && b1 < 0));
-            } else {
-              ok = ok && Compare(c, env0, 0.0) && Compare(c, env1, 0.0);
-            }
-          }
-          const z3::expr phi0 = Translate(*sf.antiderivative, env0);
-          const z3::expr phi1 = Translate(*sf.antiderivative, env1);
-          const z3::expr c = Num(ctx_, info.driver_rate);
-          out = out && z3::implies(ok, c * dv == K * (phi1 - phi0));
-          if (sf.saturation && s != 0.0) {
-            // One end inside the law's domain, the other in the saturation of max(B^n, eps):
-            // the exact law holds up to the edge w*, where |B| = eps^(1/n), and v moves on
-            // monotonically beyond it.
-            const auto [alpha, beta, edge] = *sf.saturation;
-            auto in = [&](const std::vector<std::optional<z3::expr>>& env) {
-              z3::expr r = ctx_.bool_val(true);
-              for (const Comparison& cmp : sf.domain) {
-                if (cmp.relation != Relation::kEqual) r = r && Compare(cmp, env, 0.0);
-              }
-              return r;
-            };
-            const z3::expr in0 = in(env0), in1 = in(env1);
-            for (double side_sign : {1.0, -1.0}) {
-              const double w_edge = (side_sign * edge - alpha) / beta;
-              std::vector<std::optional<z3::expr>> env_edge = env0;
-              env_edge[var_slots_[w]] = Num(ctx_, w_edge);
-              const z3::expr phi_edge = Translate(*sf.antiderivative, env_edge);
-              const z3::expr b0 = Num(ctx_, alpha) + Num(ctx_, beta) * a.x[w];
-              const z3::expr b1 = Num(ctx_, alpha) + Num(ctx_, beta) * b.x[w];
-              const z3::expr side0 = side_sign > 0 ? b0 > 0 : b0 < 0;
-              const z3::expr side1 = side_sign > 0 ? b1 > 0 : b1 < 0;
-              // Leaving the domain: v0 -> v* = v0 + D -> beyond.
-              const z3::expr d_out = K * (phi_edge - phi0) / c;
-              out = out &&
-                    z3::implies(in0 && !in1 && side0, z3::implies(d_out >= 0, dv >= d_out) &&
-                                                          z3::implies(d_out <= 0, dv <= d_out));
-              // Entering it: v0 -> v* -> v1 = v* + D.
-              const z3::expr d_in = K * (phi1 - phi_edge) / c;
-              out =
-                  out && z3::implies(!in0 && in1 && side1, z3::implies(d_in >= 0, dv >= d_in) &&
-                                                               z3::implies(d_in <= 0, dv <= d_in));
-            }
-          }
-        }
-      }
+    case FlowClass::kSeparable:
+      SeparableFlowStep(k, info, out);
       break;
-    }
     case FlowClass::kGeneral:
       for (int i = 0; i < ni; ++i) {
         out = out && Num(ctx_, input_lo_[i]) * a.d <= a.v[i] &&
@@ -781,36 +763,127 @@ z3::expr SmtEncoding::Flow(int k, int mode) {
   return out && NoUrgentGuardOnSegment(k, mode);
 }
 
+z3::expr SmtEncoding::InputLink(const StepVars& a, int i) {
+  return z3::implies(a.v[i] > 0, a.u[i] > 0) && z3::implies(a.v[i] < 0, a.u[i] < 0) &&
+         Num(ctx_, input_lo_[i]) * a.d <= a.v[i] && a.v[i] <= Num(ctx_, input_hi_[i]) * a.d;
+}
+
+void SmtEncoding::ConstantRateFlow(int k, const ModeInfo& info, z3::expr& out) {
+  StepVars& a = Vars(k);
+  StepVars& b = Vars(k + 1);
+  const int ni = static_cast<int>(input_slots_.size());
+  for (int i = 0; i < ni; ++i) out = out && InputLink(a, i);
+  for (int v : info.moving) {
+    z3::expr rhs = a.x[v] + Num(ctx_, info.drift[v]) * a.d;
+    for (int i = 0; i < ni; ++i) {
+      if (info.rate[v][i] != 0.0) rhs = rhs + Num(ctx_, info.rate[v][i]) * a.v[i];
+    }
+    out = out && b.x[v] == rhs;
+  }
+}
+
+void SmtEncoding::SeparableFlowStep(int k, const ModeInfo& info, z3::expr& out) {
+  StepVars& a = Vars(k);
+  StepVars& b = Vars(k + 1);
+  const int i = info.input;
+  out = out && InputLink(a, i);
+  const int w = info.driver;
+  out = out && b.x[w] == a.x[w] + Num(ctx_, info.driver_rate) * a.v[i];
+  const Segment segment{a, b, Env(k), Env(k + 1)};
+  for (const SeparableFlow& sf : info.separable) SeparableVariable(segment, info, sf, out);
+}
+
+void SmtEncoding::SeparableVariable(const Segment& segment, const ModeInfo& info,
+                                    const SeparableFlow& sf, z3::expr& out) {
+  const StepVars& a = segment.a;
+  const StepVars& b = segment.b;
+  const int w = info.driver;
+  const z3::expr K = Translate(sf.k, segment.env0);
+  const z3::expr dv = b.x[sf.var] - a.x[sf.var];
+  const double s = sf.sign_phi * (info.driver_rate > 0 ? 1.0 : -1.0);
+  if (s != 0.0) {
+    const z3::expr dw = Num(ctx_, s) * (b.x[w] - a.x[w]);
+    out = out && z3::implies(K >= 0 && dw >= 0, dv >= 0) &&
+          z3::implies(K >= 0 && dw <= 0, dv <= 0) && z3::implies(K <= 0 && dw >= 0, dv <= 0) &&
+          z3::implies(K <= 0 && dw <= 0, dv >= 0);
+  }
+  if (sf.antiderivative) SeparableLaw(segment, info, sf, K, dv, s, out);
+}
+
+void SmtEncoding::SeparableLaw(const Segment& segment, const ModeInfo& info,
+                               const SeparableFlow& sf, const z3::expr& K, const z3::expr& dv,
+                               double s, z3::expr& out) {
+  const auto& env0 = segment.env0;
+  const auto& env1 = segment.env1;
+  z3::expr ok = ctx_.bool_val(true);
+  for (const Comparison& c : sf.domain) {
+    if (c.relation == Relation::kEqual) {  // a pole-free factor: one strict sign
+      const z3::expr b0 = Translate(c.lhs, env0), b1 = Translate(c.lhs, env1);
+      ok = ok && ((b0 > 0 && b1 > 0) || (b0 < 0 && b1 < 0));
+    } else {
+      ok = ok && Compare(c, env0, 0.0) && Compare(c, env1, 0.0);
+    }
+  }
+  const z3::expr phi0 = Translate(*sf.antiderivative, env0);
+  const z3::expr phi1 = Translate(*sf.antiderivative, env1);
+  const z3::expr c = Num(ctx_, info.driver_rate);
+  out = out && z3::implies(ok, c * dv == K * (phi1 - phi0));
+  if (sf.saturation && s != 0.0) SaturationCrossing(segment, info, sf, {K, dv, phi0, phi1, c}, out);
+}
+
+void SmtEncoding::SaturationCrossing(const Segment& segment, const ModeInfo& info,
+                                     const SeparableFlow& sf, const Law& law, z3::expr& out) {
+  const StepVars& a = segment.a;
+  const StepVars& b = segment.b;
+  const auto& env0 = segment.env0;
+  const auto& env1 = segment.env1;
+  const int w = info.driver;
+  const z3::expr& K = law.k;
+  const z3::expr& dv = law.dv;
+  const z3::expr& phi0 = law.phi0;
+  const z3::expr& phi1 = law.phi1;
+  const z3::expr& c = law.c;
+  // One end inside the law's domain, the other in the saturation of max(B^n, eps): the exact law
+  // holds up to the edge w*, where |B| = eps^(1/n), and v moves on monotonically beyond it.
+  const auto [alpha, beta, edge] = *sf.saturation;
+  auto in = [&](const std::vector<std::optional<z3::expr>>& env) {
+    z3::expr r = ctx_.bool_val(true);
+    for (const Comparison& cmp : sf.domain) {
+      if (cmp.relation != Relation::kEqual) r = r && Compare(cmp, env, 0.0);
+    }
+    return r;
+  };
+  const z3::expr in0 = in(env0), in1 = in(env1);
+  for (double side_sign : {1.0, -1.0}) {
+    const double w_edge = (side_sign * edge - alpha) / beta;
+    std::vector<std::optional<z3::expr>> env_edge = env0;
+    env_edge[var_slots_[w]] = Num(ctx_, w_edge);
+    const z3::expr phi_edge = Translate(*sf.antiderivative, env_edge);
+    const z3::expr b0 = Num(ctx_, alpha) + Num(ctx_, beta) * a.x[w];
+    const z3::expr b1 = Num(ctx_, alpha) + Num(ctx_, beta) * b.x[w];
+    const z3::expr side0 = side_sign > 0 ? b0 > 0 : b0 < 0;
+    const z3::expr side1 = side_sign > 0 ? b1 > 0 : b1 < 0;
+    // Leaving the domain: v0 -> v* = v0 + D -> beyond.
+    const z3::expr d_out = K * (phi_edge - phi0) / c;
+    out = out && z3::implies(in0 && !in1 && side0, z3::implies(d_out >= 0, dv >= d_out) &&
+                                                       z3::implies(d_out <= 0, dv <= d_out));
+    // Entering it: v0 -> v* -> v1 = v* + D.
+    const z3::expr d_in = K * (phi1 - phi_edge) / c;
+    out = out && z3::implies(!in0 && in1 && side1, z3::implies(d_in >= 0, dv >= d_in) &&
+                                                       z3::implies(d_in <= 0, dv <= d_in));
+  }
+}
+
 z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   const ModeInfo& info = modes_[mode];
   StepVars& a = Vars(k);
   StepVars& b = Vars(k + 1);
-  const int ni = static_cast<int>(input_slots_.size());
   // Parametrisation of the segment for kConstantRate: sigma = V_i (one input, no drift) or d (no
   // input rates): x(sigma) = x_k + dir sigma.
   std::optional<z3::expr> const_sigma;
   std::vector<double> dir(var_slots_.size(), 0.0);
   if (info.flow_class == FlowClass::kConstantRate) {
-    int rated = -1, count = 0;
-    bool drift = false;
-    for (int v : info.moving) {
-      drift = drift || info.drift[v] != 0.0;
-      for (int i = 0; i < ni; ++i) {
-        if (info.rate[v][i] != 0.0 && rated != i) {
-          rated = i;
-          ++count;
-        }
-      }
-    }
-    if (count == 1 && !drift) {
-      const_sigma = a.v[rated];
-      for (int v : info.moving) dir[v] = info.rate[v][rated];
-    } else if (count == 0 && drift) {
-      const_sigma = a.d;
-      for (int v : info.moving) dir[v] = info.drift[v];
-    } else {
-      return ctx_.bool_val(true);
-    }
+    if (!StraightSegment(info, a, const_sigma, dir)) return ctx_.bool_val(true);
   } else if (info.flow_class != FlowClass::kSeparable) {
     return ctx_.bool_val(true);
   }
@@ -821,110 +894,148 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   for (int t : outgoing_[mode]) {
     const hybrid::Transition& tr = automaton_.transitions()[t];
     if (tr.urgency != Urgency::kUrgent) continue;
-    struct Atom {
-      z3::expr alpha;
-      double beta;      // sign and magnitude (for the case split)
-      z3::expr beta_q;  // the exact rational value
-      Relation rel;
-    };
-    std::vector<Atom> atoms;
-    bool ok = true;
     int sep_var = -1;
-    for (const Comparison& c : tr.guard.comparisons) {
-      const Expression r = Fold(c.Residual());
-      auto aff = r.AsAffine();
-      if (!aff) {
-        ok = false;
-        break;
-      }
-      double beta = 0.0;
-      z3::expr beta_q = Num(ctx_, 0.0);
-      for (const auto& [slot, coef] : aff->terms) {
-        const int v = var_index_[slot];
-        if (v < 0 || !moving[v]) continue;
-        if (const_sigma) {
-          beta += coef * dir[v];
-          beta_q = beta_q + Num(ctx_, coef) * Num(ctx_, dir[v]);
-        } else {
-          if (sep_var >= 0 && sep_var != v) ok = false;
-          sep_var = v;
-          beta = coef;
-          beta_q = Num(ctx_, coef);
-        }
-      }
-      if (!ok) break;
-      atoms.push_back({Translate(r, env), beta, beta_q.simplify(), c.relation});
-    }
-    if (!ok) continue;
+    const std::optional<std::vector<GuardAtom>> atoms =
+        GuardAtoms(tr, moving, const_sigma, dir, env, sep_var);
+    if (!atoms) continue;
     z3::expr sigma_end =
         const_sigma ? *const_sigma : (sep_var >= 0 ? b.x[sep_var] - a.x[sep_var] : Num(ctx_, 0.0));
-    // Guard holds at some sigma of the segment; sign: +1 [0, end), -1 (end, 0], 0 {0}.
-    auto meet = [&](int sign) {
-      z3::expr fixed = ctx_.bool_val(true);
-      std::vector<std::pair<z3::expr, bool>> lower, upper;  // (bound, strict)
-      for (const Atom& at : atoms) {
-        if (at.beta == 0.0 || sign == 0) {
-          const z3::expr& r = at.alpha;
-          switch (at.rel) {
-            case Relation::kLess:
-              fixed = fixed && r < 0;
-              break;
-            case Relation::kLessEqual:
-              fixed = fixed && r <= 0;
-              break;
-            case Relation::kGreater:
-              fixed = fixed && r > 0;
-              break;
-            case Relation::kGreaterEqual:
-              fixed = fixed && r >= 0;
-              break;
-            case Relation::kEqual:
-              fixed = fixed && r == 0;
-              break;
-          }
-          continue;
-        }
-        // alpha + beta sigma REL 0  <=>  sigma REL' -alpha / beta.
-        // Exact rational arithmetic: -alpha / beta with beta a numeral.
-        const z3::expr bound = -at.alpha / at.beta_q;
-        const bool up = at.beta > 0;  // `<=` gives an upper bound when beta > 0
-        switch (at.rel) {
-          case Relation::kLess:
-            (up ? upper : lower).emplace_back(bound, true);
-            break;
-          case Relation::kLessEqual:
-            (up ? upper : lower).emplace_back(bound, false);
-            break;
-          case Relation::kGreater:
-            (up ? lower : upper).emplace_back(bound, true);
-            break;
-          case Relation::kGreaterEqual:
-            (up ? lower : upper).emplace_back(bound, false);
-            break;
-          case Relation::kEqual:
-            lower.emplace_back(bound, false);
-            upper.emplace_back(bound, false);
-            break;
-        }
-      }
-      if (sign == 0) return fixed;
-      if (sign > 0) {
-        lower.emplace_back(Num(ctx_, 0.0), false);
-        upper.emplace_back(sigma_end, true);
-      } else {
-        lower.emplace_back(sigma_end, true);
-        upper.emplace_back(Num(ctx_, 0.0), false);
-      }
-      z3::expr out2 = fixed;
-      for (const auto& [l, ls] : lower) {
-        for (const auto& [h, hs] : upper) out2 = out2 && ((ls || hs) ? l < h : l <= h);
-      }
-      return out2;
-    };
-    out = out && z3::implies(sigma_end > 0, !meet(1)) && z3::implies(sigma_end < 0, !meet(-1)) &&
-          z3::implies(sigma_end == 0, !meet(0));
+    out = out && z3::implies(sigma_end > 0, !GuardMeets(*atoms, sigma_end, 1)) &&
+          z3::implies(sigma_end < 0, !GuardMeets(*atoms, sigma_end, -1)) &&
+          z3::implies(sigma_end == 0, !GuardMeets(*atoms, sigma_end, 0));
   }
   return out;
+}
+
+bool SmtEncoding::StraightSegment(const ModeInfo& info, const StepVars& a,
+                                  std::optional<z3::expr>& const_sigma,
+                                  std::vector<double>& dir) const {
+  const int ni = static_cast<int>(input_slots_.size());
+  int rated = -1, count = 0;
+  bool drift = false;
+  for (int v : info.moving) {
+    drift = drift || info.drift[v] != 0.0;
+    for (int i = 0; i < ni; ++i) {
+      if (info.rate[v][i] != 0.0 && rated != i) {
+        rated = i;
+        ++count;
+      }
+    }
+  }
+  if (count == 1 && !drift) {
+    const_sigma = a.v[rated];
+    for (int v : info.moving) dir[v] = info.rate[v][rated];
+  } else if (count == 0 && drift) {
+    const_sigma = a.d;
+    for (int v : info.moving) dir[v] = info.drift[v];
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::optional<std::vector<SmtEncoding::GuardAtom>> SmtEncoding::GuardAtoms(
+    const hybrid::Transition& tr, const std::vector<bool>& moving,
+    const std::optional<z3::expr>& const_sigma, const std::vector<double>& dir,
+    const std::vector<std::optional<z3::expr>>& env, int& sep_var) {
+  std::vector<GuardAtom> atoms;
+  bool ok = true;
+  for (const Comparison& c : tr.guard.comparisons) {
+    const Expression r = Fold(c.Residual());
+    auto aff = r.AsAffine();
+    if (!aff) {
+      ok = false;
+      break;
+    }
+    double beta = 0.0;
+    z3::expr beta_q = Num(ctx_, 0.0);
+    for (const auto& [slot, coef] : aff->terms) {
+      const int v = var_index_[slot];
+      if (v < 0 || !moving[v]) continue;
+      if (const_sigma) {
+        beta += coef * dir[v];
+        beta_q = beta_q + Num(ctx_, coef) * Num(ctx_, dir[v]);
+      } else {
+        if (sep_var >= 0 && sep_var != v) ok = false;
+        sep_var = v;
+        beta = coef;
+        beta_q = Num(ctx_, coef);
+      }
+    }
+    if (!ok) break;
+    atoms.push_back({Translate(r, env), beta, beta_q.simplify(), c.relation});
+  }
+  if (!ok) return std::nullopt;
+  return atoms;
+}
+
+z3::expr SmtEncoding::GuardMeets(const std::vector<GuardAtom>& atoms, const z3::expr& sigma_end,
+                                 int sign) {
+  z3::expr fixed = ctx_.bool_val(true);
+  std::vector<std::pair<z3::expr, bool>> lower, upper;  // (bound, strict)
+  for (const GuardAtom& at : atoms) {
+    if (at.beta == 0.0 || sign == 0) {
+      fixed = AndHoldsAtStart(fixed, at);
+      continue;
+    }
+    AddSigmaBound(at, lower, upper);
+  }
+  if (sign == 0) return fixed;
+  if (sign > 0) {
+    lower.emplace_back(Num(ctx_, 0.0), false);
+    upper.emplace_back(sigma_end, true);
+  } else {
+    lower.emplace_back(sigma_end, true);
+    upper.emplace_back(Num(ctx_, 0.0), false);
+  }
+  z3::expr out2 = fixed;
+  for (const auto& [l, ls] : lower) {
+    for (const auto& [h, hs] : upper) out2 = out2 && ((ls || hs) ? l < h : l <= h);
+  }
+  return out2;
+}
+
+z3::expr SmtEncoding::AndHoldsAtStart(const z3::expr& fixed, const GuardAtom& at) {
+  const z3::expr& r = at.alpha;
+  switch (at.rel) {
+    case Relation::kLess:
+      return fixed && r < 0;
+    case Relation::kLessEqual:
+      return fixed && r <= 0;
+    case Relation::kGreater:
+      return fixed && r > 0;
+    case Relation::kGreaterEqual:
+      return fixed && r >= 0;
+    case Relation::kEqual:
+      return fixed && r == 0;
+  }
+  return fixed;
+}
+
+void SmtEncoding::AddSigmaBound(const GuardAtom& at, std::vector<std::pair<z3::expr, bool>>& lower,
+                                std::vector<std::pair<z3::expr, bool>>& upper) {
+  // alpha + beta sigma REL 0  <=>  sigma REL' -alpha / beta.
+  // Exact rational arithmetic: -alpha / beta with beta a numeral.
+  const z3::expr bound = -at.alpha / at.beta_q;
+  const bool up = at.beta > 0;  // `<=` gives an upper bound when beta > 0
+  switch (at.rel) {
+    case Relation::kLess:
+      (up ? upper : lower).emplace_back(bound, true);
+      break;
+    case Relation::kLessEqual:
+      (up ? upper : lower).emplace_back(bound, false);
+      break;
+    case Relation::kGreater:
+      (up ? lower : upper).emplace_back(bound, true);
+      break;
+    case Relation::kGreaterEqual:
+      (up ? lower : upper).emplace_back(bound, false);
+      break;
+    case Relation::kEqual:
+      lower.emplace_back(bound, false);
+      upper.emplace_back(bound, false);
+      break;
+  }
 }
 
 bool SmtEncoding::ReadsMovingVariable(const Comparison& c, int mode) const {

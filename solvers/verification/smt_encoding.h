@@ -166,6 +166,30 @@ class SmtEncoding {
     double driver_rate = 0.0;
     std::vector<SeparableFlow> separable;
   };
+  // The nonzero flows of a mode: (variable index, right-hand side with nominal parameters folded).
+  using Flows = std::vector<std::pair<int, Expression>>;
+  // The two ends s_k, s_k+1 of a flow segment and their environments.
+  struct Segment {
+    const StepVars& a;
+    const StepVars& b;
+    const std::vector<std::optional<z3::expr>>& env0;
+    const std::vector<std::optional<z3::expr>>& env1;
+  };
+  // The terms of a separable variable's exact law c (v1 - v0) = K (Phi(w1) - Phi(w0)).
+  struct Law {
+    const z3::expr& k;     // K
+    const z3::expr& dv;    // v1 - v0
+    const z3::expr& phi0;  // Phi(w0)
+    const z3::expr& phi1;  // Phi(w1)
+    const z3::expr& c;     // the driver's rate
+  };
+  // One comparison of an urgent guard along a segment: alpha + beta sigma REL 0.
+  struct GuardAtom {
+    z3::expr alpha;
+    double beta;      // sign and magnitude (for the case split)
+    z3::expr beta_q;  // the exact rational value
+    Relation rel;
+  };
 
   StepVars& Vars(int k);
   // The duration and representative inputs of the flow from `v` (s.mode, s.input set).
@@ -174,17 +198,81 @@ class SmtEncoding {
   z3::expr Reuse(std::deque<std::optional<Built>>& cache, int k,
                  const std::function<z3::expr()>& build);
   z3::expr Translate(const Expression& e, const std::vector<std::optional<z3::expr>>& env);
+  // Translate's num / den: exact for a numeral den, else an auxiliary q with the definition
+  // den q = num where den != 0.
+  z3::expr Quotient(const z3::expr& num, const z3::expr& den);
+  // Translate's base^ex: a product for an integer exponent of magnitude at most 16 (its reciprocal
+  // for a negative one), else an unconstrained auxiliary. `translate` translates `base`.
+  z3::expr Power(const Expression& base, const Expression& ex,
+                 const std::function<z3::expr(const Expression&)>& translate);
   z3::expr Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
                    double margin);
   z3::expr Conjunction(const Constraint& c, const std::vector<std::optional<z3::expr>>& env);
   z3::expr Flow(int k, int mode);
+  // The representative constant input u_k has the sign of the input's integral V_k, and V_k lies
+  // within the input's bounds times d.
+  z3::expr InputLink(const StepVars& a, int i);
+  // Adds to `out` the kConstantRate flow from s_k: the inputs' links and the exact endpoints.
+  void ConstantRateFlow(int k, const ModeInfo& info, z3::expr& out);
+  // Adds to `out` the kSeparable flow from s_k: the input's link, the driver's endpoint and, per
+  // separable variable, SeparableVariable.
+  void SeparableFlowStep(int k, const ModeInfo& info, z3::expr& out);
+  // Adds to `out` what bounds one separable variable over `segment`: monotonicity (where phi has
+  // one sign) and the exact law (where there is an antiderivative).
+  void SeparableVariable(const Segment& segment, const ModeInfo& info, const SeparableFlow& sf,
+                         z3::expr& out);
+  // Adds to `out` the exact law of `sf` where both ends lie in its domain, and SaturationCrossing.
+  void SeparableLaw(const Segment& segment, const ModeInfo& info, const SeparableFlow& sf,
+                    const z3::expr& K, const z3::expr& dv, double s, z3::expr& out);
+  // Adds to `out` the segments with one end inside the law's domain and the other in the
+  // saturation of max(B^n, eps): the law holds up to the edge, v moves on monotonically beyond it.
+  void SaturationCrossing(const Segment& segment, const ModeInfo& info, const SeparableFlow& sf,
+                          const Law& law, z3::expr& out);
   z3::expr NoUrgentGuardOnSegment(int k, int mode);
+  // For kConstantRate: the segment from `a` as x(sigma) = x_k + dir sigma with sigma = V_i (one
+  // input, no drift) or d (drift, no input); false where it is neither (urgency not encoded).
+  bool StraightSegment(const ModeInfo& info, const StepVars& a,
+                       std::optional<z3::expr>& const_sigma, std::vector<double>& dir) const;
+  // The comparisons of urgent transition `tr`'s guard as affine functions of the segment's
+  // parameter sigma (const_sigma set: along `dir`; else kSeparable, sigma the change of the one
+  // moving variable read, set in `sep_var`); nullopt when a comparison is not of that form.
+  std::optional<std::vector<GuardAtom>> GuardAtoms(const hybrid::Transition& tr,
+                                                   const std::vector<bool>& moving,
+                                                   const std::optional<z3::expr>& const_sigma,
+                                                   const std::vector<double>& dir,
+                                                   const std::vector<std::optional<z3::expr>>& env,
+                                                   int& sep_var);
+  // The guard `atoms` hold at some sigma of the segment ending at `sigma_end`; sign: +1 for
+  // [0, end), -1 for (end, 0], 0 for {0}.
+  z3::expr GuardMeets(const std::vector<GuardAtom>& atoms, const z3::expr& sigma_end, int sign);
+  // fixed && (at.alpha REL 0): the atom at sigma = 0 (or where it does not depend on sigma).
+  static z3::expr AndHoldsAtStart(const z3::expr& fixed, const GuardAtom& at);
+  // Adds the bound on sigma that `at` gives (beta != 0) to `lower` or `upper` (bound, strict).
+  static void AddSigmaBound(const GuardAtom& at, std::vector<std::pair<z3::expr, bool>>& lower,
+                            std::vector<std::pair<z3::expr, bool>>& upper);
   z3::expr Jump(int k, int t);
   // Whether `c` reads a continuous variable with a flow in mode `mode`.
   bool ReadsMovingVariable(const Comparison& c, int mode) const;
   z3::expr Discrete(int k, int slot);
   Expression Fold(const Expression& e) const;
   void Classify();
+  // The nonzero flows of `mode`, recorded as moving in `info`.
+  Flows MovingFlows(const Mode& mode, ModeInfo& info) const;
+  // Whether every flow is affine in the inputs with constant coefficients; records the drifts
+  // and rates in `info` (as far as it got).
+  bool ConstantRates(const Flows& flows, ModeInfo& info) const;
+  // Makes `info` kSeparable if its flows are: one input u, a driver w' = c u, others K phi(w) u.
+  void ClassifySeparable(const Flows& flows, ModeInfo& info) const;
+  // The separable form of variable v's flow f (input slot u, driver slot w, still: slots that do
+  // not move in the mode), or nullopt if f has none.
+  std::optional<SeparableFlow> Separate(int v, const Expression& f, int u, int w,
+                                        const std::vector<bool>& still, int driver) const;
+  // Splits the factors of h into the mode-constant K and phi(w); false if a factor reads a moving
+  // variable other than w or an input, or mixes w with other symbols.
+  bool SplitFactors(const Expression& h, int w, const std::vector<bool>& still, Expression& k,
+                    Expression& phi) const;
+  // The sign of phi on the domain of variable `driver` at nominal parameters (0: unknown).
+  double SignOnDomain(const Expression& phi, int driver) const;
   z3::expr Fresh();
 
   z3::context& ctx_;
