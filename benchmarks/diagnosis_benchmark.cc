@@ -11,6 +11,7 @@
 #include <string>
 
 #include "automaton/parser.h"
+#include "benchmarks/bundled_model.h"
 #include "gripper/finger_diagnosis.h"
 #include "gripper/synthetic_data.h"
 
@@ -19,9 +20,7 @@ namespace {
 using namespace hybrid;
 
 Automaton Finger() {
-  return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha")
-      .components()[0]
-      .automaton;
+  return ParseModelFile(hybrid::benchmarks::BundledModel("finger.ha")).components()[0].automaton;
 }
 
 MeasuredData Data(const HiddenEffects& hidden) {

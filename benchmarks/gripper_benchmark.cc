@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "automaton/parser.h"
+#include "benchmarks/bundled_model.h"
 #include "gripper/finger_closed_form.h"
 #include "gripper/geometric_finger.h"
 #include "gripper/hand.h"
@@ -87,7 +88,7 @@ BENCHMARK(BM_HandClosing)->Unit(benchmark::kMillisecond);
 void HandClosingSimulated(benchmark::State& state, double spread) {
   const Hand hand({Obstacle::Circle({0.0, 0.06}, 0.02)}, spread, {255, 255, 255});
   const hybrid::System system = hand.ComposedAutomata(
-      hybrid::ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha"), true);
+      hybrid::ParseModelFile(hybrid::benchmarks::BundledModel("hand.ha")), true);
   const hybrid::Simulator simulator(system);
   hybrid::SimulationOptions options;
   options.until = 256.0;

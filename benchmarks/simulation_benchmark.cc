@@ -13,12 +13,13 @@
 #include <string>
 
 #include "automaton/parser.h"
+#include "benchmarks/bundled_model.h"
 #include "solvers/simulation/simulator.h"
 
 namespace {
 
 std::string ReadSpec(const std::string& name) {
-  const std::string path = std::string(HYBRID_SOURCE_DIR) + "/spec/" + name;
+  const std::string path = hybrid::benchmarks::BundledModel(name);
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read " + path);
   std::ostringstream text;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "automaton/parser.h"
+#include "benchmarks/bundled_model.h"
 #include "solvers/verification/property_prover.h"
 
 namespace {
@@ -15,8 +16,7 @@ namespace {
 using hybrid::Property;
 
 void ProveAll(benchmark::State& state, const std::string& model) {
-  const hybrid::System system =
-      hybrid::ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/" + model);
+  const hybrid::System system = hybrid::ParseModelFile(hybrid::benchmarks::BundledModel(model));
   std::vector<Property> invariants;
   for (const Property& p : hybrid::DeclaredProperties(system)) {
     if (p.kind != Property::Kind::kReach) invariants.push_back(p);

@@ -37,6 +37,145 @@ bool Moves(FingerPhase phase, int link) {
   return false;
 }
 
+// Throws std::invalid_argument unless the contacts and parameters are consistent (the
+// constructor's contract).
+void Validate(const FingerContacts& contacts, const FingerParameters& p) {
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(contacts.gob[i]) || contacts.gob[i] < 0.0) {
+      throw std::invalid_argument("FingerClosedForm: contact position of link " +
+                                  std::to_string(i + 1) + " must be >= 0 (got " +
+                                  std::to_string(contacts.gob[i]) + ")");
+    }
+    if (!(p.theta_min[i] < p.theta_max[i]) || !std::isfinite(p.theta_min[i]) ||
+        !std::isfinite(p.theta_max[i])) {
+      throw std::invalid_argument("FingerClosedForm: empty range for joint " +
+                                  std::to_string(i + 1));
+    }
+  }
+  if (p.theta_min[0] != 0.0 || p.theta_min[1] != 0.0 || p.theta_min[2] > 0.0 ||
+      p.theta_max[2] < 0.0 || !(p.m1() > 0.0) || !(p.m2() > 0.0) || !(p.motor_max > 0.0) ||
+      !std::isfinite(p.motor_max)) {
+    throw std::invalid_argument(
+        "FingerClosedForm: parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
+        "theta2_max, theta3_min <= 0 <= theta3_max and a positive finite motor range");
+  }
+}
+
+// The contact positions the finger can reach: those beyond the motor range become kNone.
+std::array<double, 3> ReachableContacts(const FingerContacts& contacts, const FingerParameters& p) {
+  std::array<double, 3> gob;
+  for (int i = 0; i < 3; ++i) {
+    gob[i] = contacts.gob[i] > p.motor_max ? FingerContacts::kNone : contacts.gob[i];
+  }
+  return gob;
+}
+
+// The linear rate (degrees per count) of (theta1, theta2, theta3) in `phase`; zero in phase 3
+// (theta3 follows the rational law; no linear rate) and phase 4 (stopped).
+Eigen::Vector3d RateOf(FingerPhase phase, const FingerParameters& p) {
+  switch (phase) {
+    case FingerPhase::k1:
+      return {p.m1(), 0.0, -p.m1()};
+    case FingerPhase::k1Prime:
+      return {p.m1(), 0.0, 0.0};
+    case FingerPhase::k2:
+      return {0.0, p.m2(), -p.m2()};
+    case FingerPhase::k2Prime:
+      return {0.0, p.m2(), 0.0};
+    default:
+      return Eigen::Vector3d::Zero();
+  }
+}
+
+// The piece that starts at motor position g in configuration theta with flags c and l (its end
+// g1 and span3 still to be set).
+FingerClosedForm::Piece StartPiece(double g, const Eigen::Vector3d& theta,
+                                   const std::array<int, 3>& c, const std::array<int, 3>& l,
+                                   const FingerParameters& p) {
+  FingerClosedForm::Piece piece;
+  piece.g0 = g;
+  piece.theta0 = theta;
+  piece.c = c;
+  piece.l = l;
+  piece.phase = PhaseOf(c, l);
+  piece.rate = RateOf(piece.phase, p);
+  return piece;
+}
+
+// What can end a piece: a link touching an object, a joint reaching its upper limit, theta3
+// reaching its lower limit, the end of the motor range.
+enum class EventKind { kContact, kLimit, kLower, kEndOfTravel };
+struct Event {
+  double at;
+  EventKind kind;
+  int link;
+};
+
+// The candidate events of `piece` (of a finger that is not stopped) in the simulator's priority
+// order: for each link, contact then limit; then theta3 reaching its lower limit (phases 1 and
+// 2); the end of travel last.
+std::vector<Event> CandidateEvents(const FingerClosedForm::Piece& piece,
+                                   const std::array<double, 3>& gob, const FingerParameters& p) {
+  const double g = piece.g0;
+  const Eigen::Vector3d& theta = piece.theta0;
+  const std::array<int, 3>&c = piece.c, &l = piece.l;
+  std::vector<Event> events;
+  for (int i = 0; i < 3; ++i) {
+    if (c[i] == 0 && l[i] != 1 && Moves(piece.phase, i) && gob[i] != FingerContacts::kNone) {
+      events.push_back({std::max(gob[i], g), EventKind::kContact, i});
+    }
+    if (c[i] != 0 || l[i] != 0) continue;
+    if (piece.phase == FingerPhase::k3 && i == 2) {
+      // theta3 reaches its upper limit half way between g and motor_max.
+      if (theta[2] >= p.theta_max[2]) {
+        events.push_back({g, EventKind::kLimit, 2});
+      } else if (g < p.motor_max) {
+        events.push_back({0.5 * (p.motor_max + g), EventKind::kLimit, 2});
+      }
+    } else if (piece.rate[i] > 0.0) {
+      events.push_back(
+          {g + std::max(0.0, p.theta_max[i] - theta[i]) / piece.rate[i], EventKind::kLimit, i});
+    }
+  }
+  if ((piece.phase == FingerPhase::k1 || piece.phase == FingerPhase::k2) && l[2] == 0) {
+    events.push_back(
+        {g + std::max(0.0, theta[2] - p.theta_min[2]) / -piece.rate[2], EventKind::kLower, 2});
+  }
+  events.push_back({p.motor_max, EventKind::kEndOfTravel, -1});
+  return events;
+}
+
+// The first event (in priority order) that happens by `end`, the earliest event's position.
+const Event& FirstEvent(const std::vector<Event>& events, double end) {
+  for (const Event& e : events) {
+    if (e.at <= end) return e;
+  }
+  throw std::logic_error("FingerClosedForm: no event at the end of a piece");
+}
+
+// Takes `event` (not the end of travel): sets the flag it changes and puts a joint reaching a
+// limit exactly there.
+void Apply(const Event& event, const FingerParameters& p, std::array<int, 3>& c,
+           std::array<int, 3>& l, Eigen::Vector3d& theta) {
+  switch (event.kind) {
+    case EventKind::kContact:
+      c[event.link] = 1;
+      break;
+    case EventKind::kLimit:
+      l[event.link] = 1;
+      theta[event.link] = p.theta_max[event.link];
+      break;
+    case EventKind::kLower:
+      l[2] = -1;
+      theta[2] = p.theta_min[2];
+      break;
+    case EventKind::kEndOfTravel:
+      break;
+  }
+  // Blocking link 2 leaves phases 1' and 2' for phase 3 (l3 = 0), except against the palm.
+  if ((c[1] == 1 || l[1] == 1) && l[2] == -1 && c[2] == 0 && !IsPalm(c, l)) l[2] = 0;
+}
+
 }  // namespace
 
 std::string PhaseName(FingerPhase phase) {
@@ -70,43 +209,16 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
                                    const FingerParameters& parameters)
     : parameters_(parameters), contacts_(contacts) {
   const FingerParameters& p = parameters_;
-  for (int i = 0; i < 3; ++i) {
-    if (std::isnan(contacts.gob[i]) || contacts.gob[i] < 0.0) {
-      throw std::invalid_argument("FingerClosedForm: contact position of link " +
-                                  std::to_string(i + 1) + " must be >= 0 (got " +
-                                  std::to_string(contacts.gob[i]) + ")");
-    }
-    if (!(p.theta_min[i] < p.theta_max[i]) || !std::isfinite(p.theta_min[i]) ||
-        !std::isfinite(p.theta_max[i])) {
-      throw std::invalid_argument("FingerClosedForm: empty range for joint " +
-                                  std::to_string(i + 1));
-    }
-  }
-  if (p.theta_min[0] != 0.0 || p.theta_min[1] != 0.0 || p.theta_min[2] > 0.0 ||
-      p.theta_max[2] < 0.0 || !(p.m1() > 0.0) || !(p.m2() > 0.0) || !(p.motor_max > 0.0) ||
-      !std::isfinite(p.motor_max)) {
-    throw std::invalid_argument(
-        "FingerClosedForm: parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
-        "theta2_max, theta3_min <= 0 <= theta3_max and a positive finite motor range");
-  }
-  const double kNone = FingerContacts::kNone;
-  std::array<double, 3> gob;
-  for (int i = 0; i < 3; ++i) {
-    gob[i] = contacts.gob[i] > p.motor_max ? kNone : contacts.gob[i];
-  }
-
+  Validate(contacts, p);
+  const std::array<double, 3> gob = ReachableContacts(contacts, p);
+  // Piece by piece from the open finger: each piece ends at its first event, which sets a flag.
   double g = 0.0;
   Eigen::Vector3d theta = Eigen::Vector3d::Zero();
   std::array<int, 3> c = {0, 0, 0}, l = {0, 0, 0};
   // At most one flag changes per event and flags only get set while closing, so a handful of
   // iterations suffices; the bound guards against a logic error.
   for (int iteration = 0; iteration < 32; ++iteration) {
-    Piece piece;
-    piece.g0 = g;
-    piece.theta0 = theta;
-    piece.c = c;
-    piece.l = l;
-    piece.phase = PhaseOf(c, l);
+    Piece piece = StartPiece(g, theta, c, l, p);
     if (piece.phase == FingerPhase::k4) {
       stop_ = g;
       piece.g1 = p.motor_max;
@@ -114,52 +226,7 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
       PackEnds();
       return;
     }
-    switch (piece.phase) {
-      case FingerPhase::k1:
-        piece.rate = {p.m1(), 0.0, -p.m1()};
-        break;
-      case FingerPhase::k1Prime:
-        piece.rate = {p.m1(), 0.0, 0.0};
-        break;
-      case FingerPhase::k2:
-        piece.rate = {0.0, p.m2(), -p.m2()};
-        break;
-      case FingerPhase::k2Prime:
-        piece.rate = {0.0, p.m2(), 0.0};
-        break;
-      default:
-        break;  // phase 3: theta3 follows the rational law; no linear rate
-    }
-    // Candidate events in the simulator's priority order: for each link, contact then limit;
-    // then theta3 reaching its lower limit (phases 1 and 2).
-    enum Kind { kContact, kLimit, kLower, kEndOfTravel };
-    struct Event {
-      double at;
-      Kind kind;
-      int link;
-    };
-    std::vector<Event> events;
-    for (int i = 0; i < 3; ++i) {
-      if (c[i] == 0 && l[i] != 1 && Moves(piece.phase, i) && gob[i] != kNone) {
-        events.push_back({std::max(gob[i], g), kContact, i});
-      }
-      if (c[i] == 0 && l[i] == 0) {
-        if (piece.phase == FingerPhase::k3 && i == 2) {
-          if (theta[2] >= p.theta_max[2]) {
-            events.push_back({g, kLimit, 2});
-          } else if (g < p.motor_max) {
-            events.push_back({0.5 * (p.motor_max + g), kLimit, 2});
-          }
-        } else if (piece.rate[i] > 0.0) {
-          events.push_back(
-              {g + std::max(0.0, p.theta_max[i] - theta[i]) / piece.rate[i], kLimit, i});
-        }
-      }
-    }
-    if ((piece.phase == FingerPhase::k1 || piece.phase == FingerPhase::k2) && l[2] == 0) {
-      events.push_back({g + std::max(0.0, theta[2] - p.theta_min[2]) / -piece.rate[2], kLower, 2});
-    }
-    events.push_back({p.motor_max, kEndOfTravel, -1});
+    const std::vector<Event> events = CandidateEvents(piece, gob, p);
     double end = p.motor_max;
     for (const Event& e : events) end = std::min(end, e.at);
     piece.g1 = end;
@@ -167,31 +234,12 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
     if (end > g || pieces_.empty()) pieces_.push_back(piece);
     theta = Evaluate(piece, end);
     g = end;
-    const Event* first = nullptr;
-    for (const Event& e : events) {
-      if (e.at <= end) {
-        first = &e;
-        break;
-      }
+    const Event& first = FirstEvent(events, end);
+    if (first.kind == EventKind::kEndOfTravel) {
+      PackEnds();
+      return;  // still moving at the end of the motor range
     }
-    switch (first->kind) {
-      case kEndOfTravel:
-        PackEnds();
-        return;  // still moving at the end of the motor range
-      case kContact:
-        c[first->link] = 1;
-        break;
-      case kLimit:
-        l[first->link] = 1;
-        theta[first->link] = p.theta_max[first->link];
-        break;
-      case kLower:
-        l[2] = -1;
-        theta[2] = p.theta_min[2];
-        break;
-    }
-    // Blocking link 2 leaves phases 1' and 2' for phase 3 (l3 = 0), except against the palm.
-    if ((c[1] == 1 || l[1] == 1) && l[2] == -1 && c[2] == 0 && !IsPalm(c, l)) l[2] = 0;
+    Apply(first, p, c, l, theta);
   }
   throw std::logic_error("FingerClosedForm: too many events");
 }

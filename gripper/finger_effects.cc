@@ -256,17 +256,25 @@ Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effe
   return out;
 }
 
-Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effects,
-                            const std::optional<FingerInitialState>& initial_finger) {
-  constexpr std::string_view kApi = "ExtendFingerModel";
-  const Automaton dyn = ApplyDynamicEffects(finger, effects);
-  if (!std::isfinite(effects.backlash) || effects.backlash < 0.0) {
-    Fail(kApi, "backlash must be finite and >= 0");
-  }
-  Automaton out = CopySymbols(dyn);
-  const Expression u = Sym(dyn, "u", kApi);
-  const Expression g = Sym(dyn, "g", kApi);
-  const int g_slot = SlotOf(dyn, "g", kApi);
+namespace {
+
+// The motor side of the play in the extended model: the finger model's drive input u and
+// position g, the parameters motor_offset and backlash, and the motor position g_motor.
+struct Play {
+  Expression u, g;
+  int g_slot;
+  Expression offset, backlash;
+  int motor_slot;
+  Expression motor;
+};
+
+// Adds the play's parameters (motor_offset; backlash, ranging over [0, backlash]) and the
+// variable g_motor to `out`.
+Play AddPlay(Automaton& out, const Automaton& dyn, const FingerEffects& effects,
+             std::string_view api) {
+  const Expression u = Sym(dyn, "u", api);
+  const Expression g = Sym(dyn, "g", api);
+  const int g_slot = SlotOf(dyn, "g", api);
   const int d_slot =
       out.AddParameter("motor_offset", Expression::Constant(effects.motor_offset), "count");
   const int b_slot = out.AddParameter(
@@ -275,45 +283,69 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
   const Expression d = Expression::Symbol("motor_offset", d_slot);
   const Expression b = Expression::Symbol("backlash", b_slot);
   const int gm_slot = out.AddVariable("g_motor", "count");
-  const Expression gm = Expression::Symbol("g_motor", gm_slot);
-  // Output map: measured angles with their biases.
-  struct Measured {
-    int source;  // slot of theta_j
-    int slot;    // slot of theta_j_measured
-    Expression bias;
-  };
+  return {u, g, g_slot, d, b, gm_slot, Expression::Symbol("g_motor", gm_slot)};
+}
+
+// A measured angle of the output map: theta_j_measured = theta_j + theta_j_bias.
+struct Measured {
+  int source;  // slot of theta_j
+  int slot;    // slot of theta_j_measured
+  Expression bias;
+};
+
+// Adds the output map to `out`: for each joint with a sensor bias, the parameter theta_j_bias
+// and the variable theta_j_measured.
+std::vector<Measured> AddMeasuredAngles(Automaton& out, const Automaton& dyn,
+                                        const FingerEffects& effects, std::string_view api) {
   std::vector<Measured> measured;
   for (int j = 0; j < 3; ++j) {
     if (effects.sensor_bias[j] == 0.0) continue;
     const std::string name = std::string(kJointNames[j]) + "_bias";
     const int p = out.AddParameter(name, Expression::Constant(effects.sensor_bias[j]), "deg");
     const int v = out.AddVariable(std::string(kJointNames[j]) + "_measured", "deg");
-    measured.push_back({SlotOf(dyn, kJointNames[j], kApi), v, Expression::Symbol(name, p)});
+    measured.push_back({SlotOf(dyn, kJointNames[j], api), v, Expression::Symbol(name, p)});
   }
+  return measured;
+}
 
-  // Modes: three copies of each finger mode.
-  const char* const kCopy[3] = {"_closing", "_slack", "_opening"};
-  std::vector<std::array<ModeId, 3>> ids;
+// The three copies of a finger mode: the drive engaged closing, slack, engaged opening.
+constexpr std::array<const char*, 3> kCopy = {"_closing", "_slack", "_opening"};
+using ModeCopies = std::array<ModeId, 3>;
+
+// Adds three copies of each mode of `dyn` to `out`, in order (mode m's at index m): slack
+// freezes the finger; in every copy the measured angles follow their joints and the motor moves
+// with the drive when engaged (stalling with it in phase 4) and with u when slack.
+std::vector<ModeCopies> AddModeCopies(Automaton& out, const Automaton& dyn,
+                                      const std::vector<Measured>& measured, const Play& play) {
+  std::vector<ModeCopies> ids;
   for (const Mode& m : dyn.modes()) {
-    std::array<ModeId, 3> three;
+    ModeCopies three;
     for (int c = 0; c < 3; ++c) {
       Mode copy = m;
       copy.name = m.name + kCopy[c];
       if (c == 1) copy.flows.clear();  // slack: the finger is frozen
       for (const Measured& x : measured) SetFlow(copy, x.slot, copy.FlowOf(x.source));
-      // Engaged, the motor moves with the finger's drive (and stalls with it, phase 4).
-      SetFlow(copy, gm_slot, c == 1 ? std::optional<Expression>(u) : m.FlowOf(g_slot));
+      SetFlow(copy, play.motor_slot,
+              c == 1 ? std::optional<Expression>(play.u) : m.FlowOf(play.g_slot));
       three[c] = out.AddMode(std::move(copy));
     }
     ids.push_back(three);
   }
-  // The play's transitions first: they take priority over the finger's at the same instant.
+  return ids;
+}
+
+// Adds the play's transitions between the copies of every mode: reversing or reaching an end of
+// the motor range makes the drive slack; it engages again closing (opening) once the motor has
+// taken up the play.
+void AddPlayTransitions(Automaton& out, const Automaton& dyn, const std::vector<ModeCopies>& ids,
+                        const Play& play) {
   const Expression zero = Expression::Constant(0.0);
   const Expression top = Expression::Constant(kMotorMax);
   // A finger stopped at an end of the motor range engages again only from 1e-6 counts inside it
   // (a strict `g > 0` would hold at a rounding-level g and chatter with the stop).
   const Expression zero_in = Expression::Constant(1e-6);
   const Expression top_in = Expression::Constant(kMotorMax - 1e-6);
+  const Expression &u = play.u, &g = play.g, &gm = play.motor, &d = play.offset, &b = play.backlash;
   auto add = [&](const std::string& name, ModeId from, ModeId to, std::vector<Comparison> guard) {
     Transition t;
     t.name = name;
@@ -338,6 +370,12 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
     add("stop_" + name + "_opening", opening, slack,
         {Compare(g, Relation::kLessEqual, zero), Compare(u, Relation::kLess, zero)});
   }
+}
+
+// Adds each transition of `dyn` within the closing and within the opening copies; a reset of a
+// joint resets its measured angle too, with the bias.
+void AddFingerTransitions(Automaton& out, const Automaton& dyn, const std::vector<ModeCopies>& ids,
+                          const std::vector<Measured>& measured) {
   for (const Transition& t : dyn.transitions()) {
     for (int c : {0, 2}) {
       Transition copy = t;
@@ -352,20 +390,46 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
       out.AddTransition(std::move(copy));
     }
   }
+}
 
-  // Initial state: the motor at 0, the finger where the drive map puts it.
+// Adds to `copy` (an initial state of the extended model made from `s`) the initial range of
+// each measured angle: its joint's (as `copy` sets it) plus the bias.
+void AddMeasuredInitialValues(InitialState& copy, const InitialState& s,
+                              const std::vector<Measured>& measured) {
+  for (const Measured& x : measured) {
+    for (const InitialValue& v : s.values) {
+      if (v.slot != x.source) continue;
+      const InitialValue* from = &v;
+      for (const InitialValue& w : copy.values) {
+        if (w.slot == x.source) from = &w;
+      }
+      copy.values.push_back(
+          InitialValue{x.slot, {from->range.lo + x.bias, from->range.hi + x.bias}, from->is_point});
+    }
+  }
+}
+
+// Adds the initial states: each of `dyn`'s with the motor at 0 and the finger where the drive
+// map puts it (engaged closing, or slack), in `initial_finger`'s mode and values when the play
+// has already moved it (q0 > 0).
+void AddInitialStates(Automaton& out, const Automaton& dyn, const std::vector<ModeCopies>& ids,
+                      const std::vector<Measured>& measured, const Play& play,
+                      const FingerEffects& effects,
+                      const std::optional<FingerInitialState>& initial_finger,
+                      std::string_view api) {
   const double q0 = DrivePositions(std::span<const double>(std::array<double, 1>{0.0}),
                                    effects.backlash, effects.motor_offset)[0];
   const bool engaged = q0 == -effects.motor_offset;
+  const Expression zero = Expression::Constant(0.0);
   for (const InitialState& s : dyn.initial_states()) {
     InitialState copy = s;
     int copy_index = engaged ? 0 : 1;
     if (initial_finger && q0 > 0.0) {
       const auto mode = dyn.FindMode(initial_finger->mode);
-      if (!mode) Fail(kApi, "no finger mode '" + initial_finger->mode + "'");
+      if (!mode) Fail(api, "no finger mode '" + initial_finger->mode + "'");
       copy.mode = ids[mode->value()][copy_index];
       for (const auto& [name, value] : initial_finger->values) {
-        const int slot = SlotOf(dyn, name, kApi);
+        const int slot = SlotOf(dyn, name, api);
         for (InitialValue& v : copy.values) {
           if (v.slot == slot)
             v = InitialValue{
@@ -373,25 +437,34 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
         }
       }
     } else {
-      if (q0 > 0.0) Fail(kApi, "motor_offset < 0 needs the finger's initial state");
+      if (q0 > 0.0) Fail(api, "motor_offset < 0 needs the finger's initial state");
       copy.mode = ids[s.mode.value()][copy_index];
     }
-    copy.values.push_back(InitialValue{gm_slot, {zero, zero}, true});
-    for (const Measured& x : measured) {
-      for (const InitialValue& v : s.values) {
-        if (v.slot != x.source) continue;
-        const InitialValue* from = &v;
-        for (const InitialValue& w : copy.values) {
-          if (w.slot == x.source) from = &w;
-        }
-        copy.values.push_back(InitialValue{
-            x.slot, {from->range.lo + x.bias, from->range.hi + x.bias}, from->is_point});
-      }
-    }
+    copy.values.push_back(InitialValue{play.motor_slot, {zero, zero}, true});
+    AddMeasuredInitialValues(copy, s, measured);
     std::sort(copy.values.begin(), copy.values.end(),
               [](const InitialValue& x, const InitialValue& y) { return x.slot < y.slot; });
     out.AddInitialState(std::move(copy));
   }
+}
+
+}  // namespace
+
+Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effects,
+                            const std::optional<FingerInitialState>& initial_finger) {
+  constexpr std::string_view kApi = "ExtendFingerModel";
+  const Automaton dyn = ApplyDynamicEffects(finger, effects);
+  if (!std::isfinite(effects.backlash) || effects.backlash < 0.0) {
+    Fail(kApi, "backlash must be finite and >= 0");
+  }
+  Automaton out = CopySymbols(dyn);
+  const Play play = AddPlay(out, dyn, effects, kApi);
+  const std::vector<Measured> measured = AddMeasuredAngles(out, dyn, effects, kApi);
+  const std::vector<ModeCopies> ids = AddModeCopies(out, dyn, measured, play);
+  // The play's transitions first: they take priority over the finger's at the same instant.
+  AddPlayTransitions(out, dyn, ids, play);
+  AddFingerTransitions(out, dyn, ids, measured);
+  AddInitialStates(out, dyn, ids, measured, play, effects, initial_finger, kApi);
   for (const Property& p : dyn.properties()) out.AddProperty(p);
   return out;
 }

@@ -42,7 +42,7 @@ struct FingerPrediction {
 /// along q, so that time is the drive's path length and each sample is recorded at its position
 /// on the path (the model is rate-independent: every flow is proportional to u). Sensor biases
 /// are added to the angles. This equals simulating ExtendFingerModel's automaton with the motor
-/// path (tests/solvers/finger_predictor_test.cc checks it to 1e-6 deg) whenever the motor does
+/// path (tests/gripper/finger_predictor_test.cc checks it to 1e-6 deg) whenever the motor does
 /// not travel past a point where the finger stalled it (phase 4), as a physical motor cannot.
 /// Data that do (the motor's g goes on past the stall) are still predicted: the finger stays
 /// stopped, reverses when g does, and stops at the ends of the motor range; the extended

@@ -8,24 +8,22 @@
 
 namespace hybrid::gripper {
 
-GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeometry& geometry,
-                                 const FingerParameters& parameters, const FingerContacts& imposed,
-                                 double up_to)
-    : objects_(std::move(objects)),
-      geometry_(geometry),
-      parameters_(parameters),
-      closed_form_(FingerContacts{}, parameters) {
-  const Obstacle palm_bar = palm();
-  // The whole links (knuckles included) must be clear of the objects at g = 0.
-  const auto open_links = geometry_.Links(Eigen::Vector3d::Zero());
-  for (size_t k = 0; k < objects_.size(); ++k) {
-    const Obstacle& o = objects_[k];
+namespace {
+
+constexpr int kPalm = GeometricFinger::kPalm;
+
+// Throws std::invalid_argument if an object reaches below the palm's surface or overlaps a link
+// of the open finger (knuckles included).
+void RequireClearOfOpenFinger(const std::vector<Obstacle>& objects,
+                              const FingerGeometry& geometry) {
+  const auto open_links = geometry.Links(Eigen::Vector3d::Zero());
+  for (const Obstacle& o : objects) {
     const double lowest = std::min(o.a().y(), o.b().y()) - o.radius();
-    if (lowest < geometry_.palm_y()) {
+    if (lowest < geometry.palm_y()) {
       throw std::invalid_argument(
           "GeometricFinger: object " + o.ToString() +
           " overlaps the palm (its lowest point y = " + FormatNumber(lowest) +
-          " is below the palm surface y = " + FormatNumber(geometry_.palm_y()) + ")");
+          " is below the palm surface y = " + FormatNumber(geometry.palm_y()) + ")");
     }
     for (int i = 0; i < 3; ++i) {
       if (o.Distance(open_links[i]) <= 0.0) {
@@ -34,75 +32,127 @@ GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeom
       }
     }
   }
-  // Signed distance of link i to obstacle k (kPalm for the palm) at motor position g of `cf`.
-  auto distance = [&](const FingerClosedForm& cf, double g, int i, int k) {
-    const auto links = geometry_.ContactSegments(cf.At(g).theta);
-    return (k == kPalm ? palm_bar : objects_[k]).Distance(links[i]);
-  };
+}
+
+// Sample points of the path of `cf` in [g, end]: every kResolution counts, except in phase 3,
+// where theta3's rate grows without bound towards g = 255 and the samples are every
+// kResolution * m1 degrees of theta3 instead (so no joint turns more than 0.045 degrees between
+// samples); plus every breakpoint. Sorted, without duplicates.
+std::vector<double> SearchGrid(const FingerClosedForm& cf, const FingerParameters& parameters,
+                               double g, double end) {
+  constexpr double kResolution = GeometricFinger::kResolution;
+  std::vector<double> grid = {g, end};
+  for (const auto& piece : cf.pieces()) {
+    const double lo = std::max(piece.g0, g), hi = std::min(piece.g1, end);
+    if (lo >= hi) continue;
+    grid.push_back(lo);
+    grid.push_back(hi);
+    if (piece.phase != FingerPhase::k3) {
+      for (double s = lo; s < hi; s += kResolution) grid.push_back(s);
+      continue;
+    }
+    // theta3 = theta3_s + span3 phi with phi = (g - g0) / (255 - g), so g = (g0 + 255 phi) /
+    // (1 + phi).
+    const double step = kResolution * parameters.m1() / piece.span3;
+    for (double phi = 0.0; phi < 1.0; phi += step) {
+      const double s = (piece.g0 + parameters.motor_max * phi) / (1.0 + phi);
+      if (s > lo && s < hi) grid.push_back(s);
+    }
+  }
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  return grid;
+}
+
+// The obstacles a link can touch: the objects (0, 1, ...) and the palm (kPalm).
+struct Obstacles {
+  // Signed distance of link i to obstacle k at motor position g of `cf`.
+  double Distance(const FingerClosedForm& cf, double g, int i, int k) const {
+    const auto links = geometry.ContactSegments(cf.At(g).theta);
+    return (k == kPalm ? palm : objects[k]).Distance(links[i]);
+  }
+  const FingerGeometry& geometry;
+  const std::vector<Obstacle>& objects;
+  Obstacle palm;
+};
+
+// A contact: where, of which link, with which obstacle (an object, kPalm or kImposed).
+struct Hit {
+  double g;
+  int link;
+  int obstacle;
+};
+
+// Looks for link i touching obstacle k in the sample step [lo, hi] of `cf` and keeps the touch
+// in `first` if it is earlier: found by bisection to 1e-10 counts, or at lo if the link already
+// touches there and moves further in.
+void FindTouch(const FingerClosedForm& cf, const Obstacles& obstacles, double lo, double hi, int i,
+               int k, std::optional<Hit>& first) {
+  const double d_hi = obstacles.Distance(cf, hi, i, k);
+  if (d_hi > 0.0) return;
+  const double d_lo = obstacles.Distance(cf, lo, i, k);
+  if (d_lo <= 0.0) {
+    // Touching already where the previous contact stopped the finger (e.g. at the joint shared
+    // with the blocked link): a contact if the link moves further in.
+    if (d_hi < d_lo && (!first || lo < first->g)) first = Hit{lo, i, k};
+    return;
+  }
+  while (hi - lo > 1e-10) {
+    const double mid = 0.5 * (lo + hi);
+    (obstacles.Distance(cf, mid, i, k) <= 0.0 ? hi : lo) = mid;
+  }
+  if (!first || hi < first->g) first = Hit{hi, i, k};
+}
+
+// The first contact of a link not blocked yet (in `contacts`) with an obstacle along `grid`.
+std::optional<Hit> FirstGeometricContact(const FingerClosedForm& cf, const Obstacles& obstacles,
+                                         const std::vector<double>& grid,
+                                         const FingerContacts& contacts) {
+  std::optional<Hit> first;
+  for (size_t s = 1; s < grid.size() && !first; ++s) {
+    for (int i = 0; i < 3; ++i) {
+      if (contacts.gob[i] != FingerContacts::kNone) continue;
+      for (int k = kPalm; k < static_cast<int>(obstacles.objects.size()); ++k) {
+        FindTouch(cf, obstacles, grid[s - 1], grid[s], i, k, first);
+      }
+    }
+  }
+  return first;
+}
+
+// Replaces `first` by an imposed contact in [g, end] of a link not blocked yet that comes
+// earlier.
+void TakeEarlierImposedContact(const FingerContacts& imposed, const FingerContacts& contacts,
+                               double g, double end, std::optional<Hit>& first) {
+  for (int i = 0; i < 3; ++i) {
+    const double at = imposed.gob[i];
+    if (contacts.gob[i] == FingerContacts::kNone && at >= g && at <= end &&
+        (!first || at < first->g)) {
+      first = Hit{at, i, GeometricFinger::kImposed};
+    }
+  }
+}
+
+}  // namespace
+
+GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeometry& geometry,
+                                 const FingerParameters& parameters, const FingerContacts& imposed,
+                                 double up_to)
+    : objects_(std::move(objects)),
+      geometry_(geometry),
+      parameters_(parameters),
+      closed_form_(FingerContacts{}, parameters) {
+  RequireClearOfOpenFinger(objects_, geometry_);
+  const Obstacles obstacles{geometry_, objects_, palm()};
+  // Contact by contact: the closed form with the contacts so far, searched from the last one.
   FingerContacts contacts;
   double g = 0.0;
   for (int round = 0; round < 3; ++round) {
     const FingerClosedForm cf(contacts, parameters_);
     const double end = std::min({cf.stop(), parameters_.motor_max, up_to});
-    // Sample points in [g, end]: every kResolution counts, except in phase 3, where theta3's
-    // rate grows without bound towards g = 255 and the samples are every kResolution * m1
-    // degrees of theta3 instead (so no joint turns more than 0.045 degrees between samples);
-    // plus every breakpoint.
-    std::vector<double> grid = {g, end};
-    for (const auto& piece : cf.pieces()) {
-      const double lo = std::max(piece.g0, g), hi = std::min(piece.g1, end);
-      if (lo >= hi) continue;
-      grid.push_back(lo);
-      grid.push_back(hi);
-      if (piece.phase != FingerPhase::k3) {
-        for (double s = lo; s < hi; s += kResolution) grid.push_back(s);
-        continue;
-      }
-      // theta3 = theta3_s + span3 phi with phi = (g - g0) / (255 - g), so g = (g0 + 255 phi) /
-      // (1 + phi).
-      const double step = kResolution * parameters_.m1() / piece.span3;
-      for (double phi = 0.0; phi < 1.0; phi += step) {
-        const double s = (piece.g0 + parameters_.motor_max * phi) / (1.0 + phi);
-        if (s > lo && s < hi) grid.push_back(s);
-      }
-    }
-    std::sort(grid.begin(), grid.end());
-    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-    struct Hit {
-      double g;
-      int link;
-      int obstacle;
-    };
-    std::optional<Hit> first;
-    for (size_t s = 1; s < grid.size() && !first; ++s) {
-      for (int i = 0; i < 3; ++i) {
-        if (contacts.gob[i] != FingerContacts::kNone) continue;
-        for (int k = kPalm; k < static_cast<int>(objects_.size()); ++k) {
-          const double d_hi = distance(cf, grid[s], i, k);
-          if (d_hi > 0.0) continue;
-          double lo = grid[s - 1], hi = grid[s];
-          const double d_lo = distance(cf, lo, i, k);
-          if (d_lo <= 0.0) {
-            // Touching already where the previous contact stopped the finger (e.g. at the joint
-            // shared with the blocked link): a contact if the link moves further in.
-            if (d_hi < d_lo && (!first || lo < first->g)) first = Hit{lo, i, k};
-            continue;
-          }
-          while (hi - lo > 1e-10) {
-            const double mid = 0.5 * (lo + hi);
-            (distance(cf, mid, i, k) <= 0.0 ? hi : lo) = mid;
-          }
-          if (!first || hi < first->g) first = Hit{hi, i, k};
-        }
-      }
-    }
-    for (int i = 0; i < 3; ++i) {
-      const double at = imposed.gob[i];
-      if (contacts.gob[i] == FingerContacts::kNone && at >= g && at <= end &&
-          (!first || at < first->g)) {
-        first = Hit{at, i, kImposed};
-      }
-    }
+    std::optional<Hit> first =
+        FirstGeometricContact(cf, obstacles, SearchGrid(cf, parameters_, g, end), contacts);
+    TakeEarlierImposedContact(imposed, contacts, g, end, first);
     if (!first) break;
     // The palm touches the fingertip at the free-space stop by construction (G1): not a contact.
     if (first->obstacle == kPalm && first->g >= cf.stop() - 1e-7) break;

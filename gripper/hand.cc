@@ -80,9 +80,16 @@ double SegmentDistance3(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
   return (p + u * d1 - (r + v * d2)).norm();
 }
 
-Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double, 3>& commands,
-           const HandLayout& layout)
-    : objects_(std::move(objects)), layout_(layout), commands_(commands) {
+namespace {
+
+// Joints 1 to 3 and the fingertip of fingers A, B and C in space.
+using HandLinks = std::array<std::array<Eigen::Vector3d, 4>, 3>;
+// closest[f1][l1][f2][l2]: the smallest distance between two links of different fingers.
+using ClosestLinks = std::array<std::array<std::array<std::array<double, 3>, 3>, 3>, 3>;
+
+// Throws std::invalid_argument unless the spread position and the motor commands are in
+// [0, 255].
+void ValidateMotors(double spread, const std::array<double, 3>& commands) {
   if (!(spread >= 0.0 && spread <= 255.0)) {
     throw std::invalid_argument("Hand: spread position must be in [0, 255]");
   }
@@ -91,101 +98,143 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
       throw std::invalid_argument("Hand: motor commands must be in [0, 255]");
     }
   }
-  phi_ = layout.phi_min + (layout.phi_max - layout.phi_min) * spread / 255.0;
-  std::array<FingerContacts, 3> imposed;
-  auto build = [&]() {
-    std::vector<GeometricFinger> fingers;
-    for (int f = 0; f < 3; ++f) {
-      try {
-        fingers.emplace_back(objects_, FingerGeometryOf(f), FingerParameters{}, imposed[f],
-                             commands_[f]);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(std::string("Hand: finger ") + "ABC"[f] + ": " + e.what());
-      }
+}
+
+// The three fingers of `hand` (its objects, placements and commands) with the finger-finger
+// contacts `imposed`; an invalid finger's message names it ("Hand: finger B: ...").
+std::vector<GeometricFinger> BuildFingers(const Hand& hand,
+                                          const std::array<FingerContacts, 3>& imposed) {
+  std::vector<GeometricFinger> fingers;
+  for (int f = 0; f < 3; ++f) {
+    try {
+      fingers.emplace_back(hand.objects(), hand.FingerGeometryOf(f), FingerParameters{}, imposed[f],
+                           hand.commands()[f]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("Hand: finger ") + "ABC"[f] + ": " + e.what());
     }
-    return fingers;
-  };
-  fingers_ = build();
-  // Sweep g for touches between fingers.
-  double g0 = 0.0;
-  for (int round = 0; round < 18; ++round) {
-    // Links of every finger in space at sweep position g.
-    auto links_at = [&](double g) {
-      std::array<std::array<Eigen::Vector3d, 4>, 3> p;
-      for (int f = 0; f < 3; ++f) p[f] = Points(f, At(f, g).theta);
-      return p;
-    };
-    auto separation = [&](const std::array<std::array<Eigen::Vector3d, 4>, 3>& p, int f1, int l1,
-                          int f2, int l2) {
-      return SegmentDistance3(p[f1][l1], p[f1][l1 + 1], p[f2][l2], p[f2][l2 + 1]) -
-             layout_.link_width;
-    };
-    std::vector<double> grid;
-    for (double g = g0; g < 255.0; g += GeometricFinger::kResolution) grid.push_back(g);
-    grid.push_back(255.0);
-    std::optional<FingerTouch> first;
-    auto previous = links_at(grid[0]);
-    for (size_t k = 1; k < grid.size() && !first; ++k) {
-      const auto current = links_at(grid[k]);
-      for (int f1 = 0; f1 < 3; ++f1) {
-        for (int f2 = f1 + 1; f2 < 3; ++f2) {
-          for (int l1 = 0; l1 < 3; ++l1) {
-            for (int l2 = 0; l2 < 3; ++l2) {
-              const double now = separation(current, f1, l1, f2, l2);
-              if (now > 0.0) continue;
-              double lo = grid[k - 1], hi = grid[k];
-              const double before = separation(previous, f1, l1, f2, l2);
-              if (before <= 0.0) {
-                // Touching already where the last touch stopped the sweep (e.g. A meets B and,
-                // by symmetry, C at the same g): a touch if the links move further in.
-                if (now < before && (!first || lo < first->g))
-                  first = FingerTouch{f1, l1, f2, l2, lo};
-                continue;
-              }
-              while (hi - lo > 1e-10) {
-                const double mid = 0.5 * (lo + hi);
-                (separation(links_at(mid), f1, l1, f2, l2) <= 0.0 ? hi : lo) = mid;
-              }
-              if (!first || hi < first->g) first = FingerTouch{f1, l1, f2, l2, hi};
-            }
+  }
+  return fingers;
+}
+
+// Every finger's links in space at sweep position g.
+HandLinks LinksAt(const Hand& hand, double g) {
+  HandLinks p;
+  for (int f = 0; f < 3; ++f) p[f] = hand.Points(f, hand.At(f, g).theta);
+  return p;
+}
+
+// How far link l1 of finger f1 and link l2 of finger f2 are from touching (their centre lines'
+// distance minus the link width; <= 0 touching).
+double Separation(const HandLinks& p, int f1, int l1, int f2, int l2, double link_width) {
+  return SegmentDistance3(p[f1][l1], p[f1][l1 + 1], p[f2][l2], p[f2][l2 + 1]) - link_width;
+}
+
+// Looks for the touch of link l1 of finger f1 and link l2 of finger f2 in the sweep step
+// [lo, hi] (links `previous` at lo, `current` at hi) and keeps it in `first` if it is earlier:
+// found by bisection to 1e-10 counts, or at lo if the links already touched there and move
+// further in.
+void FindPairTouch(const Hand& hand, const HandLinks& previous, const HandLinks& current, double lo,
+                   double hi, int f1, int l1, int f2, int l2,
+                   std::optional<Hand::FingerTouch>& first) {
+  const double width = hand.layout().link_width;
+  const double now = Separation(current, f1, l1, f2, l2, width);
+  if (now > 0.0) return;
+  const double before = Separation(previous, f1, l1, f2, l2, width);
+  if (before <= 0.0) {
+    // Touching already where the last touch stopped the sweep (e.g. A meets B and, by symmetry,
+    // C at the same g): a touch if the links move further in.
+    if (now < before && (!first || lo < first->g)) first = Hand::FingerTouch{f1, l1, f2, l2, lo};
+    return;
+  }
+  while (hi - lo > 1e-10) {
+    const double mid = 0.5 * (lo + hi);
+    (Separation(LinksAt(hand, mid), f1, l1, f2, l2, width) <= 0.0 ? hi : lo) = mid;
+  }
+  if (!first || hi < first->g) first = Hand::FingerTouch{f1, l1, f2, l2, hi};
+}
+
+// The first touch between links of different fingers as the sweep goes on from g0, sampled
+// every GeometricFinger::kResolution counts up to 255; nullopt if none.
+std::optional<Hand::FingerTouch> FirstTouch(const Hand& hand, double g0) {
+  std::vector<double> grid;
+  for (double g = g0; g < 255.0; g += GeometricFinger::kResolution) grid.push_back(g);
+  grid.push_back(255.0);
+  std::optional<Hand::FingerTouch> first;
+  HandLinks previous = LinksAt(hand, grid[0]);
+  for (size_t k = 1; k < grid.size() && !first; ++k) {
+    const HandLinks current = LinksAt(hand, grid[k]);
+    for (int f1 = 0; f1 < 3; ++f1) {
+      for (int f2 = f1 + 1; f2 < 3; ++f2) {
+        for (int l1 = 0; l1 < 3; ++l1) {
+          for (int l2 = 0; l2 < 3; ++l2) {
+            FindPairTouch(hand, previous, current, grid[k - 1], grid[k], f1, l1, f2, l2, first);
           }
         }
       }
-      previous = current;
     }
-    if (!first) break;
-    touches_.push_back(*first);
-    for (auto [f, l] :
-         {std::pair{first->finger_a, first->link_a}, std::pair{first->finger_b, first->link_b}}) {
-      // Only a finger still moving at the touch is blocked by it.
-      if (first->g < commands_[f] && imposed[f].gob[l] == FingerContacts::kNone) {
-        imposed[f].gob[l] = first->g;
-      }
-    }
-    fingers_ = build();
-    g0 = first->g;
+    previous = current;
   }
-  // Closest approach of every pair of links of different fingers over the closing.
-  for (auto& a : closest_) {
+  return first;
+}
+
+// Blocks both touching links at the touch, each only if its finger is still moving there and
+// the link is not blocked already.
+void BlockTouchingLinks(const Hand::FingerTouch& touch, const std::array<double, 3>& commands,
+                        std::array<FingerContacts, 3>& imposed) {
+  for (auto [f, l] :
+       {std::pair{touch.finger_a, touch.link_a}, std::pair{touch.finger_b, touch.link_b}}) {
+    if (touch.g < commands[f] && imposed[f].gob[l] == FingerContacts::kNone) {
+      imposed[f].gob[l] = touch.g;
+    }
+  }
+}
+
+// The closest approach of every pair of links of different fingers over the closing, sampled
+// every 0.25 counts.
+ClosestLinks ClosestApproaches(const Hand& hand) {
+  ClosestLinks closest;
+  for (auto& a : closest) {
     for (auto& b : a) {
       for (auto& c : b) c.fill(std::numeric_limits<double>::infinity());
     }
   }
   for (double g = 0.0; g <= 255.0; g += 0.25) {
-    std::array<std::array<Eigen::Vector3d, 4>, 3> p;
-    for (int f = 0; f < 3; ++f) p[f] = Points(f, At(f, g).theta);
+    const HandLinks p = LinksAt(hand, g);
     for (int f1 = 0; f1 < 3; ++f1) {
       for (int l1 = 0; l1 < 3; ++l1) {
         for (int f2 = 0; f2 < 3; ++f2) {
           for (int l2 = 0; l2 < 3; ++l2) {
             if (f1 == f2) continue;
-            double& d = closest_[f1][l1][f2][l2];
+            double& d = closest[f1][l1][f2][l2];
             d = std::min(d, SegmentDistance3(p[f1][l1], p[f1][l1 + 1], p[f2][l2], p[f2][l2 + 1]));
           }
         }
       }
     }
   }
+  return closest;
+}
+
+}  // namespace
+
+Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double, 3>& commands,
+           const HandLayout& layout)
+    : objects_(std::move(objects)), layout_(layout), commands_(commands) {
+  ValidateMotors(spread, commands);
+  phi_ = layout.phi_min + (layout.phi_max - layout.phi_min) * spread / 255.0;
+  std::array<FingerContacts, 3> imposed;
+  fingers_ = BuildFingers(*this, imposed);
+  // Sweep g for touches between fingers: each blocks both links, and the fingers are rebuilt.
+  double g0 = 0.0;
+  for (int round = 0; round < 18; ++round) {
+    const std::optional<FingerTouch> first = FirstTouch(*this, g0);
+    if (!first) break;
+    touches_.push_back(*first);
+    BlockTouchingLinks(*first, commands_, imposed);
+    fingers_ = BuildFingers(*this, imposed);
+    g0 = first->g;
+  }
+  closest_ = ClosestApproaches(*this);
 }
 
 FingerConfiguration Hand::At(int f, double g) const {

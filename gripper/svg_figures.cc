@@ -2,66 +2,54 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
-#include "automaton/expression.h"
+#include "plotting/svg_plot.h"
 
 namespace hybrid::gripper {
 namespace {
 
+using plotting::AttributePlacement;
+using plotting::LegendEntry;
+using plotting::LegendKey;
+using plotting::LegendLayout;
+using plotting::NumberStyle;
+using plotting::SvgPlot;
+
 // Colours of links 1..3 (and of theta1..3 in the angle plot).
 constexpr std::array<const char*, 3> kLinkColours = {"#1f77b4", "#d95f02", "#2ca02c"};
 
-// A pixel coordinate with two decimals; "-0.00" is printed as "0.00".
-std::string Px(double value) {
-  char buffer[64];
-  auto [end, ec] =
-      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::fixed, 2);
-  if (ec != std::errc()) throw std::logic_error("svg_figures: cannot format a coordinate");
-  std::string out(buffer, end);
-  if (out == "-0.00") out = "0.00";
-  return out;
-}
-
 // A value for a label: rounded to two decimals, printed shortest ("110", "62.5").
-std::string Label(double value) { return FormatNumber(std::round(value * 100.0) / 100.0 + 0.0); }
+std::string Label(double value) { return plotting::FormatRounded(value, 2); }
 
-std::string Escape(std::string_view text) { return XmlEscape(text); }
+// Text content escaped for XML (quotes need no escaping there).
+std::string Escape(std::string_view text) { return plotting::XmlEscape(text); }
 
-void OpenSvg(std::ostringstream& out, double width, double height, const std::string& title) {
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Px(width) << "\" height=\""
-      << Px(height) << "\" viewBox=\"0 0 " << Px(width) << ' ' << Px(height)
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-      << "<title>" << Escape(title) << "</title>\n"
-      << "<rect width=\"" << Px(width) << "\" height=\"" << Px(height) << "\" fill=\"white\"/>\n";
+// A figure: pixel coordinates with two decimals, presentation attributes before the geometry;
+// the root element, the document's <title> and a white page.
+SvgPlot OpenSvg(double width, double height, const std::string& title) {
+  SvgPlot svg(NumberStyle::kFixed2, AttributePlacement::kBeforeGeometry);
+  svg.Start("svg")
+      .Attribute("xmlns", "http://www.w3.org/2000/svg")
+      .Attribute("width", width)
+      .Attribute("height", height)
+      .Attribute("viewBox", "0 0 " + svg.Number(width) + ' ' + svg.Number(height))
+      .Attribute("font-family", "sans-serif")
+      .Attribute("font-size", "12")
+      .EndStart();
+  svg.Start("title").Content("title", Escape(title));
+  svg.Start("rect")
+      .Attribute("width", width)
+      .Attribute("height", height)
+      .Attribute("fill", "white")
+      .EndEmpty();
+  return svg;
 }
 
-void Line(std::ostringstream& out, const std::string& attributes, double x1, double y1, double x2,
-          double y2) {
-  out << "<line " << attributes << " x1=\"" << Px(x1) << "\" y1=\"" << Px(y1) << "\" x2=\""
-      << Px(x2) << "\" y2=\"" << Px(y2) << "\"/>\n";
-}
-
-void Text(std::ostringstream& out, const std::string& attributes, double x, double y,
-          const std::string& escaped_text) {
-  out << "<text " << attributes << " x=\"" << Px(x) << "\" y=\"" << Px(y) << "\">" << escaped_text
-      << "</text>\n";
-}
-
-// The largest 1, 2 or 5 times a power of ten not above `limit` (> 0).
-double NiceLength(double limit) {
-  const double decade = std::pow(10.0, std::floor(std::log10(limit)));
-  for (double factor : {5.0, 2.0, 1.0}) {
-    if (factor * decade <= limit) return factor * decade;
-  }
-  return decade;
-}
-
+// The length of a scale bar in m, cm or mm.
 std::string LengthLabel(double metres) {
   if (metres >= 1.0) return Label(metres) + " m";
   if (metres >= 0.01) return Label(metres * 100.0) + " cm";
@@ -76,6 +64,8 @@ constexpr double kMinWidth = 400.0;
 constexpr double kLinkWidth = 6.0, kJointRadius = 3.5;
 // Space (metres) around everything a panel shows.
 constexpr double kWorldMargin = 0.01;
+// The footer's legend starts this far right of the page margin (after the scale bar).
+constexpr double kKeyIndent = 150.0;
 
 // An axis-aligned window in metres, grown to include points and objects.
 struct Window {
@@ -136,149 +126,184 @@ std::string AtG(const std::string& prefix, const std::vector<double>& gs) {
 
 void RequireFinite(const std::string& function, double g, bool theta_finite) {
   if (!std::isfinite(g) || !theta_finite) {
-    throw std::invalid_argument(function + ": frame at g = " + FormatNumber(g) +
+    throw std::invalid_argument(function + ": frame at g = " + plotting::FormatShortest(g) +
                                 " has a value that is not finite");
   }
 }
 
-void OpenGroup(std::ostringstream& out, const std::string& class_name, double left, double top) {
-  out << "<g class=\"" << class_name << "\" transform=\"translate(" << Px(left) << ',' << Px(top)
-      << ")\">\n";
+// The page's title in large type at the top left.
+void PageTitle(SvgPlot& svg, const std::string& markup) {
+  svg.TextMarkup(kMargin, kMargin + 12, markup, "class=\"title\" font-size=\"15\"");
 }
 
-void FrameRect(std::ostringstream& out, double width, double height) {
-  out << "<rect class=\"frame\" width=\"" << Px(width) << "\" height=\"" << Px(height)
-      << "\" fill=\"none\" stroke=\"#cccccc\"/>\n";
+// Opens a group of the given class moved to (left, top); close it with svg.EndGroup().
+void OpenGroup(SvgPlot& svg, const std::string& class_name, double left, double top) {
+  svg.Group("class=\"" + class_name + "\" transform=\"translate(" + svg.Number(left) + ',' +
+            svg.Number(top) + ")\"");
 }
 
-void PalmRect(std::ostringstream& out, double x, double y, double width, double height) {
-  out << "<rect class=\"palm\" x=\"" << Px(x) << "\" y=\"" << Px(y) << "\" width=\"" << Px(width)
-      << "\" height=\"" << Px(height) << "\" fill=\"#bbbbbb\" stroke=\"#777777\"/>\n";
+void FrameRect(SvgPlot& svg, double width, double height) {
+  svg.Start("rect")
+      .Attributes("class=\"frame\"")
+      .Attribute("width", width)
+      .Attribute("height", height)
+      .Attributes("fill=\"none\" stroke=\"#cccccc\"")
+      .EndEmpty();
+}
+
+void PalmRect(SvgPlot& svg, double x, double y, double width, double height) {
+  svg.Start("rect")
+      .Attributes("class=\"palm\"")
+      .Attribute("x", x)
+      .Attribute("y", y)
+      .Attribute("width", width)
+      .Attribute("height", height)
+      .Attributes("fill=\"#bbbbbb\" stroke=\"#777777\"")
+      .EndEmpty();
 }
 
 // Objects in the x-y plane: a circle as <circle>, a bar as a thick round-capped <line> (exactly
 // its capsule).
-void Objects(std::ostringstream& out, const View& view, const std::vector<Obstacle>& objects) {
+void Objects(SvgPlot& svg, const View& view, const std::vector<Obstacle>& objects) {
   for (const Obstacle& object : objects) {
     if (object.is_circle()) {
-      out << "<circle class=\"object\" cx=\"" << Px(view.X(object.a().x())) << "\" cy=\""
-          << Px(view.Y(object.a().y())) << "\" r=\"" << Px(object.radius() * view.scale)
-          << "\" fill=\"#e6a0a0\" stroke=\"#a03030\"/>\n";
+      svg.Start("circle")
+          .Attributes("class=\"object\"")
+          .Attribute("cx", view.X(object.a().x()))
+          .Attribute("cy", view.Y(object.a().y()))
+          .Attribute("r", object.radius() * view.scale)
+          .Attributes("fill=\"#e6a0a0\" stroke=\"#a03030\"")
+          .EndEmpty();
     } else {
-      Line(out,
-           "class=\"object\" stroke=\"#e6a0a0\" stroke-linecap=\"round\" stroke-width=\"" +
-               Px(2 * object.radius() * view.scale) + "\"",
-           view.X(object.a().x()), view.Y(object.a().y()), view.X(object.b().x()),
-           view.Y(object.b().y()));
+      svg.Line(view.X(object.a().x()), view.Y(object.a().y()), view.X(object.b().x()),
+               view.Y(object.b().y()),
+               "class=\"object\" stroke=\"#e6a0a0\" stroke-linecap=\"round\" stroke-width=\"" +
+                   svg.Number(2 * object.radius() * view.scale) + "\"");
     }
   }
 }
 
-void Joint(std::ostringstream& out, double x, double y, double radius) {
-  out << "<circle class=\"joint\" cx=\"" << Px(x) << "\" cy=\"" << Px(y) << "\" r=\"" << Px(radius)
-      << "\" fill=\"white\" stroke=\"black\"/>\n";
+void Joint(SvgPlot& svg, double x, double y, double radius) {
+  svg.Start("circle")
+      .Attributes("class=\"joint\"")
+      .Attribute("cx", x)
+      .Attribute("cy", y)
+      .Attribute("r", radius)
+      .Attributes("fill=\"white\" stroke=\"black\"")
+      .EndEmpty();
 }
 
 // A bar of a round length (metres) about 80 pixels long at the left of the footer.
-void ScaleBar(std::ostringstream& out, double y, double scale) {
-  const double bar = NiceLength(80.0 / scale);
-  Line(out, "class=\"scale\" stroke=\"black\" stroke-width=\"2\"", kMargin, y,
-       kMargin + bar * scale, y);
-  Text(out, "class=\"scale\"", kMargin + bar * scale + 6, y + 4, LengthLabel(bar));
+void ScaleBar(SvgPlot& svg, double y, double scale) {
+  const double bar = plotting::NiceLengthAtMost(80.0 / scale);
+  svg.Line(kMargin, y, kMargin + bar * scale, y,
+           "class=\"scale\" stroke=\"black\" stroke-width=\"2\"");
+  svg.TextMarkup(kMargin + bar * scale + 6, y + 4, LengthLabel(bar), "class=\"scale\"");
 }
 
-}  // namespace
+// The footer of the small multiples: the scale bar and a legend of line keys side by side,
+// `spacing` pixels apart.
+void Footer(SvgPlot& svg, const PanelGrid& grid, double scale, const std::vector<LegendEntry>& keys,
+            double spacing) {
+  const double footer_y = grid.FooterY();
+  svg.Group("class=\"footer\"");
+  ScaleBar(svg, footer_y, scale);
+  LegendLayout layout;
+  layout.key_length = 20.0;
+  layout.label_offset = 28.0;
+  layout.label_drop = 4.0;
+  layout.spacing = spacing;
+  layout.per_character = 0.0;
+  layout.label_attributes = "class=\"key\"";
+  svg.Legend(kMargin + kKeyIndent, footer_y, keys, layout);
+  svg.EndGroup();
+}
 
-std::string FingerDrawingSvg(const FingerGeometry& geometry, const std::vector<Obstacle>& objects,
-                             const std::vector<std::pair<double, FingerConfiguration>>& frames) {
-  if (frames.empty()) throw std::invalid_argument("FingerDrawingSvg: no frames to draw");
-  for (const auto& [g, configuration] : frames) {
-    RequireFinite("FingerDrawingSvg", g, configuration.theta.allFinite());
-  }
+// The finger drawing (FingerDrawingSvg).
 
-  // The common window (metres): every frame's joints, every object and the palm's top.
-  const double palm_y = geometry.palm_y();
+// Every panel's window, at the same scale: every frame's joints (`points`), every object and the
+// palm's top, plus kWorldMargin, its longer side kPanelPixels.
+View FingerView(double palm_y, const std::vector<std::array<Eigen::Vector2d, 4>>& points,
+                const std::vector<Obstacle>& objects) {
   Window window(0.0, palm_y);
-  std::vector<std::array<Eigen::Vector2d, 4>> points;
-  std::vector<double> gs;
-  for (const auto& [g, configuration] : frames) {
-    gs.push_back(g);
-    points.push_back(geometry.Points(configuration.theta));
-    for (const Eigen::Vector2d& p : points.back()) window.Include(p.x(), p.y());
+  for (const auto& frame_points : points) {
+    for (const Eigen::Vector2d& p : frame_points) window.Include(p.x(), p.y());
   }
   for (const Obstacle& object : objects) window.Include(object);
   window.Grow(kWorldMargin);
-  const View view{
-      window, kPanelPixels / std::max(window.x_max - window.x_min, window.y_max - window.y_min)};
-  const double drawing_height = view.height();
-  const int n = static_cast<int>(frames.size());
-  const PanelGrid grid(n, view.width(), drawing_height + kCaption);
-
-  std::ostringstream out;
-  OpenSvg(out, grid.width, grid.height, AtG("Finger configurations", gs));
-  Text(out, "class=\"title\" font-size=\"15\"", kMargin, kMargin + 12, "Finger configurations");
-
-  for (int i = 0; i < n; ++i) {
-    const auto& [g, configuration] = frames[i];
-    OpenGroup(out, "panel", grid.Left(i), grid.Top(i));
-    FrameRect(out, grid.panel_width, drawing_height);
-    PalmRect(out, 0.0, view.Y(palm_y), grid.panel_width, drawing_height - view.Y(palm_y));
-    Objects(out, view, objects);
-    const auto& p = points[i];
-    for (int k = 0; k < 3; ++k) {
-      Line(out,
-           "class=\"link l" + std::to_string(k + 1) + "\" stroke=\"" + kLinkColours[k] +
-               "\" stroke-width=\"" + Px(kLinkWidth) + "\" stroke-linecap=\"round\"",
-           view.X(p[k].x()), view.Y(p[k].y()), view.X(p[k + 1].x()), view.Y(p[k + 1].y()));
-    }
-    for (int k = 0; k < 3; ++k) Joint(out, view.X(p[k].x()), view.Y(p[k].y()), kJointRadius);
-    Text(out, "class=\"caption\" text-anchor=\"middle\"", grid.panel_width / 2, drawing_height + 17,
-         "g = " + Label(g) + ", phase " + Escape(PhaseName(configuration.phase)));
-    out << "</g>\n";
-  }
-
-  // Footer: a scale bar and the link colours.
-  const double footer_y = grid.FooterY();
-  out << "<g class=\"footer\">\n";
-  ScaleBar(out, footer_y, view.scale);
-  for (int k = 0; k < 3; ++k) {
-    const double x = kMargin + 150 + 80 * k;
-    Line(out,
-         "class=\"key\" stroke=\"" + std::string(kLinkColours[k]) +
-             "\" stroke-width=\"6.00\" stroke-linecap=\"round\"",
-         x, footer_y, x + 20, footer_y);
-    Text(out, "class=\"key\"", x + 28, footer_y + 4, "link " + std::to_string(k + 1));
-  }
-  out << "</g>\n</svg>\n";
-  return out.str();
+  return {window,
+          kPanelPixels / std::max(window.x_max - window.x_min, window.y_max - window.y_min)};
 }
 
-std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frames) {
-  if (frames.empty()) throw std::invalid_argument("HandDrawingSvg: no frames to draw");
-  for (const HandFrame& frame : frames) {
-    bool finite = true;
-    for (const FingerConfiguration& finger : frame.fingers) finite &= finger.theta.allFinite();
-    RequireFinite("HandDrawingSvg", frame.g, finite);
+// Panel i, showing `frame` (g, configuration) with joint points `p`: frame, palm, objects, the
+// three links and their joints, the caption.
+void DrawFingerPanel(SvgPlot& svg, const PanelGrid& grid, const View& view, double palm_y,
+                     const std::vector<Obstacle>& objects, int i,
+                     const std::array<Eigen::Vector2d, 4>& p,
+                     const std::pair<double, FingerConfiguration>& frame) {
+  const auto& [g, configuration] = frame;
+  const double drawing_height = view.height();
+  OpenGroup(svg, "panel", grid.Left(i), grid.Top(i));
+  FrameRect(svg, grid.panel_width, drawing_height);
+  PalmRect(svg, 0.0, view.Y(palm_y), grid.panel_width, drawing_height - view.Y(palm_y));
+  Objects(svg, view, objects);
+  for (int k = 0; k < 3; ++k) {
+    svg.Line(view.X(p[k].x()), view.Y(p[k].y()), view.X(p[k + 1].x()), view.Y(p[k + 1].y()),
+             "class=\"link l" + std::to_string(k + 1) + "\" stroke=\"" + kLinkColours[k] +
+                 "\" stroke-width=\"" + svg.Number(kLinkWidth) + "\" stroke-linecap=\"round\"");
   }
+  for (int k = 0; k < 3; ++k) Joint(svg, view.X(p[k].x()), view.Y(p[k].y()), kJointRadius);
+  svg.TextMarkup(grid.panel_width / 2, drawing_height + 17,
+                 "g = " + Label(g) + ", phase " + Escape(PhaseName(configuration.phase)),
+                 "class=\"caption\" text-anchor=\"middle\"");
+  svg.EndGroup();
+}
 
-  // The palm spans the finger bases (joint 1 does not move) with this margin, in x and z.
-  constexpr double kPalmMargin = 0.02;
-  constexpr std::array<const char*, 3> kFingerNames = {"A", "B", "C"};
-  constexpr std::array<const char*, 3> kFingerColours = {"#1b9e77", "#7570b3", "#e7298a"};
-  constexpr double kStripGap = 14.0;  // between the side view and the view from above
-  constexpr double kPhases = 14.0;    // the phases line under the caption
-  constexpr double kKeySpacing = 90.0, kHandMinWidth = 460.0;  // room for the legend
-  // Finger C is thinner and dashed, so finger B shows where the two coincide.
-  std::array<std::string, 3> finger_styles;
+// The footer's keys of links 1 to 3 in their colours.
+std::vector<LegendEntry> LinkKeys() {
+  std::vector<LegendEntry> keys;
+  for (int k = 0; k < 3; ++k) {
+    keys.push_back({LegendKey::kLine,
+                    "class=\"key\" stroke=\"" + std::string(kLinkColours[k]) +
+                        "\" stroke-width=\"" + plotting::FormatFixed(kLinkWidth, 2) +
+                        "\" stroke-linecap=\"round\"",
+                    "link " + std::to_string(k + 1)});
+  }
+  return keys;
+}
+
+// The hand drawing (HandDrawingSvg).
+
+constexpr std::array<const char*, 3> kFingerNames = {"A", "B", "C"};
+constexpr std::array<const char*, 3> kFingerColours = {"#1b9e77", "#7570b3", "#e7298a"};
+constexpr std::array<double, 3> kFingerJointRadii = {kJointRadius, kJointRadius, 2.0};
+// The palm spans the finger bases (joint 1 does not move) with this margin, in x and z.
+constexpr double kPalmMargin = 0.02;
+constexpr double kStripGap = 14.0;  // between the side view and the view from above
+constexpr double kPhases = 14.0;    // the phases line under the caption
+constexpr double kKeySpacing = 90.0, kHandMinWidth = 460.0;  // room for the legend
+
+// Joints 1 to 3 and the fingertip of fingers A, B and C in space (Hand::Points).
+using HandPoints = std::array<std::array<Eigen::Vector3d, 4>, 3>;
+
+// Presentation attributes of each finger's links: its colour; finger C thinner and dashed, so
+// finger B shows where the two coincide.
+std::array<std::string, 3> FingerStyles() {
+  std::array<std::string, 3> styles;
   for (int f = 0; f < 3; ++f) {
-    finger_styles[f] = std::string("stroke=\"") + kFingerColours[f] + "\" stroke-width=\"" +
-                       Px(f == 2 ? kLinkWidth / 2 : kLinkWidth) + "\" stroke-linecap=\"round\"" +
-                       (f == 2 ? " stroke-dasharray=\"4 6\"" : "");
+    styles[f] = std::string("stroke=\"") + kFingerColours[f] + "\" stroke-width=\"" +
+                plotting::FormatFixed(f == 2 ? kLinkWidth / 2 : kLinkWidth, 2) +
+                "\" stroke-linecap=\"round\"" + (f == 2 ? " stroke-dasharray=\"4 6\"" : "");
   }
-  const std::array<double, 3> joint_radii = {kJointRadius, kJointRadius, 2.0};
+  return styles;
+}
 
-  // Palm extent from the finger bases.
-  const double palm_y = hand.finger(0).geometry().palm_y();
+// The palm's top (y) and its extent in x and z: the finger bases plus kPalmMargin.
+struct Palm {
+  double y, x0, x1, z0, z1;
+};
+
+Palm PalmOf(const Hand& hand) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   double base_x_min = kInfinity, base_x_max = -kInfinity;
   double base_z_min = kInfinity, base_z_max = -kInfinity;
@@ -289,21 +314,31 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
     base_z_min = std::min(base_z_min, base.z());
     base_z_max = std::max(base_z_max, base.z());
   }
-  const double palm_x0 = base_x_min - kPalmMargin, palm_x1 = base_x_max + kPalmMargin;
-  const double palm_z0 = base_z_min - kPalmMargin, palm_z1 = base_z_max + kPalmMargin;
+  return {hand.finger(0).geometry().palm_y(), base_x_min - kPalmMargin, base_x_max + kPalmMargin,
+          base_z_min - kPalmMargin, base_z_max + kPalmMargin};
+}
 
-  // The common windows (metres): side (x, y) and from above (x, z; "y" of the window is z).
-  Window side(palm_x0, palm_y), above(palm_x0, palm_z0);
-  side.Include(palm_x1, palm_y);
-  above.Include(palm_x1, palm_z1);
-  std::vector<std::array<std::array<Eigen::Vector3d, 4>, 3>> points;
-  std::vector<double> gs;
-  for (const HandFrame& frame : frames) {
-    gs.push_back(frame.g);
-    auto& frame_points = points.emplace_back();
-    for (int f = 0; f < 3; ++f) {
-      frame_points[f] = hand.Points(f, frame.fingers[f].theta);
-      for (const Eigen::Vector3d& p : frame_points[f]) {
+// What every panel of the hand drawing shares: the palm, the side view (x, y) and the view from
+// above (x, z; its window's "y" is z), at the same scale and with the same x window, and where
+// the view from above and the captions start in a panel.
+struct HandFigure {
+  // From above (from +y) with x to the right, z points down the page.
+  double Z(double z) const { return (z - above.window.y_min) * above.scale; }
+  Palm palm;
+  View side, above;
+  double above_top, caption_top;
+};
+
+// The common windows: the palm, all frames' joints and fingertips and (side view) all objects,
+// plus kWorldMargin; the side view's longer side is kPanelPixels.
+HandFigure LayOutHand(const Hand& hand, const std::vector<HandPoints>& points) {
+  const Palm palm = PalmOf(hand);
+  Window side(palm.x0, palm.y), above(palm.x0, palm.z0);
+  side.Include(palm.x1, palm.y);
+  above.Include(palm.x1, palm.z1);
+  for (const HandPoints& frame_points : points) {
+    for (const auto& finger_points : frame_points) {
+      for (const Eigen::Vector3d& p : finger_points) {
         side.Include(p.x(), p.y());
         above.Include(p.x(), p.z());
       }
@@ -316,93 +351,121 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
   above.x_max = side.x_max;
   const double scale = kPanelPixels / std::max(side.x_max - side.x_min, side.y_max - side.y_min);
   const View side_view{side, scale}, above_view{above, scale};
-  // From above (from +y) with x to the right, z points down the page.
-  auto Z = [&](double z) { return (z - above.y_min) * scale; };
-  const double side_height = side_view.height(), above_height = above_view.height();
-  const double above_top = side_height + kStripGap;
-  const double caption_top = above_top + above_height;
-  const int n = static_cast<int>(frames.size());
-  const PanelGrid grid(n, side_view.width(), caption_top + kCaption + kPhases, kHandMinWidth);
-
-  const std::string spread = "spread angle " + Label(hand.spread_angle()) + " deg";
-  std::ostringstream out;
-  OpenSvg(out, grid.width, grid.height, AtG("Hand configurations", gs) + " (" + spread + ")");
-  Text(out, "class=\"title\" font-size=\"15\"", kMargin, kMargin + 12,
-       "Hand configurations (" + spread + ")");
-
-  for (int i = 0; i < n; ++i) {
-    const HandFrame& frame = frames[i];
-    const auto& p = points[i];
-    OpenGroup(out, "panel", grid.Left(i), grid.Top(i));
-    // Side view.
-    FrameRect(out, grid.panel_width, side_height);
-    PalmRect(out, side_view.X(palm_x0), side_view.Y(palm_y), (palm_x1 - palm_x0) * scale,
-             side_height - side_view.Y(palm_y));
-    Objects(out, side_view, hand.objects());
-    for (int f = 0; f < 3; ++f) {
-      out << "<g class=\"finger " << kFingerNames[f] << "\" " << finger_styles[f] << ">\n";
-      for (int k = 0; k < 3; ++k) {
-        Line(out, "class=\"link l" + std::to_string(k + 1) + "\"", side_view.X(p[f][k].x()),
-             side_view.Y(p[f][k].y()), side_view.X(p[f][k + 1].x()), side_view.Y(p[f][k + 1].y()));
-      }
-      out << "</g>\n";
-    }
-    for (int f = 0; f < 3; ++f) {
-      for (int k = 0; k < 3; ++k) {
-        Joint(out, side_view.X(p[f][k].x()), side_view.Y(p[f][k].y()), joint_radii[f]);
-      }
-    }
-    // From above: objects are extruded along z, so they cross the whole strip.
-    OpenGroup(out, "top-view", 0.0, above_top);
-    FrameRect(out, grid.panel_width, above_height);
-    PalmRect(out, side_view.X(palm_x0), Z(palm_z0), (palm_x1 - palm_x0) * scale,
-             (palm_z1 - palm_z0) * scale);
-    for (const Obstacle& object : hand.objects()) {
-      const double x0 = std::min(object.a().x(), object.b().x()) - object.radius();
-      const double x1 = std::max(object.a().x(), object.b().x()) + object.radius();
-      out << "<rect class=\"object\" x=\"" << Px(side_view.X(x0)) << "\" y=\"0.00\" width=\""
-          << Px((x1 - x0) * scale) << "\" height=\"" << Px(above_height)
-          << "\" fill=\"#e6a0a0\" fill-opacity=\"0.6\" stroke=\"#a03030\"/>\n";
-    }
-    for (int f = 0; f < 3; ++f) {
-      out << "<g class=\"finger " << kFingerNames[f] << "\" " << finger_styles[f] << ">\n";
-      for (int k = 0; k < 3; ++k) {
-        Line(out, "class=\"top l" + std::to_string(k + 1) + "\"", side_view.X(p[f][k].x()),
-             Z(p[f][k].z()), side_view.X(p[f][k + 1].x()), Z(p[f][k + 1].z()));
-      }
-      out << "</g>\n";
-    }
-    Text(out, "class=\"view\" font-size=\"9\" fill=\"#555555\"", 2, -3, "from above");
-    out << "</g>\n";
-    Text(out, "class=\"caption\" text-anchor=\"middle\"", grid.panel_width / 2, caption_top + 17,
-         "g = " + Label(frame.g));
-    std::string phases;
-    for (int f = 0; f < 3; ++f) {
-      phases += std::string(f == 0 ? "" : ", ") + kFingerNames[f] + " " +
-                Escape(PhaseName(frame.fingers[f].phase));
-    }
-    Text(out, "class=\"phases\" text-anchor=\"middle\" font-size=\"10\" fill=\"#555555\"",
-         grid.panel_width / 2, caption_top + 17 + kPhases, "phases " + phases);
-    out << "</g>\n";
-  }
-
-  // Footer: a scale bar and the fingers.
-  const double footer_y = grid.FooterY();
-  out << "<g class=\"footer\">\n";
-  ScaleBar(out, footer_y, scale);
-  for (int f = 0; f < 3; ++f) {
-    const double x = kMargin + 150 + kKeySpacing * f;
-    Line(out, "class=\"key\" " + finger_styles[f], x, footer_y, x + 20, footer_y);
-    Text(out, "class=\"key\"", x + 28, footer_y + 4, std::string("finger ") + kFingerNames[f]);
-  }
-  out << "</g>\n</svg>\n";
-  return out.str();
+  const double above_top = side_view.height() + kStripGap;
+  return {palm, side_view, above_view, above_top, above_top + above_view.height()};
 }
 
-std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title) {
-  const double g_max = closed_form.parameters().motor_max;
+// One group per finger holding its three links, from point k to k + 1 of `p` mapped by `to_pixels`,
+// each <line class="<prefix><k>">.
+template <class ToPixels>
+void FingerLinks(SvgPlot& svg, const HandPoints& p, const std::array<std::string, 3>& styles,
+                 const std::string& prefix, ToPixels to_pixels) {
+  for (int f = 0; f < 3; ++f) {
+    svg.Group("class=\"finger " + std::string(kFingerNames[f]) + "\" " + styles[f]);
+    for (int k = 0; k < 3; ++k) {
+      const auto [x1, y1] = to_pixels(p[f][k]);
+      const auto [x2, y2] = to_pixels(p[f][k + 1]);
+      svg.Line(x1, y1, x2, y2, "class=\"" + prefix + std::to_string(k + 1) + "\"");
+    }
+    svg.EndGroup();
+  }
+}
 
-  // Samples: multiples of 0.5 counts, the end of the range and every breakpoint.
+// A panel's side view: frame, palm, objects, every finger's links and joints.
+void DrawSideView(SvgPlot& svg, const Hand& hand, const HandFigure& figure, double panel_width,
+                  const HandPoints& p, const std::array<std::string, 3>& styles) {
+  const View& side = figure.side;
+  const Palm& palm = figure.palm;
+  FrameRect(svg, panel_width, side.height());
+  PalmRect(svg, side.X(palm.x0), side.Y(palm.y), (palm.x1 - palm.x0) * side.scale,
+           side.height() - side.Y(palm.y));
+  Objects(svg, side, hand.objects());
+  FingerLinks(svg, p, styles, "link l",
+              [&](const Eigen::Vector3d& q) { return std::pair(side.X(q.x()), side.Y(q.y())); });
+  for (int f = 0; f < 3; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      Joint(svg, side.X(p[f][k].x()), side.Y(p[f][k].y()), kFingerJointRadii[f]);
+    }
+  }
+}
+
+// A panel's view from above: frame, palm, the objects as bands across the strip (they are
+// extruded along z) and every finger's links.
+void DrawViewFromAbove(SvgPlot& svg, const Hand& hand, const HandFigure& figure, double panel_width,
+                       const HandPoints& p, const std::array<std::string, 3>& styles) {
+  const View& side = figure.side;
+  const Palm& palm = figure.palm;
+  const double scale = side.scale, height = figure.above.height();
+  OpenGroup(svg, "top-view", 0.0, figure.above_top);
+  FrameRect(svg, panel_width, height);
+  PalmRect(svg, side.X(palm.x0), figure.Z(palm.z0), (palm.x1 - palm.x0) * scale,
+           (palm.z1 - palm.z0) * scale);
+  for (const Obstacle& object : hand.objects()) {
+    const double x0 = std::min(object.a().x(), object.b().x()) - object.radius();
+    const double x1 = std::max(object.a().x(), object.b().x()) + object.radius();
+    svg.Start("rect")
+        .Attributes("class=\"object\"")
+        .Attribute("x", side.X(x0))
+        .Attribute("y", 0.0)
+        .Attribute("width", (x1 - x0) * scale)
+        .Attribute("height", height)
+        .Attributes("fill=\"#e6a0a0\" fill-opacity=\"0.6\" stroke=\"#a03030\"")
+        .EndEmpty();
+  }
+  FingerLinks(svg, p, styles, "top l",
+              [&](const Eigen::Vector3d& q) { return std::pair(side.X(q.x()), figure.Z(q.z())); });
+  svg.TextMarkup(2, -3, "from above", "class=\"view\" font-size=\"9\" fill=\"#555555\"");
+  svg.EndGroup();
+}
+
+// A panel's caption "g = <g>" and, smaller, the fingers' phases.
+void DrawHandCaption(SvgPlot& svg, const HandFrame& frame, double panel_width, double caption_top) {
+  svg.TextMarkup(panel_width / 2, caption_top + 17, "g = " + Label(frame.g),
+                 "class=\"caption\" text-anchor=\"middle\"");
+  std::string phases;
+  for (int f = 0; f < 3; ++f) {
+    phases += std::string(f == 0 ? "" : ", ") + kFingerNames[f] + " " +
+              Escape(PhaseName(frame.fingers[f].phase));
+  }
+  svg.TextMarkup(panel_width / 2, caption_top + 17 + kPhases, "phases " + phases,
+                 "class=\"phases\" text-anchor=\"middle\" font-size=\"10\" fill=\"#555555\"");
+}
+
+// The footer's keys of fingers A, B and C in their styles.
+std::vector<LegendEntry> FingerKeys(const std::array<std::string, 3>& styles) {
+  std::vector<LegendEntry> keys;
+  for (int f = 0; f < 3; ++f) {
+    keys.push_back(
+        {LegendKey::kLine, "class=\"key\" " + styles[f], std::string("finger ") + kFingerNames[f]});
+  }
+  return keys;
+}
+
+// The angle plot (AnglePlotSvg), in pixels: page, plot area, gridline steps.
+constexpr double kPlotPageWidth = 640.0, kPlotPageHeight = 420.0;
+constexpr double kPlotLeft = 64.0, kPlotRight = 130.0, kPlotTop = 48.0, kPlotBottom = 56.0;
+constexpr double kPlotWidth = kPlotPageWidth - kPlotLeft - kPlotRight;
+constexpr double kPlotHeight = kPlotPageHeight - kPlotTop - kPlotBottom;
+constexpr double kGStep = 50.0, kThetaStep = 20.0;
+// No limit on the number of gridlines (the motor range and angle range bound them).
+constexpr int kAllTicks = std::numeric_limits<int>::max();
+
+// The angles sampled for the curves, the angle range shown and the pixel mapping.
+struct AngleCurves {
+  double X(double g) const { return kPlotLeft + g / g_max * kPlotWidth; }
+  double Y(double theta) const { return kPlotTop + (hi - theta) / (hi - lo) * kPlotHeight; }
+  double g_max;
+  std::vector<double> samples;
+  std::vector<Eigen::Vector3d> thetas;
+  // [-60, 100] degrees, widened by multiples of kThetaStep to hold every angle.
+  double lo = -60.0, hi = 100.0;
+};
+
+// Samples: multiples of 0.5 counts, the end of the range and every breakpoint, sorted, without
+// samples within 1e-9 counts of an earlier one; the angles there and their range.
+AngleCurves SampleAngles(const FingerClosedForm& closed_form) {
+  AngleCurves curves;
+  const double g_max = curves.g_max = closed_form.parameters().motor_max;
   std::vector<double> gs;
   for (int k = 0; k * 0.5 <= g_max; ++k) gs.push_back(k * 0.5);
   gs.push_back(g_max);
@@ -410,117 +473,174 @@ std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string&
     for (double g : {piece.g0, piece.g1}) gs.push_back(std::clamp(g, 0.0, g_max));
   }
   std::sort(gs.begin(), gs.end());
-  std::vector<double> samples;
   for (double g : gs) {
-    if (samples.empty() || g - samples.back() > 1e-9) samples.push_back(g);
+    if (curves.samples.empty() || g - curves.samples.back() > 1e-9) curves.samples.push_back(g);
   }
-  std::vector<Eigen::Vector3d> thetas;
-  double lo = -60.0, hi = 100.0;
-  for (double g : samples) {
-    thetas.push_back(closed_form.At(g).theta);
-    lo = std::min(lo, 20.0 * std::floor(thetas.back().minCoeff() / 20.0));
-    hi = std::max(hi, 20.0 * std::ceil(thetas.back().maxCoeff() / 20.0));
+  for (double g : curves.samples) {
+    curves.thetas.push_back(closed_form.At(g).theta);
+    curves.lo =
+        std::min(curves.lo, kThetaStep * std::floor(curves.thetas.back().minCoeff() / kThetaStep));
+    curves.hi =
+        std::max(curves.hi, kThetaStep * std::ceil(curves.thetas.back().maxCoeff() / kThetaStep));
   }
-
-  // Layout (pixels).
-  constexpr double kWidth = 640.0, kHeight = 420.0;
-  constexpr double kLeft = 64.0, kRight = 130.0, kTop = 48.0, kBottom = 56.0;
-  const double plot_width = kWidth - kLeft - kRight, plot_height = kHeight - kTop - kBottom;
-  auto X = [&](double g) { return kLeft + g / g_max * plot_width; };
-  auto Y = [&](double theta) { return kTop + (hi - theta) / (hi - lo) * plot_height; };
-
-  std::ostringstream out;
-  OpenSvg(out, kWidth, kHeight, title);
-  Text(out, "class=\"title\" font-size=\"15\" text-anchor=\"middle\"", kLeft + plot_width / 2,
-       kTop - 18, Escape(title));
-
-  out << "<g class=\"axes\">\n";
-  for (double g = 0.0; g <= g_max; g += 50.0) {
-    Line(out, "class=\"grid\" data-g=\"" + Label(g) + "\" stroke=\"#dddddd\"", X(g), kTop, X(g),
-         kTop + plot_height);
-    Line(out, "class=\"tick\" stroke=\"black\"", X(g), kTop + plot_height, X(g),
-         kTop + plot_height + 5);
-    Text(out, "class=\"tick\" text-anchor=\"middle\"", X(g), kTop + plot_height + 18, Label(g));
-  }
-  for (double theta = lo; theta <= hi; theta += 20.0) {
-    Line(out,
-         "class=\"grid\" data-theta=\"" + Label(theta) + "\" stroke=\"" +
-             (theta == 0.0 ? "#999999" : "#dddddd") + "\"",
-         kLeft, Y(theta), kLeft + plot_width, Y(theta));
-    Line(out, "class=\"tick\" stroke=\"black\"", kLeft - 5, Y(theta), kLeft, Y(theta));
-    Text(out, "class=\"tick\" text-anchor=\"end\"", kLeft - 8, Y(theta) + 4, Label(theta));
-  }
-  out << "<rect class=\"frame\" x=\"" << Px(kLeft) << "\" y=\"" << Px(kTop) << "\" width=\""
-      << Px(plot_width) << "\" height=\"" << Px(plot_height)
-      << "\" fill=\"none\" stroke=\"black\"/>\n";
-  Text(out, "class=\"axis-label\" text-anchor=\"middle\"", kLeft + plot_width / 2, kHeight - 16,
-       "motor position g (counts)");
-  out << "<text class=\"axis-label\" text-anchor=\"middle\" transform=\"translate(" << Px(18) << ','
-      << Px(kTop + plot_height / 2) << ") rotate(-90)\">joint angle (degrees)</text>\n";
-  out << "</g>\n";
-
-  if (std::isfinite(closed_form.stop())) {
-    const double x = X(closed_form.stop());
-    const bool right_half = closed_form.stop() > g_max / 2;
-    out << "<g class=\"stop\">\n";
-    Line(out, "class=\"stop\" stroke=\"#444444\" stroke-dasharray=\"6 4\"", x, kTop, x,
-         kTop + plot_height);
-    Text(out, std::string("class=\"stop\" text-anchor=\"") + (right_half ? "end" : "start") + "\"",
-         right_half ? x - 4 : x + 4, kTop + 14,
-         "motor stops (g = " + Label(closed_form.stop()) + ")");
-    out << "</g>\n";
-  }
-
-  out << "<g class=\"curves\">\n";
-  for (int k = 0; k < 3; ++k) {
-    out << "<polyline class=\"theta" << k + 1 << "\" fill=\"none\" stroke=\"" << kLinkColours[k]
-        << "\" stroke-width=\"2\" stroke-linejoin=\"round\" points=\"";
-    for (size_t i = 0; i < samples.size(); ++i) {
-      out << (i == 0 ? "" : " ") << Px(X(samples[i])) << ',' << Px(Y(thetas[i][k]));
-    }
-    out << "\"/>\n";
-  }
-  out << "</g>\n";
-
-  out << "<g class=\"legend\">\n";
-  for (int k = 0; k < 3; ++k) {
-    const double x = kLeft + plot_width + 16, y = kTop + 12 + 22 * k;
-    Line(out, "class=\"key\" stroke=\"" + std::string(kLinkColours[k]) + "\" stroke-width=\"2\"", x,
-         y, x + 24, y);
-    Text(out, "class=\"key\"", x + 30, y + 4, "&#952;" + std::to_string(k + 1) + " (deg)");
-  }
-  out << "</g>\n</svg>\n";
-  return out.str();
+  return curves;
 }
 
-std::string XmlEscape(std::string_view text, bool attribute) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += attribute ? "&quot;" : "\"";
-        break;
-      case '\'':
-        out += attribute ? "&apos;" : "'";
-        break;
-      default: {
-        // Control characters other than tab and newline are not allowed in XML 1.0.
-        const bool control = static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n';
-        out += control ? ' ' : c;
-      }
-    }
+// Gridlines with their value (data-g, data-theta), ticks and numbers, the frame and the axis
+// titles.
+void DrawAngleAxes(SvgPlot& svg, const AngleCurves& c) {
+  constexpr double kBottom = kPlotTop + kPlotHeight;
+  svg.Group("class=\"axes\"");
+  for (double g : plotting::Ticks({0.0, c.g_max}, kGStep, kAllTicks)) {
+    svg.Line(c.X(g), kPlotTop, c.X(g), kBottom,
+             "class=\"grid\" data-g=\"" + Label(g) + "\" stroke=\"#dddddd\"");
+    svg.Line(c.X(g), kBottom, c.X(g), kBottom + 5, "class=\"tick\" stroke=\"black\"");
+    svg.TextMarkup(c.X(g), kBottom + 18, Label(g), "class=\"tick\" text-anchor=\"middle\"");
   }
-  return out;
+  for (double theta : plotting::Ticks({c.lo, c.hi}, kThetaStep, kAllTicks)) {
+    svg.Line(kPlotLeft, c.Y(theta), kPlotLeft + kPlotWidth, c.Y(theta),
+             "class=\"grid\" data-theta=\"" + Label(theta) + "\" stroke=\"" +
+                 (theta == 0.0 ? "#999999" : "#dddddd") + "\"");
+    svg.Line(kPlotLeft - 5, c.Y(theta), kPlotLeft, c.Y(theta), "class=\"tick\" stroke=\"black\"");
+    svg.TextMarkup(kPlotLeft - 8, c.Y(theta) + 4, Label(theta),
+                   "class=\"tick\" text-anchor=\"end\"");
+  }
+  svg.Start("rect")
+      .Attributes("class=\"frame\"")
+      .Attribute("x", kPlotLeft)
+      .Attribute("y", kPlotTop)
+      .Attribute("width", kPlotWidth)
+      .Attribute("height", kPlotHeight)
+      .Attributes("fill=\"none\" stroke=\"black\"")
+      .EndEmpty();
+  svg.TextMarkup(kPlotLeft + kPlotWidth / 2, kPlotPageHeight - 16,
+                 plotting::WithUnit("motor position g", "counts"),
+                 "class=\"axis-label\" text-anchor=\"middle\"");
+  svg.Start("text")
+      .Attributes("class=\"axis-label\" text-anchor=\"middle\" transform=\"translate(" +
+                  svg.Number(18) + ',' + svg.Number(kPlotTop + kPlotHeight / 2) + ") rotate(-90)\"")
+      .Content("text", plotting::WithUnit("joint angle", "degrees"));
+  svg.EndGroup();
+}
+
+// A dashed vertical line at the motor's stop, labelled on the side with more room.
+void DrawStopLine(SvgPlot& svg, const AngleCurves& c, double stop) {
+  const double x = c.X(stop);
+  const bool right_half = stop > c.g_max / 2;
+  svg.Group("class=\"stop\"");
+  svg.Line(x, kPlotTop, x, kPlotTop + kPlotHeight,
+           "class=\"stop\" stroke=\"#444444\" stroke-dasharray=\"6 4\"");
+  svg.TextMarkup(
+      right_half ? x - 4 : x + 4, kPlotTop + 14, "motor stops (g = " + Label(stop) + ")",
+      std::string("class=\"stop\" text-anchor=\"") + (right_half ? "end" : "start") + "\"");
+  svg.EndGroup();
+}
+
+// theta1..3 as polylines in the links' colours.
+void DrawAngleCurves(SvgPlot& svg, const AngleCurves& c) {
+  svg.Group("class=\"curves\"");
+  for (int k = 0; k < 3; ++k) {
+    std::vector<plotting::Point> points;
+    for (size_t i = 0; i < c.samples.size(); ++i) {
+      points.push_back({c.X(c.samples[i]), c.Y(c.thetas[i][k])});
+    }
+    svg.Polyline(points, "class=\"theta" + std::to_string(k + 1) + "\" fill=\"none\" stroke=\"" +
+                             kLinkColours[k] + "\" stroke-width=\"2\" stroke-linejoin=\"round\"");
+  }
+  svg.EndGroup();
+}
+
+// theta1..3's keys one under the other, right of the plot.
+void DrawAngleLegend(SvgPlot& svg) {
+  std::vector<LegendEntry> keys;
+  for (int k = 0; k < 3; ++k) {
+    keys.push_back(
+        {LegendKey::kLine,
+         "class=\"key\" stroke=\"" + std::string(kLinkColours[k]) + "\" stroke-width=\"2\"",
+         plotting::WithUnit("&#952;" + std::to_string(k + 1), "deg")});
+  }
+  LegendLayout layout;
+  layout.vertical = true;
+  layout.key_length = 24.0;
+  layout.label_offset = 30.0;
+  layout.label_drop = 4.0;
+  layout.spacing = 22.0;
+  layout.label_attributes = "class=\"key\"";
+  svg.Group("class=\"legend\"");
+  svg.Legend(kPlotLeft + kPlotWidth + 16, kPlotTop + 12, keys, layout);
+  svg.EndGroup();
+}
+
+}  // namespace
+
+std::string FingerDrawingSvg(const FingerGeometry& geometry, const std::vector<Obstacle>& objects,
+                             const std::vector<std::pair<double, FingerConfiguration>>& frames) {
+  if (frames.empty()) throw std::invalid_argument("FingerDrawingSvg: no frames to draw");
+  std::vector<std::array<Eigen::Vector2d, 4>> points;
+  std::vector<double> gs;
+  for (const auto& [g, configuration] : frames) {
+    RequireFinite("FingerDrawingSvg", g, configuration.theta.allFinite());
+    gs.push_back(g);
+    points.push_back(geometry.Points(configuration.theta));
+  }
+  const View view = FingerView(geometry.palm_y(), points, objects);
+  const int n = static_cast<int>(frames.size());
+  const PanelGrid grid(n, view.width(), view.height() + kCaption);
+
+  SvgPlot svg = OpenSvg(grid.width, grid.height, AtG("Finger configurations", gs));
+  PageTitle(svg, "Finger configurations");
+  for (int i = 0; i < n; ++i) {
+    DrawFingerPanel(svg, grid, view, geometry.palm_y(), objects, i, points[i], frames[i]);
+  }
+  Footer(svg, grid, view.scale, LinkKeys(), 80.0);
+  return svg.Finish();
+}
+
+std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frames) {
+  if (frames.empty()) throw std::invalid_argument("HandDrawingSvg: no frames to draw");
+  std::vector<HandPoints> points;
+  std::vector<double> gs;
+  for (const HandFrame& frame : frames) {
+    bool finite = true;
+    for (const FingerConfiguration& finger : frame.fingers) finite &= finger.theta.allFinite();
+    RequireFinite("HandDrawingSvg", frame.g, finite);
+  }
+  for (const HandFrame& frame : frames) {
+    gs.push_back(frame.g);
+    auto& frame_points = points.emplace_back();
+    for (int f = 0; f < 3; ++f) frame_points[f] = hand.Points(f, frame.fingers[f].theta);
+  }
+  const HandFigure figure = LayOutHand(hand, points);
+  const int n = static_cast<int>(frames.size());
+  const PanelGrid grid(n, figure.side.width(), figure.caption_top + kCaption + kPhases,
+                       kHandMinWidth);
+  const std::array<std::string, 3> styles = FingerStyles();
+
+  const std::string spread = "spread angle " + Label(hand.spread_angle()) + " deg";
+  SvgPlot svg =
+      OpenSvg(grid.width, grid.height, AtG("Hand configurations", gs) + " (" + spread + ")");
+  PageTitle(svg, "Hand configurations (" + spread + ")");
+  for (int i = 0; i < n; ++i) {
+    OpenGroup(svg, "panel", grid.Left(i), grid.Top(i));
+    DrawSideView(svg, hand, figure, grid.panel_width, points[i], styles);
+    DrawViewFromAbove(svg, hand, figure, grid.panel_width, points[i], styles);
+    DrawHandCaption(svg, frames[i], grid.panel_width, figure.caption_top);
+    svg.EndGroup();
+  }
+  Footer(svg, grid, figure.side.scale, FingerKeys(styles), kKeySpacing);
+  return svg.Finish();
+}
+
+std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title) {
+  const AngleCurves curves = SampleAngles(closed_form);
+  SvgPlot svg = OpenSvg(kPlotPageWidth, kPlotPageHeight, title);
+  svg.TextMarkup(kPlotLeft + kPlotWidth / 2, kPlotTop - 18, Escape(title),
+                 "class=\"title\" font-size=\"15\" text-anchor=\"middle\"");
+  DrawAngleAxes(svg, curves);
+  if (std::isfinite(closed_form.stop())) DrawStopLine(svg, curves, closed_form.stop());
+  DrawAngleCurves(svg, curves);
+  DrawAngleLegend(svg);
+  return svg.Finish();
 }
 
 }  // namespace hybrid::gripper

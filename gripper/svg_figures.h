@@ -2,7 +2,6 @@
 
 #include <array>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -84,10 +83,5 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
 /// Returns a standalone SVG document (ending in "</svg>\n"); coordinates in pixels with two
 /// decimals, so the output is deterministic. Does not throw (apart from std::bad_alloc).
 std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title);
-
-/// `text` escaped for XML: & < > always, and " ' too when `attribute` (text content needs no
-/// quote escaping); control characters other than tab and newline (not allowed in XML 1.0)
-/// become spaces. Shared by every SVG writer.
-std::string XmlEscape(std::string_view text, bool attribute = false);
 
 }  // namespace hybrid::gripper

@@ -252,7 +252,7 @@ int RunDiagnose(const DiagnoseArgs& args) {
 }
 
 // Checks the sizes of `hybrid synthesize` before anything is allocated (the caps of
-// solvers/synthetic_data.h). Throws UsageError naming the option.
+// gripper/synthetic_data.h). Throws UsageError naming the option.
 void CheckSyntheticSize(const SynthesizeArgs& args) {
   if (args.free_runs < 0 || args.free_runs > kMaxSyntheticFreeRuns) {
     throw UsageError("--free-runs must lie in [0, " + std::to_string(kMaxSyntheticFreeRuns) +

@@ -43,7 +43,7 @@ struct SynthesizeArgs {
 /// Runs `hybrid synthesize`; returns 0. Throws UsageError or std::invalid_argument for a bad
 /// option (exit 2): --free-runs outside [0, kMaxSyntheticFreeRuns], --samples odd or outside
 /// [kMinRunSamples, kMaxSyntheticSamples], more than kMaxSyntheticSamples rows in all
-/// (solvers/synthetic_data.h; checked before anything is allocated), a malformed or unknown
+/// (gripper/synthetic_data.h; checked before anything is allocated), a malformed or unknown
 /// --effect, --out naming the --model.
 int RunSynthesize(const SynthesizeArgs& args);
 

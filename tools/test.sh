@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs, builds and runs every test (rapidcheck seeds pinned in tests/CMakeLists.txt). Three
 # stages, all run by default (`.ci/run`); name some to run only those (docs/fuzzing.md for fuzz):
-#   release    the Release build in build/ and its whole suite (ctest);
+#   release    the Release build in build/ and its whole suite (ctest), and the function-size
+#              limits (tools/function_sizes.py: none over 150 lines, at most 5 over 100);
 #   sanitized  the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer with leak
 #              detection on (build-asan/, -O1, fewer rapidcheck cases); any finding fails its test;
 #   fuzz       every libFuzzer harness (tests/fuzz/) for a short bounded time (tools/fuzz.sh).
@@ -16,6 +17,7 @@ jobs=$(nproc)
 run_release() {
   "$root/tools/build.sh"
   (cd "$root/build" && ctest --output-on-failure -j "$jobs")
+  python3 "$root/tools/function_sizes.py"
 }
 
 run_sanitized() {

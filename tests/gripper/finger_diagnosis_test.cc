@@ -1,5 +1,5 @@
-// Tests of Diagnose (solvers/diagnosis.h) on data that hide an effect: synthetic runs of the
-// finger model (solvers/synthetic_data.h) with the report's measurement noise (0.7 deg on theta1
+// Tests of Diagnose (gripper/finger_diagnosis.h) on data that hide an effect: synthetic runs of the
+// finger model (gripper/synthetic_data.h) with the report's measurement noise (0.7 deg on theta1
 // and theta2, 1.2 deg on theta3, outliers on theta3, missing samples), written to CSV and read
 // back, so that the diagnosis sees only what `hybrid diagnose DATA.csv` sees.
 //

@@ -1,4 +1,4 @@
-// Tests of synthetic measured data (solvers/synthetic_data.h): the written CSV reads back to the
+// Tests of synthetic measured data (gripper/synthetic_data.h): the written CSV reads back to the
 // same runs; the seed decides the data; noiseless data equal the predictor's angles; noise,
 // outliers and missing samples follow the design; the hidden effects outside FingerEffects
 // (ripple, theta3 hysteresis) change the angles as documented; bad designs are rejected.

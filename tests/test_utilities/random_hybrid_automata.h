@@ -1,7 +1,7 @@
 #pragma once
 
 // Random hybrid automata written as model-language TEXT, for the differential soundness test
-// (tests/solvers/soundness_test.cc). The generator never touches the IR builders of the code under
+// (tests/solvers/verification/soundness_test.cc). The generator never touches the IR builders of the code under
 // test: it keeps its own small description of the automaton (flows, guards, resets, properties as
 // sums of products of names), prints that as a `.ha` text for the parser, and evaluates the
 // properties' predicates itself, so that a test can judge a simulated state without the checker's

@@ -1,4 +1,4 @@
-// Tests of the CVODE RAII wrapper on its own (solvers/cvode_integrator.h): accuracy on x' = -x,
+// Tests of the CVODE RAII wrapper on its own (solvers/simulation/cvode_integrator.h): accuracy on x' = -x,
 // root location with crossing directions, restarts with another number of root functions,
 // interpolation inside the last step, run-time failures reported as a status (leaking nothing),
 // CVODE messages kept for message() instead of printed, and a first step that does not depend on

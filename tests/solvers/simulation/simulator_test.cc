@@ -1,4 +1,4 @@
-// Tests of the simulator (solvers/simulator.h): event times against analytic solutions of the
+// Tests of the simulator (solvers/simulation/simulator.h): event times against analytic solutions of the
 // bundled models, every special case of the event semantics on small hand-written models, misuse,
 // and rapidcheck properties (invariants hold, crossing events sit on a guard boundary, runs are
 // deterministic) on random initial states, parameters and input signals.

@@ -1,4 +1,4 @@
-// Tests of the verdict names (solvers/check_result.h): every verdict has its own documented name,
+// Tests of the verdict names (solvers/verification/check_result.h): every verdict has its own documented name,
 // and a default CheckResult is an undecided `always` property; ConfirmTrace lets a `violated` or
 // `reachable` verdict through only with a trace that replays.
 

@@ -1,4 +1,4 @@
-// Tests of the bounded-path encoding (solvers/smt_encoding.h), with Z3 directly: flows are
+// Tests of the bounded-path encoding (solvers/verification/smt_encoding.h), with Z3 directly: flows are
 // classified as documented; every flow segment the simulator runs (with a constant input, not
 // crossing a guard) is a model of the encoding (soundness, a rapidcheck property); a segment that
 // passes through an urgent guard's region is not (urgency); and on the finger's phase-3 law

@@ -1,4 +1,4 @@
-// Differential soundness test of `hybrid check --method prove` (solvers/property_prover.h), see
+// Differential soundness test of `hybrid check --method prove` (solvers/verification/property_prover.h), see
 // docs/soundness.md. Random automata are generated as model-language text
 // (tests/test_utilities/random_hybrid_automata.h) and checked by PropertyProver exactly as the
 // command does (every declared property). Then every verdict is put to the simulator:

@@ -1,4 +1,4 @@
-// Tests of traces (solvers/trace.h): the uncertain parameters of automata and systems; replaying
+// Tests of traces (solvers/verification/trace.h): the uncertain parameters of automata and systems; replaying
 // a trace finds the first recorded state that violates (`always`, `never`) or satisfies (`reach`)
 // a property, within a `within T` horizon, with the documented tolerance; the trace's parameter
 // and initial values are applied; misuse throws.

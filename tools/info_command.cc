@@ -1,0 +1,280 @@
+#include "tools/info_command.h"
+
+#include <sstream>
+#include <vector>
+
+#include "automaton/mode_graph.h"
+
+namespace hybrid::cli {
+namespace {
+
+using hybrid::Automaton;
+using hybrid::ModeGraph;
+using hybrid::ModeId;
+using json = nlohmann::ordered_json;
+
+json ModeList(const System& s, int c, const std::vector<ModeId>& modes) {
+  json out = json::array();
+  for (ModeId m : modes) out.push_back(s.QualifiedModeName(c, m));
+  return out;
+}
+
+json PropertyJson(const hybrid::Property& p) {
+  json j = {{"name", p.name},
+            {"kind", std::string(hybrid::KindKeyword(p.kind))},
+            {"predicate", p.predicate.ToString()}};
+  if (p.horizon) j["within"] = *p.horizon;
+  return j;
+}
+
+json ScenarioJson(const hybrid::Scenario& sc, const hybrid::SymbolTable& symbols) {
+  json inputs = json::array();
+  for (const auto& sig : sc.inputs) {
+    json points = json::array();
+    for (const auto& [t, v] : sig.points) points.push_back({t, v});
+    inputs.push_back({{"input", symbols[sig.slot].name},
+                      {"shape", sig.shape == hybrid::InputSignal::Shape::kStep ? "step" : "linear"},
+                      {"points", points}});
+  }
+  return {{"until", sc.until}, {"inputs", inputs}};
+}
+
+json VariablesJson(const Automaton& a, const std::vector<double>& env) {
+  const auto& sym = a.symbols();
+  json variables = json::array();
+  for (const auto& v : a.variables()) {
+    json j = {{"name", sym[v.slot].name}, {"unit", sym[v.slot].unit}};
+    if (v.domain) j["domain"] = {v.domain->lo.Evaluate(env), v.domain->hi.Evaluate(env)};
+    variables.push_back(j);
+  }
+  return variables;
+}
+
+json InputsJson(const Automaton& a, const std::vector<double>& env) {
+  const auto& sym = a.symbols();
+  json inputs = json::array();
+  for (const auto& in : a.inputs()) {
+    inputs.push_back({{"name", sym[in.slot].name},
+                      {"unit", sym[in.slot].unit},
+                      {"bounds", {in.bounds.lo.Evaluate(env), in.bounds.hi.Evaluate(env)}}});
+  }
+  return inputs;
+}
+
+json ParametersJson(const Automaton& a, const std::vector<double>& env) {
+  const auto& sym = a.symbols();
+  json parameters = json::array();
+  for (const auto& [slot, value] : a.parameters()) {
+    json p = {{"name", sym[slot].name},
+              {"unit", sym[slot].unit},
+              {"value", env[slot]},
+              {"expression", value.ToString()}};
+    if (const auto range = a.ParameterRange(slot)) {
+      p["range"] = {range->lo.Evaluate(env), range->hi.Evaluate(env)};
+    }
+    parameters.push_back(p);
+  }
+  return parameters;
+}
+
+json ModesJson(const Automaton& a) {
+  const auto& sym = a.symbols();
+  json modes = json::array();
+  for (const auto& m : a.modes()) {
+    json flows = json::object();
+    for (const auto& [slot, rhs] : m.flows) flows[sym[slot].name] = rhs.ToString();
+    json values = json::object();
+    for (const auto& [slot, v] : m.discrete_values) values[sym[slot].name] = v;
+    modes.push_back({{"name", m.name},
+                     {"discrete", values},
+                     {"flows", flows},
+                     {"invariant", m.invariant.ToString()}});
+  }
+  return modes;
+}
+
+json TransitionsJson(const Automaton& a) {
+  const auto& sym = a.symbols();
+  json transitions = json::array();
+  for (const auto& t : a.transitions()) {
+    json resets = json::object();
+    for (const auto& r : t.resets) resets[sym[r.slot].name] = r.value.ToString();
+    transitions.push_back({{"name", t.name},
+                           {"source", a.mode(t.source).name},
+                           {"target", a.mode(t.target).name},
+                           {"label", t.label},
+                           {"guard", t.guard.ToString()},
+                           {"resets", resets},
+                           {"urgency", t.urgency == hybrid::Urgency::kLazy ? "lazy" : "urgent"}});
+  }
+  return transitions;
+}
+
+json InitialStatesJson(const Automaton& a, const std::vector<double>& env) {
+  const auto& sym = a.symbols();
+  json initial = json::array();
+  for (const auto& init : a.initial_states()) {
+    json values = json::object();
+    for (const auto& v : init.values) {
+      values[sym[v.slot].name] = v.is_point
+                                     ? json(v.range.lo.Evaluate(env))
+                                     : json({v.range.lo.Evaluate(env), v.range.hi.Evaluate(env)});
+    }
+    initial.push_back({{"mode", a.mode(init.mode).name}, {"values", values}});
+  }
+  return initial;
+}
+
+// Component c of `s` as `hybrid info --json` reports it; its warnings are also appended to
+// `warnings` (qualified by the instance name).
+json ComponentJson(const System& s, int c, json& warnings) {
+  const auto& comp = s.components()[c];
+  const Automaton& a = comp.automaton;
+  const auto& sym = a.symbols();
+  const std::vector<double> env = a.ParameterEnvironment();
+  json discrete = json::array();
+  for (int d : a.discrete_variables()) discrete.push_back(sym[d].name);
+  const ModeGraph graph(a);
+  json sccs = json::array();
+  for (const auto& scc : graph.StronglyConnectedComponents()) {
+    if (scc.size() > 1) sccs.push_back(ModeList(s, c, scc));
+  }
+  json component_warnings = json::array();
+  for (const std::string& w : graph.Warnings()) {
+    const std::string qualified = comp.instance.empty() ? w : comp.instance + ": " + w;
+    component_warnings.push_back(qualified);
+    warnings.push_back(qualified);
+  }
+  json properties = json::array();
+  for (const auto& p : a.properties()) properties.push_back(PropertyJson(p));
+  return {{"instance", comp.instance},
+          {"automaton", a.name()},
+          {"variables", VariablesJson(a, env)},
+          {"discrete_variables", discrete},
+          {"inputs", InputsJson(a, env)},
+          {"parameters", ParametersJson(a, env)},
+          {"modes", ModesJson(a)},
+          {"transitions", TransitionsJson(a)},
+          {"initial_states", InitialStatesJson(a, env)},
+          {"reachable_modes", ModeList(s, c, graph.ReachableModes())},
+          {"unreachable_modes", ModeList(s, c, graph.UnreachableModes())},
+          {"terminal_modes", ModeList(s, c, graph.TerminalModes())},
+          {"cycles", sccs},
+          {"properties", properties},
+          {"warnings", component_warnings}};
+}
+
+}  // namespace
+
+json InfoJson(const System& s, const std::string& file) {
+  json components = json::array();
+  json warnings = json::array();
+  for (int c = 0; c < static_cast<int>(s.components().size()); ++c) {
+    components.push_back(ComponentJson(s, c, warnings));
+  }
+  json properties = json::array();
+  for (const auto& p : s.properties()) properties.push_back(PropertyJson(p));
+  json shared = json::array();
+  for (const auto& n : s.shared()) shared.push_back(n);
+  json out = {{"file", file},
+              {"name", s.name()},
+              {"shared", shared},
+              {"components", components},
+              {"properties", properties},
+              {"scenario", s.scenario() ? ScenarioJson(*s.scenario(), s.symbols()) : json()},
+              {"warnings", warnings}};
+  return out;
+}
+
+namespace {
+
+std::string Join(const json& array, const std::string& sep = ", ") {
+  std::string out;
+  for (size_t i = 0; i < array.size(); ++i) {
+    out +=
+        (i > 0 ? sep : "") + (array[i].is_string() ? array[i].get<std::string>() : array[i].dump());
+  }
+  return out;
+}
+
+// One component of InfoText.
+void ComponentText(const json& c, std::ostringstream& out) {
+  const std::string instance = c["instance"].get<std::string>();
+  out << "\n"
+      << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
+      << c["automaton"].get<std::string>() << "\n";
+  out << "  variables (" << c["variables"].size() << "):";
+  for (const auto& v : c["variables"]) {
+    out << " " << v["name"].get<std::string>();
+    if (!v["unit"].get<std::string>().empty()) out << " [" << v["unit"].get<std::string>() << "]";
+    if (v.contains("domain")) out << " in " << v["domain"].dump();
+    out << ";";
+  }
+  out << "\n";
+  if (!c["discrete_variables"].empty()) {
+    out << "  discrete variables (" << c["discrete_variables"].size()
+        << "): " << Join(c["discrete_variables"]) << "\n";
+  }
+  for (const auto& in : c["inputs"]) {
+    out << "  input " << in["name"].get<std::string>() << " in " << in["bounds"].dump() << "\n";
+  }
+  out << "  parameters (" << c["parameters"].size() << "):";
+  for (const auto& p : c["parameters"]) {
+    out << " " << p["name"].get<std::string>() << " = " << p["value"].dump() << ";";
+  }
+  out << "\n  modes (" << c["modes"].size() << "): ";
+  json names = json::array();
+  for (const auto& m : c["modes"]) names.push_back(m["name"]);
+  out << Join(names) << "\n";
+  out << "  transitions (" << c["transitions"].size() << "):\n";
+  for (const auto& t : c["transitions"]) {
+    out << "    " << t["name"].get<std::string>() << ": " << t["source"].get<std::string>()
+        << " -> " << t["target"].get<std::string>();
+    if (!t["label"].get<std::string>().empty()) out << " [" << t["label"].get<std::string>() << "]";
+    out << " when " << t["guard"].get<std::string>();
+    if (t["urgency"] == "lazy") out << " (lazy)";
+    out << "\n";
+  }
+  for (const auto& init : c["initial_states"]) {
+    out << "  initial: " << init["mode"].get<std::string>() << " " << init["values"].dump() << "\n";
+  }
+  out << "  reachable modes (" << c["reachable_modes"].size() << " of " << c["modes"].size()
+      << "): " << Join(c["reachable_modes"]) << "\n";
+  out << "  terminal modes: " << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"]))
+      << "\n";
+  out << "  cycles (strongly connected components with more than one mode): " << c["cycles"].size()
+      << "\n";
+  for (const auto& p : c["properties"]) {
+    out << "  property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
+        << " " << p["predicate"].get<std::string>() << "\n";
+  }
+}
+
+}  // namespace
+
+std::string InfoText(const json& info) {
+  std::ostringstream out;
+  out << "model " << info["name"].get<std::string>() << " (" << info["file"].get<std::string>()
+      << ")\n";
+  if (!info["shared"].empty()) out << "shared: " << Join(info["shared"]) << "\n";
+  for (const auto& c : info["components"]) ComponentText(c, out);
+  for (const auto& p : info["properties"]) {
+    if (info["components"].size() == 1) break;  // single automaton: already listed
+    out << "property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
+        << " " << p["predicate"].get<std::string>() << "\n";
+  }
+  if (!info["scenario"].is_null()) {
+    out << "\nscenario: until " << info["scenario"]["until"].dump();
+    for (const auto& in : info["scenario"]["inputs"]) {
+      out << "; " << in["input"].get<std::string>() << " = " << in["shape"].get<std::string>()
+          << in["points"].dump();
+    }
+    out << "\n";
+  }
+  out << "\nwarnings: "
+      << (info["warnings"].empty() ? "none" : std::to_string(info["warnings"].size())) << "\n";
+  for (const auto& w : info["warnings"]) out << "  warning: " << w.get<std::string>() << "\n";
+  return out.str();
+}
+
+}  // namespace hybrid::cli
