@@ -353,9 +353,11 @@ class Run final : public OdeSystem {
         signals_(std::move(signals)),
         options_(options) {}
 
+  // A model without continuous variables is integrated as one constant dummy variable (CVODE
+  // needs at least one), whose derivative must be written too.
   void Derivatives(double t, const double* x, double* dxdt) override {
     Load(t, x);
-    for (size_t i = 0; i < x_size(); ++i) dxdt[i] = 0.0;
+    for (size_t i = 0; i < std::max<size_t>(x_size(), 1); ++i) dxdt[i] = 0.0;
     for (const auto& [index, rhs] : active_flows_) dxdt[index] = rhs->Evaluate(env_.data());
   }
 
