@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -107,6 +108,72 @@ double PowInt(double x, int n) {
   return n < 0 ? 1.0 / r : r;
 }
 
+// How a non-leaf expression is compiled: the code of `first` (left in the accumulator), then,
+// if `second` is set, the code of `second` (one stack entry deeper), then one instruction.
+struct OperationPlan {
+  Code code;
+  std::int32_t slot = 0;
+  double value = 0.0;
+  const Expression* first;
+  const Expression* second = nullptr;
+};
+
+// Whether `e` is read straight from an instruction (a constant or a symbol).
+bool IsLeaf(const Expression& e) { return e.is_constant() || e.is_symbol(); }
+
+// `lhs ^ rhs` with rhs an integer constant in [-4, 4]: squared, cubed or PowInt; else nullopt.
+std::optional<OperationPlan> SmallPowerPlan(const Expression& lhs, const Expression& rhs) {
+  if (!rhs.is_constant() || std::nearbyint(rhs.constant()) != rhs.constant() ||
+      !(std::abs(rhs.constant()) <= 4)) {
+    return std::nullopt;
+  }
+  const int n = static_cast<int>(rhs.constant());
+  if (n == 2 || n == 3) return OperationPlan{n == 2 ? Code::kSquare : Code::kCube, 0, 0.0, &lhs};
+  return OperationPlan{Code::kPowInt, n, 0.0, &lhs};
+}
+
+// A leaf on the left of a compound right operand of + * - /: the right operand is evaluated
+// first and the operation applied with the leaf taken from the instruction (exact: + and *
+// commute in IEEE arithmetic, and the reversed forms compute leaf - acc and leaf / acc).
+OperationPlan LeafLeftPlan(Op op, const Expression& lhs, const Expression& rhs) {
+  const bool constant = lhs.is_constant();
+  Code code;
+  switch (op) {
+    case Op::kAdd:
+      code = constant ? Code::kAddC : Code::kAddV;
+      break;
+    case Op::kMul:
+      code = constant ? Code::kMulC : Code::kMulV;
+      break;
+    case Op::kSub:
+      code = constant ? Code::kRSubC : Code::kRSubV;
+      break;
+    default:
+      code = constant ? Code::kRDivC : Code::kRDivV;
+      break;
+  }
+  return {code, lhs.is_symbol() ? lhs.slot() : 0, constant ? lhs.constant() : 0.0, &rhs};
+}
+
+// The plan of the non-leaf `e`.
+OperationPlan PlanOperation(const Expression& e) {
+  const Expression& lhs = e.args()[0];
+  if (Arity(e.op()) == 1) return {UnaryCode(e.op()), 0, 0.0, &lhs};
+  const Expression& rhs = e.args()[1];
+  if (e.op() == Op::kPow) {
+    if (std::optional<OperationPlan> power = SmallPowerPlan(lhs, rhs)) return *power;
+  }
+  if (IsLeaf(lhs) && !IsLeaf(rhs) &&
+      (e.op() == Op::kAdd || e.op() == Op::kMul || e.op() == Op::kSub || e.op() == Op::kDiv)) {
+    return LeafLeftPlan(e.op(), lhs, rhs);
+  }
+  // The stack form of the op; the constant and symbol forms follow it.
+  const Code base = BinaryCode(e.op());
+  if (rhs.is_constant()) return {Offset(base, 1), 0, rhs.constant(), &lhs};
+  if (rhs.is_symbol()) return {Offset(base, 2), rhs.slot(), 0.0, &lhs};
+  return {base, 0, 0.0, &lhs, &rhs};
+}
+
 }  // namespace
 
 CompiledExpression::CompiledExpression() : CompiledExpression(Expression::Constant(0.0)) {}
@@ -146,66 +213,6 @@ void CompiledExpression::Emit(const Expression& root) {
     Instruction instruction;
   };
   std::vector<Task> todo = {{Task::kEmit, &root, 1, {}}};
-  auto emit = [&](const Expression& e, int depth) { todo.push_back({Task::kEmit, &e, depth, {}}); };
-  auto append = [&](Code code, std::int32_t slot, double value) {
-    todo.push_back({Task::kAppend, nullptr, 0, {code, slot, value}});
-  };
-  // The operation of the non-leaf `e`, its arguments first.
-  auto operation = [&](const Expression& e, int depth) {
-    const Expression& lhs = e.args()[0];
-    if (Arity(e.op()) == 1) {
-      append(UnaryCode(e.op()), 0, 0.0);
-      emit(lhs, depth);
-      return;
-    }
-    const Expression& rhs = e.args()[1];
-    if (e.op() == Op::kPow && rhs.is_constant() &&
-        std::nearbyint(rhs.constant()) == rhs.constant() && std::abs(rhs.constant()) <= 4) {
-      const int n = static_cast<int>(rhs.constant());
-      if (n == 2 || n == 3) {
-        append(n == 2 ? Code::kSquare : Code::kCube, 0, 0.0);
-      } else {
-        append(Code::kPowInt, n, 0.0);
-      }
-      emit(lhs, depth);
-      return;
-    }
-    const bool leaf_left = lhs.is_constant() || lhs.is_symbol();
-    if (leaf_left && !rhs.is_constant() && !rhs.is_symbol() &&
-        (e.op() == Op::kAdd || e.op() == Op::kMul || e.op() == Op::kSub || e.op() == Op::kDiv)) {
-      // A leaf on the left of a compound right operand: evaluate the right operand first and
-      // apply the operation with the leaf taken from the instruction (exact: + and * commute in
-      // IEEE arithmetic, and the reversed forms compute leaf - acc and leaf / acc).
-      Code code;
-      switch (e.op()) {
-        case Op::kAdd:
-          code = lhs.is_constant() ? Code::kAddC : Code::kAddV;
-          break;
-        case Op::kMul:
-          code = lhs.is_constant() ? Code::kMulC : Code::kMulV;
-          break;
-        case Op::kSub:
-          code = lhs.is_constant() ? Code::kRSubC : Code::kRSubV;
-          break;
-        default:
-          code = lhs.is_constant() ? Code::kRDivC : Code::kRDivV;
-          break;
-      }
-      append(code, lhs.is_symbol() ? lhs.slot() : 0, lhs.is_constant() ? lhs.constant() : 0.0);
-      emit(rhs, depth);
-      return;
-    }
-    const Code base = BinaryCode(e.op());
-    if (rhs.is_constant()) {
-      append(Offset(base, 1), 0, rhs.constant());
-    } else if (rhs.is_symbol()) {
-      append(Offset(base, 2), rhs.slot(), 0.0);
-    } else {
-      append(base, 0, 0.0);
-      emit(rhs, depth + 1);
-    }
-    emit(lhs, depth);
-  };
   while (!todo.empty()) {
     const Task task = todo.back();
     todo.pop_back();
@@ -238,7 +245,11 @@ void CompiledExpression::Emit(const Expression& root) {
       }
       todo.push_back({Task::kStore, &e, task.depth, {}});
     }
-    operation(e, task.depth);
+    // The operation of the non-leaf `e`, its operands first.
+    const OperationPlan plan = PlanOperation(e);
+    todo.push_back({Task::kAppend, nullptr, 0, {plan.code, plan.slot, plan.value}});
+    if (plan.second) todo.push_back({Task::kEmit, plan.second, task.depth + 1, {}});
+    todo.push_back({Task::kEmit, plan.first, task.depth, {}});
   }
 }
 
@@ -259,6 +270,40 @@ double CompiledExpression::Evaluate(const double* env) const {
 #if defined(__clang__)
 #pragma clang diagnostic ignored "-Wgnu-label-as-value"
 #endif
+// The handlers of Run's instructions. Each ends by jumping to the handler of the next
+// instruction. SET sets the accumulator to `expr`; PUSH pushes the accumulator on the stack, then
+// sets it to `expr`; BINARY defines the three forms of a binary operation (label_s, label_c,
+// label_v) computing `expr` from its operands a (left) and b (right).
+#define NEXT goto* kDispatch[static_cast<std::uint32_t>((++pc)->code)]
+#define SET(label, expr) \
+  label:                 \
+  acc = (expr);          \
+  NEXT;
+#define PUSH(label, expr) \
+  label:                  \
+  *sp++ = acc;            \
+  acc = (expr);           \
+  NEXT;
+#define BINARY(label, expr)         \
+  label##_s : {                     \
+    const double b = acc;           \
+    const double a = *--sp;         \
+    acc = (expr);                   \
+    NEXT;                           \
+  }                                 \
+  label##_c : {                     \
+    const double a = acc;           \
+    const double b = pc->value;     \
+    acc = (expr);                   \
+    NEXT;                           \
+  }                                 \
+  label##_v : {                     \
+    const double a = acc;           \
+    const double b = env[pc->slot]; \
+    acc = (expr);                   \
+    NEXT;                           \
+  }
+
 double CompiledExpression::Run(const double* env, double* stack, double* registers) const {
   // Direct threading (GCC/Clang "labels as values"): each handler jumps straight to the next.
   static const void* const kDispatch[] = {
@@ -272,106 +317,44 @@ double CompiledExpression::Run(const double* env, double* stack, double* registe
   const Instruction* pc = code_.data();
   double acc = 0.0;
   double* sp = stack;  // next free entry below the accumulator
-#define NEXT goto* kDispatch[static_cast<std::uint32_t>((++pc)->code)]
-#define BINARY(label, expr_s, expr_c, expr_v) \
-  label##_s : {                               \
-    const double b = acc;                     \
-    const double a = *--sp;                   \
-    acc = (expr_s);                           \
-    NEXT;                                     \
-  }                                           \
-  label##_c : {                               \
-    const double a = acc;                     \
-    const double b = pc->value;               \
-    acc = (expr_c);                           \
-    NEXT;                                     \
-  }                                           \
-  label##_v : {                               \
-    const double a = acc;                     \
-    const double b = env[pc->slot];           \
-    acc = (expr_v);                           \
-    NEXT;                                     \
-  }
-#define BINARY_SAME(label, expr) BINARY(label, expr, expr, expr)
-
   goto* kDispatch[static_cast<std::uint32_t>(pc->code)];
-push_c:
-  *sp++ = acc;
-  acc = pc->value;
-  NEXT;
-push_v:
-  *sp++ = acc;
-  acc = env[pc->slot];
-  NEXT;
-neg:
-  acc = -acc;
-  NEXT;
-sin_:
-  acc = std::sin(acc);
-  NEXT;
-cos_:
-  acc = std::cos(acc);
-  NEXT;
-tan_:
-  acc = std::tan(acc);
-  NEXT;
-exp_:
-  acc = std::exp(acc);
-  NEXT;
-log_:
-  acc = std::log(acc);
-  NEXT;
-sqrt_:
-  acc = std::sqrt(acc);
-  NEXT;
-abs_:
-  acc = std::abs(acc);
-  NEXT;
-sign_:
-  acc = acc > 0.0 ? 1.0 : (acc < 0.0 ? -1.0 : 0.0);
-  NEXT;
-sq:
-  acc = acc * acc;
-  NEXT;
-cube:
-  acc = acc * acc * acc;
-  NEXT;
-powint:
-  acc = PowInt(acc, pc->slot);
-  NEXT;
-  BINARY_SAME(add, a + b)
-  BINARY_SAME(sub, a - b)
-  BINARY_SAME(mul, a * b)
-  BINARY_SAME(div, a / b)
-  BINARY_SAME(pow, std::pow(a, b))
-  BINARY_SAME(min, std::min(a, b))
-  BINARY_SAME(max, std::max(a, b))
-  BINARY_SAME(atan2, std::atan2(a, b))
-rsub_c:
-  acc = pc->value - acc;
-  NEXT;
-rsub_v:
-  acc = env[pc->slot] - acc;
-  NEXT;
-rdiv_c:
-  acc = pc->value / acc;
-  NEXT;
-rdiv_v:
-  acc = env[pc->slot] / acc;
-  NEXT;
+  PUSH(push_c, pc->value)
+  PUSH(push_v, env[pc->slot])
+  SET(neg, -acc)
+  SET(sin_, std::sin(acc))
+  SET(cos_, std::cos(acc))
+  SET(tan_, std::tan(acc))
+  SET(exp_, std::exp(acc))
+  SET(log_, std::log(acc))
+  SET(sqrt_, std::sqrt(acc))
+  SET(abs_, std::abs(acc))
+  SET(sign_, acc > 0.0 ? 1.0 : (acc < 0.0 ? -1.0 : 0.0))
+  SET(sq, acc * acc)
+  SET(cube, acc * acc * acc)
+  SET(powint, PowInt(acc, pc->slot))
+  BINARY(add, a + b)
+  BINARY(sub, a - b)
+  BINARY(mul, a * b)
+  BINARY(div, a / b)
+  BINARY(pow, std::pow(a, b))
+  BINARY(min, std::min(a, b))
+  BINARY(max, std::max(a, b))
+  BINARY(atan2, std::atan2(a, b))
+  SET(rsub_c, pc->value - acc)
+  SET(rsub_v, env[pc->slot] - acc)
+  SET(rdiv_c, pc->value / acc)
+  SET(rdiv_v, env[pc->slot] / acc)
 store_r:
   registers[pc->slot] = acc;
   NEXT;
-load_r:
-  *sp++ = acc;
-  acc = registers[pc->slot];
-  NEXT;
+  PUSH(load_r, registers[pc->slot])
 end:
   return acc;
-#undef BINARY_SAME
-#undef BINARY
-#undef NEXT
 }
+#undef BINARY
+#undef PUSH
+#undef SET
+#undef NEXT
 #pragma GCC diagnostic pop
 
 }  // namespace hybrid

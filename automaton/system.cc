@@ -146,6 +146,353 @@ Automaton Renamed(const Automaton& a, const std::function<std::string(const std:
   return out;
 }
 
+// The local slot of System slot `g` in component `c`, or -1 if `c` does not have it.
+int LocalSlot(const Component& c, int g) {
+  auto it = std::find(c.global_slot.begin(), c.global_slot.end(), g);
+  return it == c.global_slot.end() ? -1 : static_cast<int>(it - c.global_slot.begin());
+}
+
+// Throws unless no component of `components` has the instance name `instance`.
+void CheckNewInstance(std::span<const Component> components, const std::string& instance) {
+  for (const Component& c : components) {
+    if (c.instance == instance) {
+      Fail(instance.empty() ? "two unnamed instances (at most one instance may keep its names)"
+                            : "duplicate instance '" + instance + "'");
+    }
+  }
+}
+
+// A shared parameter is one constant: throws unless parameter `s` of the new component `c`
+// (value `value`, System slot `g`) has the value and declared range it has in the first of
+// `components` that declares `g`.
+void CheckSharedParameter(const Component& c, int s, double value, int g,
+                          std::span<const Component> components) {
+  const std::string& name = c.automaton.symbols()[s].name;
+  for (const Component& other : components) {
+    const int other_slot = LocalSlot(other, g);
+    if (other_slot < 0) continue;
+    const double theirs = other.automaton.ParameterEnvironment()[other_slot];
+    if (theirs != value) {
+      Fail("shared parameter '" + name + "' is " + FormatNumber(value) + " in '" + c.source.name() +
+           "' but " + FormatNumber(theirs) + " in '" + other.automaton.name() + "'");
+    }
+    const std::string ours = RangeText(c.automaton, s);
+    const std::string their_range = RangeText(other.automaton, other_slot);
+    if (ours != their_range) {
+      Fail("shared parameter '" + name + "' has range " + ours + " in '" + c.source.name() +
+           "' but " + their_range + " in '" + other.automaton.name() + "'");
+    }
+    break;
+  }
+}
+
+// Whether some mode of `a` gives a flow to slot `slot`.
+bool HasFlow(const Automaton& a, int slot) {
+  return std::any_of(a.modes().begin(), a.modes().end(),
+                     [slot](const Mode& m) { return m.FlowOf(slot).has_value(); });
+}
+
+// At most one component may define the flow of a shared variable: throws if a variable the new
+// component `c` (its System slots bound) gives a flow also has one in one of `components`.
+void CheckSharedFlows(const Component& c, std::span<const Component> components) {
+  const SymbolTable& local = c.automaton.symbols();
+  for (int s = 0; s < local.size(); ++s) {
+    if (local[s].kind != SymbolKind::kVariable) continue;
+    if (!HasFlow(c.automaton, s)) continue;
+    for (const Component& other : components) {
+      const int other_slot = LocalSlot(other, c.global_slot[s]);
+      if (other_slot < 0) continue;
+      if (HasFlow(other.automaton, other_slot)) {
+        Fail("shared variable '" + local[s].name + "' has flows in two components");
+      }
+    }
+  }
+}
+
+// Expression `e` of component `c` over System slots.
+Expression Global(const Component& c, const Expression& e, const SymbolTable& symbols) {
+  return Remap(e, c.global_slot, symbols);
+}
+
+// Declares in `out` the System symbol `sym`, which is slot `local` of component `c`, with the
+// domain, bounds or value and declared range it has in `c`.
+void DeclareSymbol(const Symbol& sym, const Component& c, int local, const SymbolTable& symbols,
+                   Automaton& out) {
+  const Automaton& a = c.automaton;
+  auto global = [&](const Expression& e) { return Global(c, e, symbols); };
+  switch (sym.kind) {
+    case SymbolKind::kVariable: {
+      std::optional<Range> domain;
+      for (const VariableInfo& v : a.variables()) {
+        if (v.slot == local && v.domain) domain = Range{global(v.domain->lo), global(v.domain->hi)};
+      }
+      out.AddVariable(sym.name, sym.unit, domain);
+      break;
+    }
+    case SymbolKind::kDiscrete:
+      out.AddDiscreteVariable(sym.name);
+      break;
+    case SymbolKind::kInput:
+      for (const InputInfo& in : a.inputs()) {
+        if (in.slot == local) {
+          out.AddInput(sym.name, {global(in.bounds.lo), global(in.bounds.hi)}, sym.unit);
+        }
+      }
+      break;
+    case SymbolKind::kParameter:
+      for (const auto& [slot, value] : a.parameters()) {
+        if (slot != local) continue;
+        std::optional<Range> range = a.ParameterRange(slot);
+        if (range) range = Range{global(range->lo), global(range->hi)};
+        out.AddParameter(sym.name, global(value), sym.unit, range);
+      }
+      break;
+  }
+}
+
+// Declares every symbol of `symbols` in `out`, in slot order so that slots coincide, as the
+// first of `components` that has it declares it.
+void DeclareSymbols(const SymbolTable& symbols, std::span<const Component> components,
+                    Automaton& out) {
+  for (int s = 0; s < symbols.size(); ++s) {
+    for (const Component& c : components) {
+      const int local = LocalSlot(c, s);
+      if (local < 0) continue;
+      DeclareSymbol(symbols[s], c, local, symbols, out);
+      break;
+    }
+  }
+}
+
+// Product modes are tuples of component modes (ModeId values, one per component).
+using Tuple = std::vector<int>;
+// A transition of the component with the given index.
+using Participant = std::pair<int, const Transition*>;
+
+// The product mode of `tuple`: component mode names joined with "__", the components' flows
+// (sorted by slot) and invariants, and their discrete values (sorted, without repeats).
+Mode ProductMode(const Tuple& tuple, std::span<const Component> components,
+                 const SymbolTable& symbols) {
+  Mode m;
+  for (int i = 0; i < static_cast<int>(components.size()); ++i) {
+    const Component& c = components[i];
+    const Mode& local = c.automaton.mode(ModeId(tuple[i]));
+    m.name += (i > 0 ? "__" : "") + local.name;
+    for (const auto& [slot, rhs] : local.flows) {
+      m.flows.emplace_back(c.global_slot[slot], Global(c, rhs, symbols));
+    }
+    for (const Comparison& x : local.invariant.comparisons) {
+      m.invariant.comparisons.push_back(Remap(x, c.global_slot, symbols));
+    }
+    for (const auto& [slot, value] : local.discrete_values) {
+      m.discrete_values.emplace_back(c.global_slot[slot], value);
+    }
+  }
+  std::sort(m.flows.begin(), m.flows.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(m.discrete_values.begin(), m.discrete_values.end());
+  m.discrete_values.erase(std::unique(m.discrete_values.begin(), m.discrete_values.end()),
+                          m.discrete_values.end());
+  return m;
+}
+
+// The initial tuples, the cartesian product of the components' initial states (the first
+// component varying slowest), each with its initial values over System slots: for a slot
+// several components initialise, the first component's value (values in the order given).
+std::vector<std::pair<Tuple, std::vector<InitialValue>>> InitialTuples(
+    std::span<const Component> components, const SymbolTable& symbols) {
+  std::vector<std::pair<Tuple, std::vector<InitialValue>>> inits = {{{}, {}}};
+  for (const Component& c : components) {
+    std::vector<std::pair<Tuple, std::vector<InitialValue>>> next;
+    for (const auto& [tuple, values] : inits) {
+      for (const InitialState& s : c.automaton.initial_states()) {
+        auto t = tuple;
+        t.push_back(s.mode.value());
+        auto v = values;
+        for (const InitialValue& iv : s.values) {
+          const int g = c.global_slot[iv.slot];
+          if (std::none_of(v.begin(), v.end(),
+                           [g](const InitialValue& x) { return x.slot == g; })) {
+            v.push_back({g,
+                         {Global(c, iv.range.lo, symbols), Global(c, iv.range.hi, symbols)},
+                         iv.is_point});
+          }
+        }
+        next.emplace_back(std::move(t), std::move(v));
+      }
+    }
+    inits = std::move(next);
+  }
+  return inits;
+}
+
+// Every way of picking one transition from each non-empty `choices[j]`, in lexicographic order
+// (lower j varying slowest), each as its participants in increasing component order.
+std::vector<std::vector<Participant>> Combinations(
+    const std::vector<std::vector<const Transition*>>& choices) {
+  std::vector<std::vector<Participant>> combos = {{}};
+  for (int j = 0; j < static_cast<int>(choices.size()); ++j) {
+    if (choices[j].empty()) continue;
+    std::vector<std::vector<Participant>> next;
+    for (const auto& combo : combos) {
+      for (const Transition* u : choices[j]) {
+        auto c = combo;
+        c.emplace_back(j, u);
+        next.push_back(std::move(c));
+      }
+    }
+    combos = std::move(next);
+  }
+  return combos;
+}
+
+// Builds the reachable part of the product of `components` into `out` (whose symbols are the
+// System's, declared in slot order): product modes are created when first reached and explored
+// breadth first; transitions are numbered in the order they are added.
+class ProductBuilder {
+ public:
+  ProductBuilder(const SymbolTable& symbols, std::span<const Component> components, int max_modes,
+                 Automaton& out)
+      : symbols_(symbols), components_(components), max_modes_(max_modes), out_(out) {
+    // Labels used by each component (for synchronisation).
+    for (const Component& c : components_) {
+      std::set<std::string>& labels = alphabet_.emplace_back();
+      for (const Transition& t : c.automaton.transitions()) {
+        if (!t.label.empty()) labels.insert(t.label);
+      }
+    }
+  }
+
+  // Adds the initial states (InitialTuples, values sorted by slot) and their product modes.
+  void AddInitialStates() {
+    for (auto& [tuple, values] : InitialTuples(components_, symbols_)) {
+      std::sort(values.begin(), values.end(),
+                [](const InitialValue& a, const InitialValue& b) { return a.slot < b.slot; });
+      out_.AddInitialState({ModeOf(tuple), std::move(values)});
+    }
+  }
+
+  // Adds the transitions of every product mode reached, and the modes they reach, until no new
+  // mode is reached.
+  void Explore() {
+    while (!queue_.empty()) {
+      const Tuple tuple = queue_.front();
+      queue_.pop_front();
+      const ModeId source = index_.at(tuple);
+      for (int i = 0; i < n(); ++i) {
+        for (const Transition& t : components_[i].automaton.transitions()) {
+          if (t.source.value() != tuple[i]) continue;
+          const std::optional<std::vector<std::vector<const Transition*>>> choices =
+              Choices(tuple, i, t);
+          if (!choices) continue;
+          for (const auto& combo : Combinations(*choices)) AddJoint(tuple, source, t.label, combo);
+        }
+      }
+    }
+  }
+
+ private:
+  int n() const { return static_cast<int>(components_.size()); }
+
+  // The product mode of `tuple`, added (and queued for exploration) if new; throws past
+  // `max_modes_` modes.
+  ModeId ModeOf(const Tuple& tuple) {
+    if (auto it = index_.find(tuple); it != index_.end()) return it->second;
+    if (static_cast<int>(index_.size()) >= max_modes_) {
+      Fail("the composed system has more than " + std::to_string(max_modes_) + " product modes");
+    }
+    const ModeId id = out_.AddMode(ProductMode(tuple, components_, symbols_));
+    index_.emplace(tuple, id);
+    queue_.push_back(tuple);
+    return id;
+  }
+
+  // The transitions that can take part in a step of transition `t` of component `i` from
+  // `tuple`: `t` for `i`, and for every other component whose alphabet has t's label its
+  // transitions from its mode with that label (empty for components not taking part). Nullopt
+  // if one of those has none (the step is blocked) or if a lower component takes part (a
+  // synchronised step is generated once, from its first participant).
+  std::optional<std::vector<std::vector<const Transition*>>> Choices(const Tuple& tuple, int i,
+                                                                     const Transition& t) const {
+    std::vector<std::vector<const Transition*>> choices(n());
+    bool blocked = false;
+    bool leader = true;
+    for (int j = 0; j < n() && !blocked; ++j) {
+      if (j == i || t.label.empty() || !alphabet_[j].count(t.label)) continue;
+      if (j < i) leader = false;
+      for (const Transition& u : components_[j].automaton.transitions()) {
+        if (u.source.value() == tuple[j] && u.label == t.label) choices[j].push_back(&u);
+      }
+      blocked = choices[j].empty();
+    }
+    if (blocked || !leader) return std::nullopt;
+    choices[i] = {&t};
+    return choices;
+  }
+
+  // Adds the transition, labelled `label`, that takes the participants of `combo` together from
+  // product mode `source` (tuple `tuple`): guards conjoined, resets joined (throws if two reset
+  // one variable), urgent if one of them is, named "t<number>_" + the participants' qualified
+  // names joined with "__" ('.' becoming '_').
+  void AddJoint(const Tuple& tuple, ModeId source, const std::string& label,
+                const std::vector<Participant>& combo) {
+    Tuple target = tuple;
+    Transition joint;
+    joint.source = source;
+    joint.label = label;
+    joint.urgency = Urgency::kLazy;
+    std::string name;
+    for (const auto& [j, u] : combo) {
+      const Component& c = components_[j];
+      target[j] = u->target.value();
+      name +=
+          (name.empty() ? "" : "__") + (c.instance.empty() ? u->name : c.instance + "." + u->name);
+      for (const Comparison& x : u->guard.comparisons) {
+        joint.guard.comparisons.push_back(Remap(x, c.global_slot, symbols_));
+      }
+      for (const Reset& r : u->resets) {
+        const int g = c.global_slot[r.slot];
+        if (std::any_of(joint.resets.begin(), joint.resets.end(),
+                        [g](const Reset& x) { return x.slot == g; })) {
+          Fail("synchronised transitions reset '" + symbols_[g].name + "' twice");
+        }
+        joint.resets.push_back({g, Global(c, r.value, symbols_)});
+      }
+      if (u->urgency == Urgency::kUrgent) joint.urgency = Urgency::kUrgent;
+    }
+    std::sort(joint.resets.begin(), joint.resets.end(),
+              [](const Reset& a, const Reset& b) { return a.slot < b.slot; });
+    joint.name = "t" + std::to_string(transition_count_++) + "_" + name;
+    for (char& ch : joint.name) {
+      if (ch == '.') ch = '_';
+    }
+    joint.target = ModeOf(target);
+    out_.AddTransition(std::move(joint));
+  }
+
+  const SymbolTable& symbols_;
+  std::span<const Component> components_;
+  const int max_modes_;
+  Automaton& out_;
+  std::vector<std::set<std::string>> alphabet_;  // per component
+  std::map<Tuple, ModeId> index_;
+  std::deque<Tuple> queue_;  // product modes added but not explored yet
+  int transition_count_ = 0;
+};
+
+// Adds to `out` the system properties without `in` atoms. Product modes are tuples; an `in A.m`
+// atom holds in every product mode containing A.m. It cannot be expressed as one product mode
+// name, so product properties keep only comparisons; properties with `in` atoms are checked on
+// the System, not the product.
+void AddProductProperties(std::span<const Property> properties, Automaton& out) {
+  for (const Property& p : properties) {
+    Property copy = p;
+    bool has_mode_atom = false;
+    p.predicate.ForEachMode([&](const std::string&) { has_mode_atom = true; });
+    if (!has_mode_atom) out.AddProperty(std::move(copy));
+  }
+}
+
 }  // namespace
 
 System::System(std::string name) : name_(std::move(name)) {
@@ -169,12 +516,7 @@ System System::Of(const Automaton& automaton) {
 void System::Share(std::string name) { shared_.insert(std::move(name)); }
 
 void System::AddComponent(std::string instance, const Automaton& automaton) {
-  for (const Component& c : components_) {
-    if (c.instance == instance) {
-      Fail(instance.empty() ? "two unnamed instances (at most one instance may keep its names)"
-                            : "duplicate instance '" + instance + "'");
-    }
-  }
+  CheckNewInstance(components_, instance);
   auto rename = [&](const std::string& n) {
     return instance.empty() || shared_.count(n) ? n : instance + "." + n;
   };
@@ -188,54 +530,14 @@ void System::AddComponent(std::string instance, const Automaton& automaton) {
              automaton.name() + "' but " + WithArticle(KindName(symbols_[*g].kind)) + " elsewhere");
       }
       if (local[s].kind == SymbolKind::kParameter) {
-        // A shared parameter is one constant: its values and declared ranges must agree.
-        for (const Component& other : components_) {
-          auto it = std::find(other.global_slot.begin(), other.global_slot.end(), *g);
-          if (it == other.global_slot.end()) continue;
-          const int other_slot = static_cast<int>(it - other.global_slot.begin());
-          const double theirs = other.automaton.ParameterEnvironment()[other_slot];
-          if (theirs != parameters[s]) {
-            Fail("shared parameter '" + local[s].name + "' is " + FormatNumber(parameters[s]) +
-                 " in '" + automaton.name() + "' but " + FormatNumber(theirs) + " in '" +
-                 other.automaton.name() + "'");
-          }
-          const std::string ours = RangeText(c.automaton, s);
-          const std::string their_range = RangeText(other.automaton, other_slot);
-          if (ours != their_range) {
-            Fail("shared parameter '" + local[s].name + "' has range " + ours + " in '" +
-                 automaton.name() + "' but " + their_range + " in '" + other.automaton.name() +
-                 "'");
-          }
-          break;
-        }
+        CheckSharedParameter(c, s, parameters[s], *g, components_);
       }
       c.global_slot.push_back(*g);
     } else {
       c.global_slot.push_back(symbols_.Add(local[s]));
     }
   }
-  // At most one component may define the flow of a shared variable.
-  for (int s = 0; s < local.size(); ++s) {
-    if (local[s].kind != SymbolKind::kVariable) continue;
-    auto has_flow = [s](const Automaton& a) {
-      return std::any_of(a.modes().begin(), a.modes().end(),
-                         [s](const Mode& m) { return m.FlowOf(s).has_value(); });
-    };
-    if (!has_flow(c.automaton)) continue;
-    for (const Component& other : components_) {
-      auto it = std::find(other.global_slot.begin(), other.global_slot.end(), c.global_slot[s]);
-      if (it == other.global_slot.end()) continue;
-      const int other_slot = static_cast<int>(it - other.global_slot.begin());
-      auto other_has_flow = [other_slot](const Automaton& a) {
-        return std::any_of(a.modes().begin(), a.modes().end(), [other_slot](const Mode& m) {
-          return m.FlowOf(other_slot).has_value();
-        });
-      };
-      if (other_has_flow(other.automaton)) {
-        Fail("shared variable '" + local[s].name + "' has flows in two components");
-      }
-    }
-  }
+  CheckSharedFlows(c, components_);
   components_.push_back(std::move(c));
 }
 
@@ -388,208 +690,13 @@ void System::SetScenario(Scenario scenario) {
 }
 
 Automaton System::Product(int max_modes) const {
-  const int n = static_cast<int>(components_.size());
-  if (n == 0) Fail("system '" + name_ + "' has no components");
+  if (components_.empty()) Fail("system '" + name_ + "' has no components");
   Automaton out(name_);
-  // Declare the global symbols in slot order so that slots coincide.
-  std::vector<int> identity(symbols_.size());
-  for (int s = 0; s < symbols_.size(); ++s) identity[s] = s;
-  auto global = [&](const Component& c, const Expression& e) {
-    return Remap(e, c.global_slot, symbols_);
-  };
-  for (int s = 0; s < symbols_.size(); ++s) {
-    const Symbol& sym = symbols_[s];
-    // Find the component that declared the symbol first, for its domain/bounds/value.
-    for (const Component& c : components_) {
-      auto it = std::find(c.global_slot.begin(), c.global_slot.end(), s);
-      if (it == c.global_slot.end()) continue;
-      const int local = static_cast<int>(it - c.global_slot.begin());
-      const Automaton& a = c.automaton;
-      switch (sym.kind) {
-        case SymbolKind::kVariable: {
-          std::optional<Range> domain;
-          for (const VariableInfo& v : a.variables()) {
-            if (v.slot == local && v.domain) {
-              domain = Range{global(c, v.domain->lo), global(c, v.domain->hi)};
-            }
-          }
-          out.AddVariable(sym.name, sym.unit, domain);
-          break;
-        }
-        case SymbolKind::kDiscrete:
-          out.AddDiscreteVariable(sym.name);
-          break;
-        case SymbolKind::kInput:
-          for (const InputInfo& in : a.inputs()) {
-            if (in.slot == local) {
-              out.AddInput(sym.name, {global(c, in.bounds.lo), global(c, in.bounds.hi)}, sym.unit);
-            }
-          }
-          break;
-        case SymbolKind::kParameter:
-          for (const auto& [slot, value] : a.parameters()) {
-            if (slot != local) continue;
-            std::optional<Range> range = a.ParameterRange(slot);
-            if (range) range = Range{global(c, range->lo), global(c, range->hi)};
-            out.AddParameter(sym.name, global(c, value), sym.unit, range);
-          }
-          break;
-      }
-      break;
-    }
-  }
-
-  // Labels used by each component (for synchronisation).
-  std::vector<std::set<std::string>> alphabet(n);
-  for (int i = 0; i < n; ++i) {
-    for (const Transition& t : components_[i].automaton.transitions()) {
-      if (!t.label.empty()) alphabet[i].insert(t.label);
-    }
-  }
-
-  using Tuple = std::vector<int>;
-  std::map<Tuple, ModeId> index;
-  std::deque<Tuple> queue;
-  auto mode_of = [&](const Tuple& tuple) -> ModeId {
-    if (auto it = index.find(tuple); it != index.end()) return it->second;
-    if (static_cast<int>(index.size()) >= max_modes) {
-      Fail("the composed system has more than " + std::to_string(max_modes) + " product modes");
-    }
-    Mode m;
-    for (int i = 0; i < n; ++i) {
-      const Component& c = components_[i];
-      const Mode& local = c.automaton.mode(ModeId(tuple[i]));
-      m.name += (i > 0 ? "__" : "") + local.name;
-      for (const auto& [slot, rhs] : local.flows) {
-        m.flows.emplace_back(c.global_slot[slot], global(c, rhs));
-      }
-      for (const Comparison& x : local.invariant.comparisons) {
-        m.invariant.comparisons.push_back(Remap(x, c.global_slot, symbols_));
-      }
-      for (const auto& [slot, value] : local.discrete_values) {
-        m.discrete_values.emplace_back(c.global_slot[slot], value);
-      }
-    }
-    std::sort(m.flows.begin(), m.flows.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::sort(m.discrete_values.begin(), m.discrete_values.end());
-    m.discrete_values.erase(std::unique(m.discrete_values.begin(), m.discrete_values.end()),
-                            m.discrete_values.end());
-    const ModeId id = out.AddMode(std::move(m));
-    index.emplace(tuple, id);
-    queue.push_back(tuple);
-    return id;
-  };
-
-  // Initial tuples: the cartesian product of the components' initial states.
-  std::vector<std::pair<Tuple, std::vector<InitialValue>>> inits = {{{}, {}}};
-  for (const Component& c : components_) {
-    std::vector<std::pair<Tuple, std::vector<InitialValue>>> next;
-    for (const auto& [tuple, values] : inits) {
-      for (const InitialState& s : c.automaton.initial_states()) {
-        auto t = tuple;
-        t.push_back(s.mode.value());
-        auto v = values;
-        for (const InitialValue& iv : s.values) {
-          const int g = c.global_slot[iv.slot];
-          if (std::none_of(v.begin(), v.end(),
-                           [g](const InitialValue& x) { return x.slot == g; })) {
-            v.push_back({g, {global(c, iv.range.lo), global(c, iv.range.hi)}, iv.is_point});
-          }
-        }
-        next.emplace_back(std::move(t), std::move(v));
-      }
-    }
-    inits = std::move(next);
-  }
-  for (auto& [tuple, values] : inits) {
-    std::sort(values.begin(), values.end(),
-              [](const InitialValue& a, const InitialValue& b) { return a.slot < b.slot; });
-    out.AddInitialState({mode_of(tuple), std::move(values)});
-  }
-
-  int transition_count = 0;
-  while (!queue.empty()) {
-    const Tuple tuple = queue.front();
-    queue.pop_front();
-    const ModeId source = index.at(tuple);
-    for (int i = 0; i < n; ++i) {
-      for (const Transition& t : components_[i].automaton.transitions()) {
-        if (t.source.value() != tuple[i]) continue;
-        // Partners: every other component whose alphabet has the label.
-        std::vector<std::vector<const Transition*>> choices(n);
-        bool blocked = false;
-        bool leader = true;  // a synchronised step is generated once, from its first participant
-        for (int j = 0; j < n && !blocked; ++j) {
-          if (j == i || t.label.empty() || !alphabet[j].count(t.label)) continue;
-          if (j < i) leader = false;
-          for (const Transition& u : components_[j].automaton.transitions()) {
-            if (u.source.value() == tuple[j] && u.label == t.label) choices[j].push_back(&u);
-          }
-          blocked = choices[j].empty();
-        }
-        if (blocked || !leader) continue;
-        choices[i] = {&t};
-        // Enumerate combinations.
-        std::vector<std::vector<std::pair<int, const Transition*>>> combos = {{}};
-        for (int j = 0; j < n; ++j) {
-          if (choices[j].empty()) continue;
-          std::vector<std::vector<std::pair<int, const Transition*>>> next;
-          for (const auto& combo : combos) {
-            for (const Transition* u : choices[j]) {
-              auto c = combo;
-              c.emplace_back(j, u);
-              next.push_back(std::move(c));
-            }
-          }
-          combos = std::move(next);
-        }
-        for (const auto& combo : combos) {
-          Tuple target = tuple;
-          Transition joint;
-          joint.source = source;
-          joint.label = t.label;
-          joint.urgency = Urgency::kLazy;
-          std::string name;
-          for (const auto& [j, u] : combo) {
-            const Component& c = components_[j];
-            target[j] = u->target.value();
-            name += (name.empty() ? "" : "__") +
-                    (c.instance.empty() ? u->name : c.instance + "." + u->name);
-            for (const Comparison& x : u->guard.comparisons) {
-              joint.guard.comparisons.push_back(Remap(x, c.global_slot, symbols_));
-            }
-            for (const Reset& r : u->resets) {
-              const int g = c.global_slot[r.slot];
-              if (std::any_of(joint.resets.begin(), joint.resets.end(),
-                              [g](const Reset& x) { return x.slot == g; })) {
-                Fail("synchronised transitions reset '" + symbols_[g].name + "' twice");
-              }
-              joint.resets.push_back({g, global(c, r.value)});
-            }
-            if (u->urgency == Urgency::kUrgent) joint.urgency = Urgency::kUrgent;
-          }
-          std::sort(joint.resets.begin(), joint.resets.end(),
-                    [](const Reset& a, const Reset& b) { return a.slot < b.slot; });
-          joint.name = "t" + std::to_string(transition_count++) + "_" + name;
-          for (char& ch : joint.name) {
-            if (ch == '.') ch = '_';
-          }
-          joint.target = mode_of(target);
-          out.AddTransition(std::move(joint));
-        }
-      }
-    }
-  }
-  for (const Property& p : properties_) {
-    Property copy = p;
-    // Product modes are tuples; an `in A.m` atom holds in every product mode containing A.m.
-    // It cannot be expressed as one product mode name, so product properties keep only
-    // comparisons; properties with `in` atoms are checked on the System, not the product.
-    bool has_mode_atom = false;
-    p.predicate.ForEachMode([&](const std::string&) { has_mode_atom = true; });
-    if (!has_mode_atom) out.AddProperty(std::move(copy));
-  }
+  DeclareSymbols(symbols_, components_, out);
+  ProductBuilder builder(symbols_, components_, max_modes, out);
+  builder.AddInitialStates();
+  builder.Explore();
+  AddProductProperties(properties_, out);
   if (scenario_) out.SetScenario(*scenario_);
   return out;
 }

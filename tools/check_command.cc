@@ -1,5 +1,6 @@
 #include "tools/check_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -7,9 +8,9 @@
 #include <stdexcept>
 
 #include "automaton/parser.h"
+#include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
 #include "solvers/verification/property_sampler.h"
-#include "solvers/simulation/simulator.h"
 #include "tools/output.h"
 
 namespace hybrid::cli {
@@ -115,9 +116,9 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
   return out.str();
 }
 
-}  // namespace
-
-int RunCheck(const CheckArgs& args) {
+// Throws std::invalid_argument for an option value out of its range (in the order of the
+// checks: method, depth, induction, runs, budget).
+void CheckOptions(const CheckArgs& args) {
   if (args.method != "prove" && args.method != "sample") {
     throw std::invalid_argument("--method must be 'prove' or 'sample', not '" + args.method + "'");
   }
@@ -130,50 +131,56 @@ int RunCheck(const CheckArgs& args) {
   if (!(args.budget > 0) || !(args.budget <= 1e6)) {
     throw std::invalid_argument("--budget must be a number of budget seconds in (0, 1e6]");
   }
-  const auto start = std::chrono::steady_clock::now();
-  const System system = ParseModelFile(args.model);
-  const std::vector<Property> declared = DeclaredProperties(system);
+}
+
+// The properties --property names, in the order given (every declared one without --property);
+// throws std::invalid_argument for a name that is not declared.
+std::vector<Property> ChosenProperties(const CheckArgs& args,
+                                       const std::vector<Property>& declared) {
+  if (args.properties.empty()) return declared;
   std::vector<Property> chosen;
-  if (args.properties.empty()) {
-    chosen = declared;
-  } else {
-    for (const std::string& name : args.properties) {
-      auto it = std::find_if(declared.begin(), declared.end(),
-                             [&](const Property& p) { return p.name == name; });
-      if (it == declared.end()) {
-        std::string known;
-        for (const Property& p : declared) known += " " + p.name;
-        throw std::invalid_argument("--property: '" + name + "' is not a property of " +
-                                    args.model +
-                                    " (properties:" + (known.empty() ? " none" : known) + ")");
-      }
-      chosen.push_back(*it);
+  for (const std::string& name : args.properties) {
+    auto it = std::find_if(declared.begin(), declared.end(),
+                           [&](const Property& p) { return p.name == name; });
+    if (it == declared.end()) {
+      std::string known;
+      for (const Property& p : declared) known += " " + p.name;
+      throw std::invalid_argument("--property: '" + name + "' is not a property of " + args.model +
+                                  " (properties:" + (known.empty() ? " none" : known) + ")");
     }
+    chosen.push_back(*it);
   }
-  // One solver budget for the whole command: the properties, then --modes, draw from it.
-  SolverBudget budget(args.budget);
-  PropertyProver::Options prove;
-  prove.max_depth = args.depth;
-  prove.max_induction = args.induction;
+  return chosen;
+}
+
+// What the check found: per chosen property its result, and with --modes per component the
+// reachability of its discrete states; `seconds` is the wall-clock time from parsing on.
+struct Findings {
+  std::vector<Property> chosen;
   std::vector<CheckResult> results;
-  if (args.method == "prove") {
-    results = PropertyProver(prove).Check(system, chosen, budget);
-  } else {
-    PropertySampler::Options options;
-    options.runs = args.runs;
-    options.seed = args.seed;
-    const PropertySampler sampler(options);
-    for (const Property& p : chosen) results.push_back(sampler.Check(system, p));
-  }
   std::vector<std::vector<PropertyProver::ModeReachability>> modes;
-  if (args.modes) {
-    for (std::size_t c = 0; c < system.components().size(); ++c) {
-      modes.push_back(PropertyProver(prove).ReachableModes(system, static_cast<int>(c), budget));
-    }
-  }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const Simulator sim(system);
+  double seconds = 0.0;
+};
+
+// Checks `chosen` on `system` by --method (prove: with `budget`; sample: --runs runs from
+// --seed), one result per property in order.
+std::vector<CheckResult> CheckProperties(const CheckArgs& args,
+                                         const PropertyProver::Options& prove, const System& system,
+                                         const std::vector<Property>& chosen,
+                                         SolverBudget& budget) {
+  if (args.method == "prove") return PropertyProver(prove).Check(system, chosen, budget);
+  std::vector<CheckResult> results;
+  PropertySampler::Options options;
+  options.runs = args.runs;
+  options.seed = args.seed;
+  const PropertySampler sampler(options);
+  for (const Property& p : chosen) results.push_back(sampler.Check(system, p));
+  return results;
+}
+
+// The exit code: kExitViolated if a property is violated or a reach target unreachable, else
+// kExitUnknown if a verdict is unknown, else 0.
+int ExitCode(const std::vector<CheckResult>& results) {
   int code = 0;
   for (const CheckResult& r : results) {
     if (r.verdict == Verdict::kViolated || r.verdict == Verdict::kUnreachable) code = kExitViolated;
@@ -183,56 +190,73 @@ int RunCheck(const CheckArgs& args) {
       if (r.verdict == Verdict::kUnknown) code = kExitUnknown;
     }
   }
-  if (args.json) {
-    json props = json::array();
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      const CheckResult& r = results[i];
-      json j = {{"name", r.property},
-                {"kind", std::string(KindKeyword(r.kind))},
-                {"predicate", chosen[i].predicate.ToString()},
-                {"verdict", std::string(VerdictName(r.verdict))},
-                {"method", r.method},
-                {"seconds", r.seconds},
-                {"reason", r.reason}};
-      if (r.trace) j["trace"] = TraceJson(system, sim, *r.trace);
-      props.push_back(j);
-    }
-    json out = {{"model", args.model},
-                {"method", args.method},
-                {"seconds", seconds},
-                {"properties", props}};
-    if (args.modes) {
-      json ms = json::array();
-      for (const auto& comp : modes) {
-        for (const auto& m : comp) {
-          json d = json::object();
-          for (const auto& [n, v] : m.discrete) d[n] = v;
-          json e = {{"mode", m.mode},
-                    {"discrete", d},
-                    {"verdict", std::string(VerdictName(m.verdict))},
-                    {"reason", m.reason}};
-          if (m.trace) e["trace"] = TraceJson(system, sim, *m.trace);
-          ms.push_back(e);
-        }
-      }
-      out["modes"] = ms;
-    }
-    // The model path may be any bytes: replace invalid UTF-8 rather than throw.
-    WriteOutput("-", out.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
-    return code;
+  return code;
+}
+
+// The "properties" array of the JSON report.
+json PropertiesJson(const System& system, const Simulator& sim, const Findings& found) {
+  json props = json::array();
+  for (std::size_t i = 0; i < found.results.size(); ++i) {
+    const CheckResult& r = found.results[i];
+    json j = {{"name", r.property},
+              {"kind", std::string(KindKeyword(r.kind))},
+              {"predicate", found.chosen[i].predicate.ToString()},
+              {"verdict", std::string(VerdictName(r.verdict))},
+              {"method", r.method},
+              {"seconds", r.seconds},
+              {"reason", r.reason}};
+    if (r.trace) j["trace"] = TraceJson(system, sim, *r.trace);
+    props.push_back(j);
   }
+  return props;
+}
+
+// The "modes" array of the JSON report (--modes): every component's discrete states in order.
+json ModesJson(const System& system, const Simulator& sim, const Findings& found) {
+  json ms = json::array();
+  for (const auto& comp : found.modes) {
+    for (const auto& m : comp) {
+      json d = json::object();
+      for (const auto& [n, v] : m.discrete) d[n] = v;
+      json e = {{"mode", m.mode},
+                {"discrete", d},
+                {"verdict", std::string(VerdictName(m.verdict))},
+                {"reason", m.reason}};
+      if (m.trace) e["trace"] = TraceJson(system, sim, *m.trace);
+      ms.push_back(e);
+    }
+  }
+  return ms;
+}
+
+// The report of `hybrid check --json`.
+json ReportJson(const CheckArgs& args, const System& system, const Simulator& sim,
+                const Findings& found) {
+  json out = {{"model", args.model},
+              {"method", args.method},
+              {"seconds", found.seconds},
+              {"properties", PropertiesJson(system, sim, found)}};
+  if (args.modes) out["modes"] = ModesJson(system, sim, found);
+  return out;
+}
+
+// The report of `hybrid check` as text: a summary line, a line per property (with its trace),
+// and with --modes a line per discrete state.
+std::string ReportText(const CheckArgs& args, const System& system, const Simulator& sim,
+                       const Findings& found) {
   std::ostringstream out;
   out.precision(4);
-  out << args.model << ": " << results.size() << (results.size() == 1 ? " property" : " properties")
-      << ", method " << args.method << ", " << seconds << " s\n";
-  for (const CheckResult& r : results) {
+  const std::size_t count = found.results.size();
+  out << args.model << ": " << count << (count == 1 ? " property" : " properties") << ", method "
+      << args.method << ", " << found.seconds << " s\n";
+  for (const CheckResult& r : found.results) {
     out << "  " << VerdictName(r.verdict) << "  " << r.property << " (" << KindKeyword(r.kind)
         << ", " << r.seconds << " s): " << r.reason << "\n";
     if (r.trace) out << TraceText(system, sim, *r.trace);
   }
   if (args.modes) {
     out << "modes (discrete states):\n";
-    for (const auto& comp : modes) {
+    for (const auto& comp : found.modes) {
       for (const auto& m : comp) {
         out << "  " << VerdictName(m.verdict) << "  " << m.mode << " (";
         for (std::size_t i = 0; i < m.discrete.size(); ++i) {
@@ -242,7 +266,39 @@ int RunCheck(const CheckArgs& args) {
       }
     }
   }
-  WriteOutput("-", out.str());
+  return out.str();
+}
+
+}  // namespace
+
+int RunCheck(const CheckArgs& args) {
+  CheckOptions(args);
+  const auto start = std::chrono::steady_clock::now();
+  const System system = ParseModelFile(args.model);
+  Findings found;
+  found.chosen = ChosenProperties(args, DeclaredProperties(system));
+  // One solver budget for the whole command: the properties, then --modes, draw from it.
+  SolverBudget budget(args.budget);
+  PropertyProver::Options prove;
+  prove.max_depth = args.depth;
+  prove.max_induction = args.induction;
+  found.results = CheckProperties(args, prove, system, found.chosen, budget);
+  if (args.modes) {
+    for (std::size_t c = 0; c < system.components().size(); ++c) {
+      found.modes.push_back(
+          PropertyProver(prove).ReachableModes(system, static_cast<int>(c), budget));
+    }
+  }
+  found.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const Simulator sim(system);
+  const int code = ExitCode(found.results);
+  if (args.json) {
+    // The model path may be any bytes: replace invalid UTF-8 rather than throw.
+    const json out = ReportJson(args, system, sim, found);
+    WriteOutput("-", out.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
+    return code;
+  }
+  WriteOutput("-", ReportText(args, system, sim, found));
   return code;
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 
 #include "automaton/expression.h"
 #include "automaton/parser.h"
@@ -202,10 +203,18 @@ std::vector<double> DefaultFrames(const std::vector<double>& at) {
   return at.empty() ? std::vector<double>{0, 30, 70, 110, 150, 180, 210, 255} : at;
 }
 
-}  // namespace
+// Names of the hand's fingers, by index.
+constexpr std::string_view kFingerNames = "ABC";
 
-int RunFinger(const FingerArgs& args_in) {
-  FingerArgs args = args_in;
+// Whether any of --gob1..3 is given.
+bool AnyGob(const FingerArgs& args) {
+  return std::any_of(args.gob.begin(), args.gob.end(),
+                     [](const std::optional<double>& gob) { return gob.has_value(); });
+}
+
+// Validates the options of `hybrid finger` (throwing as RunFinger documents) and returns the
+// contact positions given by --gob1..3 (the others at their default). Turns a --g of -0 into 0.
+FingerContacts CheckFingerArgs(FingerArgs& args) {
   const std::vector<NamedFile> outputs = {{"--draw", args.draw}, {"--plot", args.plot}};
   CheckDistinctFiles(
       args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
@@ -217,35 +226,44 @@ int RunFinger(const FingerArgs& args_in) {
   }
   for (double g : args.draw_at) CheckMotor("--at", g);
   FingerContacts contacts;
-  bool any_gob = false;
   for (int i = 0; i < 3; ++i) {
     if (!args.gob[i]) continue;
     CheckMotor("--gob" + std::to_string(i + 1), *args.gob[i]);
     contacts.gob[i] = *args.gob[i];
-    any_gob = true;
   }
-  if (any_gob && !args.objects.empty()) {
+  if (AnyGob(args) && !args.objects.empty()) {
     throw std::invalid_argument("--gob1..3 and --object cannot be combined");
   }
   if (!args.g && args.draw.empty() && args.plot.empty()) {
     throw std::invalid_argument("nothing to do: give --g, --draw or --plot");
   }
-  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  return contacts;
+}
+
+// The finger closing on `objects` (none without objects); throws InputError if the objects are
+// invalid or the finger cannot reach them.
+std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& objects) {
   std::optional<GeometricFinger> geometric;
-  if (!objects.empty()) {
-    try {
-      geometric.emplace(objects);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(UserMessage(e.what()));
-    }
-    if (!geometric->touches_object()) {
-      throw InputError("the finger cannot reach the object(s): it closes to g = " +
-                       FormatNumber(std::min(255.0, geometric->closed_form().stop())) +
-                       " without touching " +
-                       (objects.size() == 1 ? objects[0].ToString() : "any of them"));
-    }
+  if (objects.empty()) return geometric;
+  try {
+    geometric.emplace(objects);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(UserMessage(e.what()));
   }
-  const FingerClosedForm closed = geometric ? geometric->closed_form() : FingerClosedForm(contacts);
+  if (!geometric->touches_object()) {
+    throw InputError("the finger cannot reach the object(s): it closes to g = " +
+                     FormatNumber(std::min(255.0, geometric->closed_form().stop())) +
+                     " without touching " +
+                     (objects.size() == 1 ? objects[0].ToString() : "any of them"));
+  }
+  return geometric;
+}
+
+// The report of `hybrid finger` before any simulation: the configuration at --g (if given), the
+// contacts that take effect, where the finger stops and the objects.
+json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
+                  const std::optional<GeometricFinger>& geometric,
+                  const std::vector<Obstacle>& objects) {
   std::array<std::optional<int>, 3> by;
   if (geometric) by = geometric->blocked_by();
   json report;
@@ -257,30 +275,40 @@ int RunFinger(const FingerArgs& args_in) {
     for (const Obstacle& o : objects) list.push_back(o.ToString());
     report["objects"] = list;
   }
-  int code = 0;
-  if (args.simulate) {
-    const System model = ParseModelFile(args.model);
-    if (model.components().size() != 1) {
-      throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
-                       std::to_string(model.components().size()) + " components)");
-    }
-    CheckFingerModel(model.components()[0].automaton, args.model);
-    System system("finger");
-    try {
-      system = System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
-                                    : model.components()[0].automaton);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(args.model + ": " + e.what());
-    }
-    for (int i = 0; i < 3 && !geometric; ++i) {
-      system.SetParameter("gob" + std::to_string(i + 1), std::min(contacts.gob[i], 256.0));
-    }
-    const Comparison c = SimulateClosing(system, {""}, {{"u", 255.0}}, {closed.stop()},
-                                         [&](int, double g) { return closed.At(g).theta; });
-    report["simulation"] = SimulationJson(c);
-    const bool agrees = Agrees(c);
-    if (!agrees) code = kExitDisagrees;
+  return report;
+}
+
+// `hybrid finger --simulate`: the finger automaton of --model (with the geometric contact guards
+// of `geometric`, else with the contact positions `contacts`) closing at u = 1 up to 255,
+// compared with `closed`. Throws InputError if --model is not a finger model.
+Comparison SimulateFinger(const FingerArgs& args, const std::optional<GeometricFinger>& geometric,
+                          const FingerContacts& contacts, const FingerClosedForm& closed) {
+  const System model = ParseModelFile(args.model);
+  if (model.components().size() != 1) {
+    throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
+                     std::to_string(model.components().size()) + " components)");
   }
+  CheckFingerModel(model.components()[0].automaton, args.model);
+  System system("finger");
+  try {
+    system = System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
+                                  : model.components()[0].automaton);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.model + ": " + e.what());
+  }
+  for (int i = 0; i < 3 && !geometric; ++i) {
+    system.SetParameter("gob" + std::to_string(i + 1), std::min(contacts.gob[i], 256.0));
+  }
+  return SimulateClosing(system, {""}, {{"u", 255.0}}, {closed.stop()},
+                         [&](int, double g) { return closed.At(g).theta; });
+}
+
+// The files of `hybrid finger`: --draw (the finger at the frames' motor positions) and --plot
+// (the joint angles against g), as (path, SVG) pairs.
+std::vector<std::pair<std::string, std::string>> FingerFiles(
+    const FingerArgs& args, const FingerClosedForm& closed,
+    const std::optional<GeometricFinger>& geometric, const std::vector<Obstacle>& objects,
+    const FingerContacts& contacts) {
   std::vector<std::pair<std::string, std::string>> files;
   if (!args.draw.empty()) {
     std::vector<std::pair<double, FingerConfiguration>> frames;
@@ -292,18 +320,18 @@ int RunFinger(const FingerArgs& args_in) {
   if (!args.plot.empty()) {
     std::string title = "Robotiq finger, closed form";
     if (!objects.empty()) title += " against " + objects[0].ToString();
-    for (int i = 0; i < 3 && any_gob; ++i) {
+    for (int i = 0; i < 3 && AnyGob(args); ++i) {
       if (contacts.gob[i] <= 255.0) {
         title += ", gob" + std::to_string(i + 1) + " = " + FormatNumber(contacts.gob[i]);
       }
     }
     files.emplace_back(args.plot, gripper::AnglePlotSvg(closed, title));
   }
-  WriteOutputs(files);
-  if (args.json) {
-    WriteOutput("-", report.dump(2) + "\n");
-    return code;
-  }
+  return files;
+}
+
+// The text output of `hybrid finger` from its `report`.
+std::string FingerText(const FingerArgs& args, const FingerClosedForm& closed, const json& report) {
   std::ostringstream out;
   if (args.g) {
     const FingerConfiguration q = closed.At(*args.g);
@@ -314,8 +342,8 @@ int RunFinger(const FingerArgs& args_in) {
         << " deg\ntheta3 = " << Fixed(q.theta[2]) << " deg\n";
   }
   out << "contacts:";
-  if (report["contacts"].empty()) out << " none";
-  for (const auto& c : report["contacts"]) {
+  if (report.at("contacts").empty()) out << " none";
+  for (const auto& c : report.at("contacts")) {
     out << " link " << c["link"].get<int>() << " at g = " << Fixed(c["g"].get<double>()) << " ("
         << c["by"].get<std::string>() << ");";
   }
@@ -323,39 +351,43 @@ int RunFinger(const FingerArgs& args_in) {
       << (std::isfinite(closed.stop()) ? "g = " + Fixed(closed.stop()) : "no g (still moving)")
       << "\n";
   if (args.simulate) {
-    const json& s = report["simulation"];
+    const json& s = report.at("simulation");
     out << "simulation (" << args.model << "): " << s["status"].get<std::string>()
         << ", max |theta difference| = " << s["max_angle_difference_deg"].get<double>()
         << " deg: " << (s["agrees"].get<bool>() ? "agrees" : "DISAGREES")
         << " with the closed form\n";
   }
-  WriteOutput("-", out.str());
-  return code;
+  return out.str();
 }
 
-int RunHand(const HandArgs& args) {
-  CheckDistinctFiles(
-      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
-      {{"--draw", args.draw}});
-  CheckOutputPlaces({{"--draw", args.draw}});
-  CheckMotor("--g", args.g);
+// The motor commands of fingers A, B and C: --g, or per finger --g-a, --g-b, --g-c (checked).
+std::array<double, 3> HandCommands(const HandArgs& args) {
   std::array<double, 3> commands = {args.g, args.g, args.g};
   const std::array<std::optional<double>, 3> per = {args.g_a, args.g_b, args.g_c};
-  const bool per_finger = args.g_a || args.g_b || args.g_c;
   for (int f = 0; f < 3; ++f) {
     if (per[f]) {
       CheckMotor(std::string("--g-") + "abc"[f], *per[f]);
       commands[f] = *per[f];
     }
   }
+  return commands;
+}
+
+// The spread motor position: --spread (checked), else the position of --mode.
+double HandSpread(const HandArgs& args) {
   const gripper::SpreadMode mode = gripper::SpreadModeByName(args.mode);
   double spread = gripper::Hand::SpreadPosition(mode);
   if (args.spread) {
     CheckMotor("--spread", *args.spread);
     spread = *args.spread;
   }
-  for (double g : args.draw_at) CheckMotor("--at", g);
-  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  return spread;
+}
+
+// The hand closing on `objects`; throws InputError if the hand cannot be built or no finger
+// reaches the objects.
+gripper::Hand HandOnObjects(const std::vector<Obstacle>& objects, double spread,
+                            const std::array<double, 3>& commands) {
   std::optional<gripper::Hand> hand;
   try {
     hand.emplace(objects, spread, commands);
@@ -367,79 +399,82 @@ int RunHand(const HandArgs& args) {
   if (!objects.empty() && !touched) {
     throw InputError("no finger reaches the object(s): the hand closes without touching them");
   }
-  const std::string names = "ABC";
+  return *std::move(hand);
+}
+
+// The "fingers" array of the hand report: per finger its command, its configuration at the end of
+// the closing, the contacts that take effect (other fingers named) and where it stops by itself.
+json HandFingersJson(const gripper::Hand& hand, const std::array<double, 3>& commands) {
   json fingers = json::array();
   for (int f = 0; f < 3; ++f) {
     std::array<std::string, 3> imposed;
-    for (const auto& t : hand->touches()) {
-      if (t.finger_a == f) imposed[t.link_a] = std::string("finger ") + names[t.finger_b];
-      if (t.finger_b == f) imposed[t.link_b] = std::string("finger ") + names[t.finger_a];
+    for (const auto& t : hand.touches()) {
+      if (t.finger_a == f) imposed[t.link_a] = std::string("finger ") + kFingerNames[t.finger_b];
+      if (t.finger_b == f) imposed[t.link_b] = std::string("finger ") + kFingerNames[t.finger_a];
     }
-    json j = {{"finger", std::string(1, names[f])}, {"command", commands[f]}};
-    j.update(ConfigurationJson(commands[f], hand->At(f, 255.0)));
+    json j = {{"finger", std::string(1, kFingerNames[f])}, {"command", commands[f]}};
+    j.update(ConfigurationJson(commands[f], hand.At(f, 255.0)));
     j.erase("g");
     j["contacts"] =
-        ContactsJson(hand->finger(f).closed_form(), hand->finger(f).blocked_by(), imposed);
+        ContactsJson(hand.finger(f).closed_form(), hand.finger(f).blocked_by(), imposed);
     // Where the finger stops by itself (phase 4), if before its command; else null.
-    const double stop = hand->finger(f).closed_form().stop();
+    const double stop = hand.finger(f).closed_form().stop();
     j["stop"] = StopJson(stop <= commands[f] ? stop : std::numeric_limits<double>::infinity());
     fingers.push_back(j);
   }
+  return fingers;
+}
+
+// The "finger_touches" array of the hand report.
+json HandTouchesJson(const gripper::Hand& hand) {
   json touches = json::array();
-  for (const auto& t : hand->touches()) {
-    touches.push_back({{"fingers", std::string{names[t.finger_a], names[t.finger_b]}},
+  for (const auto& t : hand.touches()) {
+    touches.push_back({{"fingers", std::string{kFingerNames[t.finger_a], kFingerNames[t.finger_b]}},
                        {"links", {t.link_a + 1, t.link_b + 1}},
                        {"g", t.g}});
   }
-  json report = {{"mode", args.mode},
-                 {"spread", spread},
-                 {"spread_angle_deg", hand->spread_angle()},
-                 {"fingers", fingers},
-                 {"finger_touches", touches}};
-  int code = 0;
-  if (args.simulate) {
-    const System model = ParseModelFile(args.model);
-    System system("hand");
-    try {
-      for (const Component& c : model.components()) {
-        if (c.source.name() == "finger") CheckFingerModel(c.source, args.model);
-      }
-      system = hand->ComposedAutomata(model, /*shared_command=*/!per_finger);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(args.model + ": " + UserMessage(e.what()));
+  return touches;
+}
+
+// `hybrid hand --simulate`: the finger automata of --model composed as `hand` has them, driven
+// by `commands` (one shared input u unless `per_finger`), compared with the closed form. Throws
+// InputError if --model has no suitable finger automaton.
+Comparison SimulateHand(const HandArgs& args, const gripper::Hand& hand,
+                        const std::array<double, 3>& commands, bool per_finger) {
+  const System model = ParseModelFile(args.model);
+  System system("hand");
+  try {
+    for (const Component& c : model.components()) {
+      if (c.source.name() == "finger") CheckFingerModel(c.source, args.model);
     }
-    std::vector<std::pair<std::string, double>> inputs;
-    if (per_finger) {
-      for (int f = 0; f < 3; ++f) inputs.emplace_back(std::string(1, names[f]) + ".u", commands[f]);
-    } else {
-      inputs.emplace_back("u", args.g);
+    system = hand.ComposedAutomata(model, /*shared_command=*/!per_finger);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.model + ": " + UserMessage(e.what()));
+  }
+  std::vector<std::pair<std::string, double>> inputs;
+  if (per_finger) {
+    for (int f = 0; f < 3; ++f) {
+      inputs.emplace_back(std::string(1, kFingerNames[f]) + ".u", commands[f]);
     }
-    std::vector<double> stops;
-    for (int f = 0; f < 3; ++f) stops.push_back(hand->finger(f).closed_form().stop());
-    const Comparison c = SimulateClosing(
-        system, {"A.", "B.", "C."}, inputs, stops,
-        [&](int f, double g) { return hand->finger(f).At(std::min(g, commands[f])).theta; });
-    const bool agrees = Agrees(c);
-    report["simulation"] = SimulationJson(c);
-    if (!agrees) code = kExitDisagrees;
+  } else {
+    inputs.emplace_back("u", args.g);
   }
-  if (!args.draw.empty()) {
-    std::vector<gripper::HandFrame> frames;
-    for (double g : DefaultFrames(args.draw_at)) {
-      frames.push_back({g, {hand->At(0, g), hand->At(1, g), hand->At(2, g)}});
-    }
-    WriteOutput(args.draw, gripper::HandDrawingSvg(*hand, frames));
-  }
-  if (args.json) {
-    WriteOutput("-", report.dump(2) + "\n");
-    return code;
-  }
+  std::vector<double> stops;
+  for (int f = 0; f < 3; ++f) stops.push_back(hand.finger(f).closed_form().stop());
+  return SimulateClosing(system, {"A.", "B.", "C."}, inputs, stops, [&](int f, double g) {
+    return hand.finger(f).At(std::min(g, commands[f])).theta;
+  });
+}
+
+// The text output of `hybrid hand` from its `report` (spread position `spread`).
+std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spread,
+                     const std::vector<Obstacle>& objects, const json& report) {
   std::ostringstream out;
   out << "hand, " << args.mode << " mode (spread s = " << FormatNumber(spread) << ", angle "
-      << Fixed(hand->spread_angle(), 3) << " deg)";
+      << Fixed(hand.spread_angle(), 3) << " deg)";
   for (const Obstacle& o : objects) out << ", object " << o.ToString();
   out << "\n";
-  for (const auto& j : fingers) {
+  for (const auto& j : report.at("fingers")) {
     out << "finger " << j["finger"].get<std::string>() << " (command "
         << FormatNumber(j["command"].get<double>()) << "): phase " << j["phase"].get<std::string>()
         << ", " << j["mode"].get<std::string>() << ", motor at "
@@ -453,19 +488,82 @@ int RunHand(const HandArgs& args) {
     }
     out << "\n";
   }
-  for (const auto& t : touches) {
+  for (const auto& t : report.at("finger_touches")) {
     out << "fingers " << t["fingers"].get<std::string>() << " touch (links "
         << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
         << ") at g = " << Fixed(t["g"].get<double>(), 4) << "\n";
   }
   if (args.simulate) {
-    const json& s = report["simulation"];
+    const json& s = report.at("simulation");
     out << "simulation of the composed automata: " << s["status"].get<std::string>()
         << ", max |theta difference| = " << s["max_angle_difference_deg"].get<double>()
         << " deg: " << (s["agrees"].get<bool>() ? "agrees" : "DISAGREES")
         << " with the closed form\n";
   }
-  WriteOutput("-", out.str());
+  return out.str();
+}
+
+}  // namespace
+
+int RunFinger(const FingerArgs& args_in) {
+  FingerArgs args = args_in;
+  const FingerContacts contacts = CheckFingerArgs(args);
+  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects);
+  const FingerClosedForm closed = geometric ? geometric->closed_form() : FingerClosedForm(contacts);
+  json report = FingerReport(args, closed, geometric, objects);
+  int code = 0;
+  if (args.simulate) {
+    const Comparison c = SimulateFinger(args, geometric, contacts, closed);
+    report["simulation"] = SimulationJson(c);
+    const bool agrees = Agrees(c);
+    if (!agrees) code = kExitDisagrees;
+  }
+  WriteOutputs(FingerFiles(args, closed, geometric, objects, contacts));
+  if (args.json) {
+    WriteOutput("-", report.dump(2) + "\n");
+    return code;
+  }
+  WriteOutput("-", FingerText(args, closed, report));
+  return code;
+}
+
+int RunHand(const HandArgs& args) {
+  CheckDistinctFiles(
+      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
+      {{"--draw", args.draw}});
+  CheckOutputPlaces({{"--draw", args.draw}});
+  CheckMotor("--g", args.g);
+  const std::array<double, 3> commands = HandCommands(args);
+  const bool per_finger = args.g_a || args.g_b || args.g_c;
+  const double spread = HandSpread(args);
+  for (double g : args.draw_at) CheckMotor("--at", g);
+  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  const gripper::Hand hand = HandOnObjects(objects, spread, commands);
+  json report = {{"mode", args.mode},
+                 {"spread", spread},
+                 {"spread_angle_deg", hand.spread_angle()},
+                 {"fingers", HandFingersJson(hand, commands)},
+                 {"finger_touches", HandTouchesJson(hand)}};
+  int code = 0;
+  if (args.simulate) {
+    const Comparison c = SimulateHand(args, hand, commands, per_finger);
+    const bool agrees = Agrees(c);
+    report["simulation"] = SimulationJson(c);
+    if (!agrees) code = kExitDisagrees;
+  }
+  if (!args.draw.empty()) {
+    std::vector<gripper::HandFrame> frames;
+    for (double g : DefaultFrames(args.draw_at)) {
+      frames.push_back({g, {hand.At(0, g), hand.At(1, g), hand.At(2, g)}});
+    }
+    WriteOutput(args.draw, gripper::HandDrawingSvg(hand, frames));
+  }
+  if (args.json) {
+    WriteOutput("-", report.dump(2) + "\n");
+    return code;
+  }
+  WriteOutput("-", HandText(args, hand, spread, objects, report));
   return code;
 }
 
