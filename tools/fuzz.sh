@@ -12,6 +12,7 @@
 #   harness...     some of: fuzz_model_parser fuzz_round_trip fuzz_signal fuzz_object
 #                  fuzz_measured_data fuzz_numbers fuzz_options (default: all)
 # Each harness runs with -max_total_time=N -rss_limit_mb=2048 -timeout=10 (seconds per input),
+# (HYBRID_FUZZ_RSS_MB overrides the 2048 MB of -rss_limit_mb and -malloc_limit_mb: long runs),
 # leak detection on and -print_final_stats=1; its corpus is DIR/fuzz/corpus/HARNESS (seeds copied
 # in by tests/fuzz/collect_seeds.py), its log DIR/fuzz/logs/HARNESS.log, and any crashing, timing
 # out, leaking or memory-exhausting input is written to DIR/fuzz/findings/HARNESS/ (those of
@@ -30,7 +31,7 @@ fresh=0
 build=1
 harnesses=()
 extra=()
-usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=${2:?}; shift 2 ;;
@@ -45,8 +46,9 @@ while [ $# -gt 0 ]; do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-for n in "$seconds" "$jobs" ${runs:+"$runs"}; do
-  [[ "$n" =~ ^[1-9][0-9]*$ ]] || { echo "fuzz.sh: '$n' is not a positive integer" >&2; exit 2; }
+rss_mb=${HYBRID_FUZZ_RSS_MB:-2048}
+for n in "$seconds" "$jobs" "$rss_mb" ${runs:+"$runs"}; do
+  [[ "$n" =~ ^[1-9][0-9]*$ ]] || { echo "fuzz.sh: '$n' is not a positive integer (--seconds, --runs, --jobs, HYBRID_FUZZ_RSS_MB)" >&2; exit 2; }
 done
 [ ${#harnesses[@]} -gt 0 ] || harnesses=("${all_harnesses[@]}")
 for h in "${harnesses[@]}"; do
@@ -95,7 +97,7 @@ run_one() {
   [ "$fresh" -eq 0 ] || rm -rf "$corpus"
   mkdir -p "$corpus" "$findings"
   python3 "$root/tests/fuzz/collect_seeds.py" "$root" "$h" "$corpus" >/dev/null
-  local flags=(-max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=2048 -timeout=10
+  local flags=(-max_total_time="$seconds" -rss_limit_mb="$rss_mb" -malloc_limit_mb="$rss_mb" -timeout=10
                -detect_leaks=1 -print_final_stats=1 -close_fd_mask=1
                -artifact_prefix="$findings/"
                -dict="$root/tests/fuzz/dictionaries/$(dictionary "$h").dict")
@@ -128,7 +130,7 @@ for h in "${harnesses[@]}"; do
   findings=() stalls=()
   for f in $(find "$work/findings/$h" -type f -newer "$stamp" | sort); do
     if [[ "$(basename "$f")" == timeout-* ]] &&
-       "$build_dir/tests/fuzz/$h" -timeout=10 -rss_limit_mb=2048 "$f" >"$log.rerun" 2>&1; then
+       "$build_dir/tests/fuzz/$h" -timeout=10 -rss_limit_mb="$rss_mb" "$f" >"$log.rerun" 2>&1; then
       stalls+=("$f")
     else
       findings+=("$f")
