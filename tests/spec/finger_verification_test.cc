@@ -7,8 +7,8 @@
 #include <string>
 
 #include "automaton/parser.h"
-#include "solvers/verification/property_prover.h"
 #include "solvers/simulation/simulator.h"
+#include "solvers/verification/property_prover.h"
 #include "solvers/verification/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"

@@ -1,12 +1,13 @@
 #pragma once
 
 // Random hybrid automata written as model-language TEXT, for the differential soundness test
-// (tests/solvers/verification/soundness_test.cc). The generator never touches the IR builders of the code under
-// test: it keeps its own small description of the automaton (flows, guards, resets, properties as
-// sums of products of names), prints that as a `.ha` text for the parser, and evaluates the
-// properties' predicates itself, so that a test can judge a simulated state without the checker's
-// code. Randomness comes from a caller-owned std::mt19937_64 only (no distribution objects, whose
-// output the C++ standard leaves to the library): one seed gives the same models everywhere.
+// (tests/solvers/verification/soundness_test.cc). The generator never touches the IR builders of
+// the code under test: it keeps its own small description of the automaton (flows, guards, resets,
+// properties as sums of products of names), prints that as a `.ha` text for the parser, and
+// evaluates the properties' predicates itself, so that a test can judge a simulated state without
+// the checker's code. Randomness comes from a caller-owned std::mt19937_64 only (no distribution
+// objects, whose output the C++ standard leaves to the library): one seed gives the same models
+// everywhere.
 
 #include <cstdint>
 #include <map>

@@ -1,5 +1,5 @@
-// Tests of the CVODE RAII wrapper on its own (solvers/simulation/cvode_integrator.h): accuracy on x' = -x,
-// root location with crossing directions, restarts with another number of root functions,
+// Tests of the CVODE RAII wrapper on its own (solvers/simulation/cvode_integrator.h): accuracy on
+// x' = -x, root location with crossing directions, restarts with another number of root functions,
 // interpolation inside the last step, run-time failures reported as a status (leaking nothing),
 // CVODE messages kept for message() instead of printed, and a first step that does not depend on
 // how far away the stop time is.

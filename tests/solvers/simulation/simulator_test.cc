@@ -1,7 +1,7 @@
-// Tests of the simulator (solvers/simulation/simulator.h): event times against analytic solutions of the
-// bundled models, every special case of the event semantics on small hand-written models, misuse,
-// and rapidcheck properties (invariants hold, crossing events sit on a guard boundary, runs are
-// deterministic) on random initial states, parameters and input signals.
+// Tests of the simulator (solvers/simulation/simulator.h): event times against analytic solutions
+// of the bundled models, every special case of the event semantics on small hand-written models,
+// misuse, and rapidcheck properties (invariants hold, crossing events sit on a guard boundary, runs
+// are deterministic) on random initial states, parameters and input signals.
 
 #include "solvers/simulation/simulator.h"
 

@@ -1,6 +1,6 @@
-// Tests of the verdict names (solvers/verification/check_result.h): every verdict has its own documented name,
-// and a default CheckResult is an undecided `always` property; ConfirmTrace lets a `violated` or
-// `reachable` verdict through only with a trace that replays.
+// Tests of the verdict names (solvers/verification/check_result.h): every verdict has its own
+// documented name, and a default CheckResult is an undecided `always` property; ConfirmTrace lets a
+// `violated` or `reachable` verdict through only with a trace that replays.
 
 #include "solvers/verification/check_result.h"
 

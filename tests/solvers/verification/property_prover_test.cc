@@ -1,5 +1,5 @@
-// Tests of the SMT prover (solvers/verification/property_prover.h) on small models: invariants kept by an
-// urgent transition are proved and broken ones violated with a trace the simulator replays;
+// Tests of the SMT prover (solvers/verification/property_prover.h) on small models: invariants kept
+// by an urgent transition are proved and broken ones violated with a trace the simulator replays;
 // reachable targets get replayed witnesses and impossible ones are proved unreachable; uncertain
 // parameters are covered over their ranges; instances of one automaton share the proof; misuse
 // throws; and the finger model (spec/finger.ha): its invariants are proved and its modes'

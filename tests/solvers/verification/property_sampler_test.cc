@@ -1,7 +1,7 @@
-// Tests of the sampling checker (solvers/verification/property_sampler.h): counterexamples and witnesses found
-// on small models, shrunk to minimal input schedules, parameter values and initial values; true
-// invariants stay unknown; results are repeatable for a seed; misuse throws; and a broken copy of
-// the finger model (spec/finger.ha) is caught.
+// Tests of the sampling checker (solvers/verification/property_sampler.h): counterexamples and
+// witnesses found on small models, shrunk to minimal input schedules, parameter values and initial
+// values; true invariants stay unknown; results are repeatable for a seed; misuse throws; and a
+// broken copy of the finger model (spec/finger.ha) is caught.
 
 #include "solvers/verification/property_sampler.h"
 

@@ -1,5 +1,5 @@
-// Tests of the bounded-path encoding (solvers/verification/smt_encoding.h), with Z3 directly: flows are
-// classified as documented; every flow segment the simulator runs (with a constant input, not
+// Tests of the bounded-path encoding (solvers/verification/smt_encoding.h), with Z3 directly: flows
+// are classified as documented; every flow segment the simulator runs (with a constant input, not
 // crossing a guard) is a model of the encoding (soundness, a rapidcheck property); a segment that
 // passes through an urgent guard's region is not (urgency); and on the finger's phase-3 law
 // (separable), a segment from a state on the law's curve reaches exactly the point on the curve.

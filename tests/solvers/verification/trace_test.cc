@@ -1,7 +1,7 @@
-// Tests of traces (solvers/verification/trace.h): the uncertain parameters of automata and systems; replaying
-// a trace finds the first recorded state that violates (`always`, `never`) or satisfies (`reach`)
-// a property, within a `within T` horizon, with the documented tolerance; the trace's parameter
-// and initial values are applied; misuse throws.
+// Tests of traces (solvers/verification/trace.h): the uncertain parameters of automata and systems;
+// replaying a trace finds the first recorded state that violates (`always`, `never`) or satisfies
+// (`reach`) a property, within a `within T` horizon, with the documented tolerance; the trace's
+// parameter and initial values are applied; misuse throws.
 
 #include "solvers/verification/trace.h"
 
