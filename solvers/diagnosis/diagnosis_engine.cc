@@ -108,6 +108,13 @@ class Engine {
                                     std::to_string(run.channels.size()) + " channels, not " +
                                     std::to_string(channels));
       }
+      for (const std::vector<double>& channel : run.channels) {
+        if (channel.size() != run.input.size()) {
+          throw std::invalid_argument(
+              "Diagnose: run '" + run.label + "' has " + std::to_string(run.input.size()) +
+              " input samples but a channel of " + std::to_string(channel.size()));
+        }
+      }
       samples_ += static_cast<int>(run.input.size());
     }
   }
@@ -122,8 +129,18 @@ class Engine {
   const DiagnosisOptions& options() const { return o_; }
   const CandidateParameter& parameter(int p) const { return model_.Parameters()[p]; }
 
+  // The model's prediction of run r, checked to have the run's shape (a model that returns
+  // another is misused: std::logic_error).
   RunPrediction Predict(int r, const ParameterValues& values) const {
-    return model_.Predict(r, values);
+    RunPrediction p = model_.Predict(r, values);
+    const size_t n = runs_[r].input.size();
+    bool fits = p.channels.size() == sigma_.size() && p.mode.size() == n && p.direction.size() == n;
+    for (const std::vector<double>& channel : p.channels) fits = fits && channel.size() == n;
+    if (!fits) {
+      throw std::logic_error("Diagnose: the model's prediction of run '" + runs_[r].label +
+                             "' does not have the run's channels and samples");
+    }
+    return p;
   }
 
   // The predictions of every run under `values` (in parallel).

@@ -137,6 +137,25 @@ TEST(DiagnoseModel, RefusesInconsistentInput) {
   EXPECT_THROW(DiagnoseModel(model, runs, ChannelNoise{{0.01, 0.01}, {10, 10}}),
                std::invalid_argument);
   EXPECT_THROW(DiagnoseModel(model, runs, ChannelNoise{{0.01}, {}}), std::invalid_argument);
+  std::vector<DiagnosisRun> ragged = runs;
+  ragged[2].channels[0].pop_back();
+  EXPECT_THROW(DiagnoseModel(model, ragged, ChannelNoise{{0.01}, {10}}), std::invalid_argument);
+}
+
+// A model whose predictions do not have the runs' shape is refused, not read out of bounds.
+TEST(DiagnoseModel, RefusesPredictionsOfAnotherShape) {
+  class Short : public LineModel {
+   public:
+    using LineModel::LineModel;
+    RunPrediction Predict(int run, const ParameterValues& values) const override {
+      RunPrediction p = LineModel::Predict(run, values);
+      p.channels[0].pop_back();
+      return p;
+    }
+  };
+  const auto runs = Runs([](double x) { return x; }, 6);
+  const Short model(runs, {"offset"});
+  EXPECT_THROW(DiagnoseModel(model, runs, ChannelNoise{{0.01}, {10}}), std::logic_error);
 }
 
 }  // namespace
