@@ -89,20 +89,10 @@ void Translate(const ModelDiagnosis& m, const FingerDiagnosisModel& model, const
   d.effects = model.Effects(m.parameters);
   d.baseline_mse = Joints(m.baseline_mse);
   d.extended_mse = Joints(m.extended_mse);
-  for (const ChannelResiduals& g : m.residuals) {
-    d.residuals.push_back(ResidualGroup{g.channel, g.mode, g.direction, g.samples, g.mean, g.slope,
-                                        g.rms, g.excess, g.input_min, g.input_max});
-  }
-  for (const ResidualJump& c : m.change_points) {
-    d.change_points.push_back(
-        ChangePoint{c.run, c.sample, c.input, c.from_mode, c.to_mode, c.channel, c.jump});
-  }
+  d.residuals = m.residuals;
+  d.change_points = m.change_points;
   d.direction_difference = Joints(m.direction_difference);
-  if (m.where) {
-    const SystematicResidual& w = *m.where;
-    d.where = ResidualLocation{w.channel,   w.mode,          w.direction, w.input_min,
-                               w.input_max, w.mean_residual, w.excess};
-  }
+  d.where = m.where;
   for (const ParameterFit& f : m.candidates) d.candidates.push_back(AsCandidateFit(f, model));
   for (size_t r = 0; r < data.runs.size(); ++r) {
     d.curves.push_back(RunCurves{data.runs[r].label, data.runs[r].g, data.runs[r].theta,

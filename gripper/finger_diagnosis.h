@@ -34,39 +34,15 @@ struct CandidateFit {
   bool significant = false;
 };
 
-/// Baseline residuals of one joint in one mode and direction of travel.
-struct ResidualGroup {
-  int joint = 0;  ///< 0..2
-  std::string mode;
-  int direction = 1;  ///< +1 closing, -1 opening
-  int samples = 0;
-  double mean = 0.0;   ///< bias, deg
-  double slope = 0.0;  ///< trend, deg per count of g
-  double rms = 0.0;
-  /// mean square / noise variance - 1 (0 for pure noise).
-  double excess = 0.0;
-  double g_min = 0.0, g_max = 0.0;
-};
+/// Baseline residuals of one joint (channel 0..2 = theta1..3) in one mode and direction of
+/// travel (+1 closing, -1 opening); input = g, deg.
+using ResidualGroup = ChannelResiduals;
 
-/// A jump of the mean residual where the baseline switches mode.
-struct ChangePoint {
-  std::string run;
-  int sample = 0;
-  double g = 0.0;
-  std::string from_mode, to_mode;
-  int joint = 0;
-  double jump = 0.0;  ///< mean residual over the next 10 samples minus the previous 10, deg
-};
+/// A jump of the mean residual where the baseline switches mode (input = g).
+using ChangePoint = ResidualJump;
 
-/// Where a systematic residual is, when no candidate explains it.
-struct ResidualLocation {
-  int joint = 0;
-  std::string mode;
-  int direction = 1;
-  double g_min = 0.0, g_max = 0.0;
-  double mean_residual = 0.0;
-  double excess = 0.0;
-};
+/// Where a systematic residual is, when no candidate explains it (input = g).
+using ResidualLocation = SystematicResidual;
 
 /// Measured, baseline and extended angles of one run (for plots).
 struct RunCurves {

@@ -78,10 +78,12 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   out["noise_floor"] = noise;
   out["mse_unit"] = "deg^2";
   if (d.where) {
-    out["where"] = {
-        {"joint", kJoints[d.where->joint]},           {"mode", d.where->mode},
-        {"direction", Direction(d.where->direction)}, {"g_range", {d.where->g_min, d.where->g_max}},
-        {"mean_residual", d.where->mean_residual},    {"excess", d.where->excess}};
+    out["where"] = {{"joint", kJoints[d.where->channel]},
+                    {"mode", d.where->mode},
+                    {"direction", Direction(d.where->direction)},
+                    {"g_range", {d.where->input_min, d.where->input_max}},
+                    {"mean_residual", d.where->mean_residual},
+                    {"excess", d.where->excess}};
   } else {
     out["where"] = nullptr;
   }
@@ -102,7 +104,7 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   out["candidates"] = candidates;
   json groups = json::array();
   for (const ResidualGroup& g : d.residuals) {
-    groups.push_back({{"joint", kJoints[g.joint]},
+    groups.push_back({{"joint", kJoints[g.channel]},
                       {"mode", g.mode},
                       {"direction", Direction(g.direction)},
                       {"samples", g.samples},
@@ -110,7 +112,7 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
                       {"trend_per_count", g.slope},
                       {"rms", g.rms},
                       {"excess", g.excess},
-                      {"g_range", {g.g_min, g.g_max}}});
+                      {"g_range", {g.input_min, g.input_max}}});
   }
   out["residuals"] = groups;
   json dir = json::object();
@@ -120,10 +122,10 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   for (const ChangePoint& c : d.change_points) {
     changes.push_back({{"run", c.run},
                        {"sample", c.sample},
-                       {"g", c.g},
+                       {"g", c.input},
                        {"from_mode", c.from_mode},
                        {"to_mode", c.to_mode},
-                       {"joint", kJoints[c.joint]},
+                       {"joint", kJoints[c.channel]},
                        {"jump", c.jump}});
   }
   out["change_points"] = changes;
@@ -156,9 +158,9 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
     out << "  " << ParameterName(p) << " = " << Fixed(v, 4) << " " << ParameterUnit(p) << "\n";
   }
   if (d.where) {
-    out << "where: " << kJoints[d.where->joint] << ", mode " << d.where->mode << ", "
-        << Direction(d.where->direction) << ", g in [" << Fixed(d.where->g_min, 1) << ", "
-        << Fixed(d.where->g_max, 1) << "], mean residual " << Fixed(d.where->mean_residual, 2)
+    out << "where: " << kJoints[d.where->channel] << ", mode " << d.where->mode << ", "
+        << Direction(d.where->direction) << ", g in [" << Fixed(d.where->input_min, 1) << ", "
+        << Fixed(d.where->input_max, 1) << "], mean residual " << Fixed(d.where->mean_residual, 2)
         << " deg\n";
   }
   out << "held-out MSE (deg^2)      theta1    theta2    theta3\n";

@@ -558,32 +558,24 @@ struct RefinementCost {
 // search ranges, from the cross-validated values); `values` when no solution is usable.
 std::vector<double> Refine(const Engine& e, const std::vector<int>& named,
                            const std::vector<double>& values) {
-  const std::vector<std::vector<double>> starts = {values};
-  double best_cost = std::numeric_limits<double>::infinity();
-  std::vector<double> best = values;
-  for (std::vector<double> x : starts) {
-    ceres::Problem problem;
-    auto* cost = new ceres::DynamicNumericDiffCostFunction<RefinementCost, ceres::CENTRAL>(
-        new RefinementCost{&e, named});
-    cost->AddParameterBlock(static_cast<int>(x.size()));
-    cost->SetNumResiduals(e.channels() * e.samples());
-    problem.AddResidualBlock(cost, nullptr, x.data());
-    for (size_t i = 0; i < named.size(); ++i) {
-      problem.SetParameterLowerBound(x.data(), static_cast<int>(i), e.parameter(named[i]).lo);
-      problem.SetParameterUpperBound(x.data(), static_cast<int>(i), e.parameter(named[i]).hi);
-    }
-    ceres::Solver::Options so;
-    so.max_num_iterations = 12;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    if (summary.IsSolutionUsable() && summary.final_cost < best_cost) {
-      best_cost = summary.final_cost;
-      best = x;
-    }
+  std::vector<double> x = values;
+  ceres::Problem problem;
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<RefinementCost, ceres::CENTRAL>(
+      new RefinementCost{&e, named});
+  cost->AddParameterBlock(static_cast<int>(x.size()));
+  cost->SetNumResiduals(e.channels() * e.samples());
+  problem.AddResidualBlock(cost, nullptr, x.data());
+  for (size_t i = 0; i < named.size(); ++i) {
+    problem.SetParameterLowerBound(x.data(), static_cast<int>(i), e.parameter(named[i]).lo);
+    problem.SetParameterUpperBound(x.data(), static_cast<int>(i), e.parameter(named[i]).hi);
   }
-  return best;
+  ceres::Solver::Options so;
+  so.max_num_iterations = 12;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  return summary.IsSolutionUsable() ? x : values;
 }
 
 // Step 4 of DiagnoseModel for an unexplained residual: the group of largest total excess, and

@@ -27,7 +27,7 @@ struct DiagnosisOptions {
   int grid_points = 9;
   /// The same for the second parameter of a pair (the first one fixed).
   int pair_grid_points = 7;
-  /// Refine the selected parameters with Ceres (robust loss, several starts).
+  /// Refine the selected parameters with Ceres (robust loss, from the cross-validated values).
   bool refine = true;
   /// Worker threads for the simulations (>= 1).
   int threads = 2;

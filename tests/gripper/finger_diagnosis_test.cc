@@ -104,7 +104,7 @@ std::string Describe(const Diagnosis& d) {
   for (size_t i = 0; i < d.cause.size(); ++i) s << (i ? "+" : "") << d.cause[i];
   for (const auto& [p, v] : d.parameters) s << " " << ParameterName(p) << "=" << v;
   if (d.where) {
-    s << " where=theta" << d.where->joint + 1 << "/" << d.where->mode << "/"
+    s << " where=theta" << d.where->channel + 1 << "/" << d.where->mode << "/"
       << (d.where->direction > 0 ? "closing" : "opening");
   }
   return s.str();
@@ -164,7 +164,7 @@ TEST(DiagnoseTest, GearRippleIsUnexplained) {
   const Diagnosis d = DiagnoseSynthetic(hidden, 3);
   EXPECT_EQ(d.cause, std::vector<std::string>{"unexplained"}) << Describe(d);
   ASSERT_TRUE(d.where.has_value()) << Describe(d);
-  EXPECT_LE(d.where->g_min, d.where->g_max);
+  EXPECT_LE(d.where->input_min, d.where->input_max);
   EXPECT_GT(d.where->excess, 0.0);
 }
 
@@ -174,8 +174,8 @@ TEST(DiagnoseTest, Theta3HysteresisIsUnexplainedOnTheta3) {
   const Diagnosis d = DiagnoseSynthetic(hidden, 3);
   EXPECT_EQ(d.cause, std::vector<std::string>{"unexplained"}) << Describe(d);
   ASSERT_TRUE(d.where.has_value()) << Describe(d);
-  EXPECT_EQ(d.where->joint, 2) << Describe(d);
-  EXPECT_LE(d.where->g_min, d.where->g_max);
+  EXPECT_EQ(d.where->channel, 2) << Describe(d);
+  EXPECT_LE(d.where->input_min, d.where->input_max);
   // A direction-dependent offset: the baseline residual of theta3 differs between closing and
   // opening by about 2 h.
   EXPECT_NEAR(d.direction_difference[2], 4.0, 1.0);
@@ -347,7 +347,7 @@ Verdict Judge(const Effect& e, const Diagnosis& d) {
       break;
     case Other::kHysteresis:
       v.hit = d.cause == std::vector<std::string>{"unexplained"} && d.where.has_value() &&
-              d.where->joint == 2;
+              d.where->channel == 2;
       break;
   }
   return v;
