@@ -1,7 +1,5 @@
 #include "automaton/parser.h"
 
-#include <pthread.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -17,6 +15,8 @@
 #include <tao/pegtl/contrib/limit_depth.hpp>
 #include <tao/pegtl/contrib/parse_tree.hpp>
 #include <vector>
+
+#include "automaton/stack_thread.h"
 
 namespace hybrid {
 
@@ -1182,37 +1182,23 @@ void Builder::Merge(const Node& n, const std::map<std::string, Automaton>& autom
 // 1 MiB caller stack). Only the pages touched are committed.
 constexpr std::size_t kParserStackBytes = std::size_t{64} << 20;
 
-// Runs `f` on a thread with a kParserStackBytes stack; returns its result or rethrows what it
-// throws. If no thread can be made, runs `f` here.
+// The thread with a kParserStackBytes stack that parses for the calling thread: made on its first
+// parse, reused by every later one, ended with it.
+StackThread& ParserThread() {
+  thread_local StackThread thread(kParserStackBytes);
+  return thread;
+}
+
+// Runs `f` on ParserThread(); returns its result or rethrows what it throws. Runs `f` here if
+// already on such a stack (an import parsed during a parse) or if no thread can be made.
 template <class F>
 auto OnParserStack(F f) -> decltype(f()) {
-  using Result = decltype(f());
-  struct Call {
-    F* f;
-    std::optional<Result> result;
-    std::exception_ptr error;
-  } call{&f, std::nullopt, nullptr};
-  auto body = [](void* p) -> void* {
-    auto* c = static_cast<Call*>(p);
-    try {
-      c->result.emplace((*c->f)());
-    } catch (...) {
-      c->error = std::current_exception();
-    }
-    return nullptr;
-  };
-  pthread_attr_t attr;
-  pthread_t thread;
-  bool started = false;
-  if (pthread_attr_init(&attr) == 0) {
-    started = pthread_attr_setstacksize(&attr, kParserStackBytes) == 0 &&
-              pthread_create(&thread, &attr, body, &call) == 0;
-    pthread_attr_destroy(&attr);
-  }
-  if (!started) return f();
-  pthread_join(thread, nullptr);
-  if (call.error) std::rethrow_exception(call.error);
-  return std::move(*call.result);
+  if (StackThread::CurrentStackBytes() >= kParserStackBytes) return f();
+  StackThread& thread = ParserThread();
+  if (!thread.running()) return f();
+  std::optional<decltype(f())> result;
+  thread.Run([&] { result.emplace(f()); });
+  return std::move(*result);
 }
 
 // The imports of a top-level file of `bytes` bytes: the file itself is active, so that

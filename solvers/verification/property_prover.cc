@@ -12,6 +12,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "solvers/verification/cpu_watchdog.h"
 #include "solvers/verification/smt_encoding.h"
 
 namespace hybrid {
@@ -136,7 +137,8 @@ std::uint64_t ResourceCount(const z3::solver& s) {
 // Runs the solver queries of one Z3 context against a SolverBudget.
 class Meter {
  public:
-  explicit Meter(SolverBudget& budget) : budget_(budget) {}
+  Meter(z3::context& ctx, SolverBudget& budget)
+      : budget_(budget), watchdog_([&ctx] { ctx.interrupt(); }) {}
 
   // s.check() (for `what`, in HYBRID_CHECK_TIMING's report) with at most `cap` resource units
   // and never past `ceiling` (a level of
@@ -146,6 +148,9 @@ class Meter {
     if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
       ++starved_;
       return z3::unknown;
+    }
+    for (const z3::solver& stopped : stopped_solvers_) {
+      if (static_cast<Z3_solver>(stopped) == static_cast<Z3_solver>(s)) return z3::unknown;
     }
     if (std::getenv("HYBRID_CHECK_TIMING")) std::cerr << "query start (" << what << ")\n";
     // What is left, rounded down to a power of two when less than `cap`: setting a solver's
@@ -157,16 +162,14 @@ class Meter {
       allowed = 1;
       while (allowed * 2 <= left) allowed *= 2;
     }
-    // The wall-clock limit of the query, from the units it may use (10 s per budget second, at
-    // least 10 s): work Z3 does not count (a search query of the finger's --modes ran for 20
-    // minutes on a constant limit of the whole deadline) is cut there.
-    const unsigned safety = budget_.SafetyMilliseconds(allowed);
+    // The CPU-time limit of the query, from the units it may use (10 s per budget second, at
+    // least 10 s): work Z3 does not count (a search query of the finger's --modes spent 100 s on
+    // 1.8 million units, Z3's large-number arithmetic) is cut there.
     const bool same =
         last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
     if (!same || last_allowed_ != allowed) {
       z3::params p(s.ctx());
       p.set("rlimit", static_cast<unsigned>(allowed));
-      p.set("timeout", safety);
       s.set(p);
       last_solver_ = s;  // held, so that no other solver can take its address
       last_allowed_ = allowed;
@@ -177,16 +180,24 @@ class Meter {
           << s.to_smt2();
     }
     const Clock::time_point t0 = Clock::now();
-    const z3::check_result r = s.check();
+    watchdog_.Arm(budget_.SafetyCpuSeconds(allowed));
+    z3::check_result r = s.check();
+    const bool stopped = watchdog_.Disarm();
     const double seconds = Since(t0);
     const std::uint64_t count = ResourceCount(s);
     const std::uint64_t spent = count > seen_ ? count - seen_ : 0;
     seen_ = std::max(seen_, count);
-    budget_.Charge(spent);
-    if (r == z3::unknown) {
-      if (spent < allowed && seconds * 1000.0 >= 0.9 * safety) budget_.NoteSafetyStop();
-      if (allowed < cap) ++starved_;
+    if (stopped) {
+      // Where the net stopped the query depends on the machine's speed; what it charges and
+      // what follows on this solver must not: the whole allowance, and no further query.
+      r = z3::unknown;
+      budget_.Charge(std::max<std::uint64_t>(spent, allowed));
+      budget_.NoteSafetyStop();
+      stopped_solvers_.push_back(s);
+    } else {
+      budget_.Charge(spent);
     }
+    if (r == z3::unknown && allowed < cap) ++starved_;
     if (std::getenv("HYBRID_CHECK_TIMING")) {
       std::cerr << "query: " << r << ", " << spent << " units, " << seconds << " s (" << what
                 << ")\n";
@@ -214,6 +225,10 @@ class Meter {
   int dumped_ = 0;
   std::optional<z3::solver> last_solver_;  // the solver of the last query, and its rlimit
   std::uint64_t last_allowed_ = 0;
+  // Solvers whose query the safety net stopped: their state depends on where it stopped, so
+  // they get no further query (held, so that no other solver can take their address).
+  std::vector<z3::solver> stopped_solvers_;
+  CpuWatchdog watchdog_;  // the safety net; interrupts the context
 };
 
 // The check of one automaton (one Job) within `share` resource units of the budget: its Z3
@@ -231,7 +246,7 @@ class JobRun {
         job_(job),
         a_(*job.automaton),
         enc_(ctx_, a_),
-        meter_(budget),
+        meter_(ctx_, budget),
         bmc_(MakeIncremental(ctx_)),
         first_(budget.used()),
         share_(share) {}
@@ -800,8 +815,8 @@ void JobRun::Conclude() {
   }
   if (budget_.safety_stopped()) {
     note +=
-        "a solver query was stopped by the wall-clock safety limit, so this result may "
-        "depend on the machine; ";
+        "a solver query was stopped by the CPU-time safety limit (work the solver does not "
+        "count), so this result may depend on the machine's speed; ";
   }
   const std::string depth = std::to_string(options_.max_depth);
   const std::string paths = searched_ >= 0 ? " after paths of " + std::to_string(searched_) +
@@ -1159,18 +1174,20 @@ SolverBudget::SolverBudget(double seconds) : seconds_(seconds) {
   }
   total_ = static_cast<std::uint64_t>(
       std::ceil(seconds * static_cast<double>(kResourceUnitsPerBudgetSecond)));
-  start_ = std::chrono::steady_clock::now();
+  start_cpu_ = CpuSeconds(CLOCK_PROCESS_CPUTIME_ID);
 }
 
 double SolverBudget::SafetySeconds() const { return std::max(60.0, 10.0 * seconds_); }
 
-unsigned SolverBudget::SafetyMilliseconds(std::uint64_t units) const {
-  const double ms =
-      10000.0 * static_cast<double>(units) / static_cast<double>(kResourceUnitsPerBudgetSecond);
-  return static_cast<unsigned>(std::clamp(ms, 10000.0, std::min(1000.0 * SafetySeconds(), 4.0e9)));
+double SolverBudget::SafetyCpuSeconds(std::uint64_t units) const {
+  const double seconds =
+      10.0 * static_cast<double>(units) / static_cast<double>(kResourceUnitsPerBudgetSecond);
+  return std::clamp(seconds, 10.0, SafetySeconds());
 }
 
-bool SolverBudget::SafetyExpired() const { return Since(start_) > SafetySeconds(); }
+bool SolverBudget::SafetyExpired() const {
+  return CpuSeconds(CLOCK_PROCESS_CPUTIME_ID) - start_cpu_ > SafetySeconds();
+}
 
 double PropertyProver::BudgetSeconds() const {
   return options_.search_seconds > 0 ? options_.search_seconds : options_.budget;

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -27,11 +26,14 @@ inline constexpr std::uint64_t kResourceUnitsPerBudgetSecond = 2'500'000;
 /// the same check with the same budget always gives the same verdicts. A query is given at most
 /// what is left; once nothing is left, no query runs and what is undecided stays `unknown`.
 ///
-/// A safety net bounds wall-clock time where Z3 does not count its work (some nonlinear
-/// arithmetic): with T = max(60 s, 10 s per budget second), no query starts later than T after
-/// the budget's creation, and a query given u units runs at most 10 s per budget second of u
-/// (at least 10 s, at most T). Only when it fires can a verdict depend on the machine: what it
-/// stops is `unknown`, and the reasons say so.
+/// A safety net bounds CPU time where Z3 does not count its work (its large-number arithmetic,
+/// some nonlinear arithmetic): with T = max(60 s, 10 s per budget second), no query starts after
+/// the process has used T of CPU time since the budget's creation, and a query given u units runs
+/// at most 10 s of CPU time per budget second of u (at least 10 s, at most T). CPU time, not
+/// wall-clock time, so that the machine's load does not change where it fires; a query it stops
+/// is `unknown`, is charged its whole allowance, and its solver gets no further query, so that
+/// what follows does not depend on where it stopped. Only the machine's speed can then change a
+/// verdict, and the reasons say when the net fired.
 class SolverBudget {
  public:
   /// A budget of `seconds` budget seconds (positive and finite, at most 10^6), i.e. seconds *
@@ -45,11 +47,12 @@ class SolverBudget {
   /// Records `units` spent (the budget may be overdrawn by the last query's overshoot).
   void Charge(std::uint64_t units) { used_ += units; }
 
-  /// The safety net's deadline, in seconds from the budget's creation: max(60, 10 * seconds()).
+  /// The safety net's deadline, in seconds of the process's CPU time from the budget's
+  /// creation: max(60, 10 * seconds()).
   double SafetySeconds() const;
-  /// The time limit of a query given `units` resource units, in milliseconds: 10 s per budget
+  /// The CPU-time limit of a query given `units` resource units, in seconds: 10 s per budget
   /// second of `units`, at least 10 s, at most SafetySeconds().
-  unsigned SafetyMilliseconds(std::uint64_t units) const;
+  double SafetyCpuSeconds(std::uint64_t units) const;
   /// Whether the deadline has passed (no query may start).
   bool SafetyExpired() const;
   /// Records that the safety net stopped a query; safety_stopped() tells.
@@ -60,7 +63,7 @@ class SolverBudget {
   double seconds_;
   std::uint64_t total_;
   std::uint64_t used_ = 0;
-  std::chrono::steady_clock::time_point start_;
+  double start_cpu_ = 0.0;  // the process's CPU time at creation, in seconds
   bool safety_stopped_ = false;
 };
 
