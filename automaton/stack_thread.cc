@@ -1,5 +1,7 @@
 #include "automaton/stack_thread.h"
 
+#include <unistd.h>
+
 #include <stdexcept>
 #include <utility>
 
@@ -11,7 +13,7 @@ thread_local std::size_t current_stack_bytes = 0;
 
 }  // namespace
 
-StackThread::StackThread(std::size_t stack_bytes) : stack_bytes_(stack_bytes) {
+StackThread::StackThread(std::size_t stack_bytes) : stack_bytes_(stack_bytes), owner_(getpid()) {
   pthread_attr_t attr;
   if (pthread_attr_init(&attr) != 0) return;
   running_ = pthread_attr_setstacksize(&attr, stack_bytes) == 0 &&
@@ -20,7 +22,7 @@ StackThread::StackThread(std::size_t stack_bytes) : stack_bytes_(stack_bytes) {
 }
 
 StackThread::~StackThread() {
-  if (!running_) return;
+  if (!running()) return;
   {
     const std::lock_guard lock(mutex_);
     stop_ = true;
@@ -30,7 +32,7 @@ StackThread::~StackThread() {
 }
 
 void StackThread::Run(const std::function<void()>& task) {
-  if (!running_) throw std::logic_error("no thread to run the task on");
+  if (!running()) throw std::logic_error("no thread to run the task on");
   const std::lock_guard one_at_a_time(run_mutex_);
   std::unique_lock lock(mutex_);
   task_ = &task;
@@ -40,6 +42,8 @@ void StackThread::Run(const std::function<void()>& task) {
   changed_.wait(lock, [this] { return done_; });
   if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
 }
+
+bool StackThread::running() const { return running_ && owner_ == getpid(); }
 
 std::size_t StackThread::CurrentStackBytes() { return current_stack_bytes; }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <pthread.h>
+#include <sys/types.h>
 
 #include <condition_variable>
 #include <cstddef>
@@ -30,8 +31,9 @@ class StackThread {
   StackThread(const StackThread&) = delete;
   StackThread& operator=(const StackThread&) = delete;
 
-  /// Whether the thread was made.
-  [[nodiscard]] bool running() const { return running_; }
+  /// Whether the thread runs: it was made, and this is the process that made it (a child made
+  /// by fork() has no copy of it).
+  [[nodiscard]] bool running() const;
 
   /// Runs `task` on the thread and waits for it; rethrows here what it threw there.
   /// Precondition: running().
@@ -53,6 +55,7 @@ class StackThread {
   bool done_ = false;                            // the last task has returned
   bool stop_ = false;                            // the destructor asks the thread to end
   bool running_ = false;
+  pid_t owner_;  // the process that made the thread
   pthread_t thread_{};
 };
 

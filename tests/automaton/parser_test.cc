@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -740,6 +741,28 @@ TEST(Parser, ReusesOneThreadForItsStack) {
   std::thread caller([&] { (void)ParseModel(kThermostat, "a.ha"); });
   caller.join();
   EXPECT_EQ(ThreadCount(), before);
+}
+
+// A child made by fork() has no copy of the parser's thread: it parses on its own stack rather
+// than wait for a thread that does not exist (alarm() turns such a wait into a failure).
+TEST(Parser, ParsesInAForkedChild) {
+  (void)ParseModel("automaton t { var x in [0, 1]; mode m { x' = 0; } init m { x = 0; } }", "a.ha");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    alarm(10);
+    try {
+      const System s = ParseModel(
+          "automaton t { var x in [0, 1]; mode m { x' = 0; } init m { x = 0; } }", "a.ha");
+      _exit(s.name() == "t" ? 0 : 1);
+    } catch (...) {
+      _exit(2);
+    }
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child was killed (signal " << WTERMSIG(status) << ")";
+  EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
 // ---------------------------------------------------------------------------------------------
