@@ -557,6 +557,20 @@ TEST(PropertyProverBudget, SharedBudgetIsDrawnDown) {
   EXPECT_THROW(SolverBudget(1e7), std::invalid_argument);
 }
 
+// The safety net's CPU-time limits: 10 s per budget second of a query's units, at least 10 s,
+// at most T = max(60 s, 10 s per budget second).
+TEST(PropertyProverBudget, SafetyLimitsFollowTheUnits) {
+  const SolverBudget small(1.0);
+  EXPECT_EQ(small.SafetySeconds(), 60.0);
+  EXPECT_EQ(small.SafetyCpuSeconds(0), 10.0);
+  EXPECT_EQ(small.SafetyCpuSeconds(3 * kResourceUnitsPerBudgetSecond), 30.0);
+  EXPECT_EQ(small.SafetyCpuSeconds(100 * kResourceUnitsPerBudgetSecond), 60.0);
+  const SolverBudget large(60.0);
+  EXPECT_EQ(large.SafetySeconds(), 600.0);
+  EXPECT_EQ(large.SafetyCpuSeconds(25'000'000), 100.0);
+  EXPECT_FALSE(large.SafetyExpired());
+}
+
 System Finger() { return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha"); }
 
 TEST(PropertyProverFinger, EveryInvariantIsProved) {
