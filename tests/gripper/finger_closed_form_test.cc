@@ -12,6 +12,7 @@
 
 #include "automaton/parser.h"
 #include "solvers/simulation/simulator.h"
+#include "tests/test_utilities/robotiq_rig.h"
 
 namespace hybrid::gripper {
 namespace {
@@ -267,6 +268,34 @@ RC_GTEST_PROP(FingerClosedFormProperty, SimulationEqualsClosedForm, ()) {
   // Reopened at the end. (While opening only the angles are compared: the flags may differ,
   // e.g. a link-1 contact with theta2 at its minimum is released as soon as the motor reverses.)
   RC_ASSERT(std::abs(r.samples.back().x[g] - std::min(0.25, closed.stop())) <= 1e-6);
+}
+
+}  // namespace
+}  // namespace hybrid::gripper
+
+namespace hybrid::gripper {
+namespace {
+
+// One truth with the independent rig simulator (tests/test_utilities/robotiq_rig.h, written
+// from the report apart from gripper/): for no object or an object on link 1 or link 2 anywhere,
+// and any g, the closed form's angles equal the rig's, and both stop the finger at the same
+// position. (Objects on link 3 and on two links at once are not in the rig.)
+RC_GTEST_PROP(FingerClosedFormProperty, EqualsTheIndependentRig, ()) {
+  const int link = *rc::gen::inRange(0, 3);  // 0: no object
+  const double gob = *rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 1e4; });
+  const double g = *rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 1e4; });
+  FingerContacts contacts;
+  testing::RigObject object;
+  if (link == 1) object.gob1 = contacts.gob[0] = gob;
+  if (link == 2) object.gob2 = contacts.gob[1] = gob;
+  const FingerClosedForm closed(contacts);
+  const testing::RigFinger finger;
+  RC_LOG() << "link " << link << " gob " << gob << " g " << g << "\n";
+  RC_ASSERT(std::abs(std::min(closed.stop(), 255.0) - testing::RigStopPosition(finger, object)) <
+            1e-9);
+  const Eigen::Vector3d theta = closed.At(g).theta;
+  const std::array<double, 3> rig = testing::RigAngles(g, finger, object);
+  for (int j = 0; j < 3; ++j) RC_ASSERT(std::abs(theta[j] - rig[j]) < 1e-9);
 }
 
 }  // namespace
