@@ -54,10 +54,11 @@ void Validate(const FingerContacts& contacts, const FingerParameters& p) {
   }
   if (p.theta_min[0] != 0.0 || p.theta_min[1] != 0.0 || p.theta_min[2] > 0.0 ||
       p.theta_max[2] < 0.0 || !(p.m1() > 0.0) || !(p.m2() > 0.0) || !(p.motor_max > 0.0) ||
-      !std::isfinite(p.motor_max)) {
+      !std::isfinite(p.motor_max) || !(p.theta3_fraction > 0.0 && p.theta3_fraction < 1.0)) {
     throw std::invalid_argument(
         "FingerClosedForm: parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
-        "theta2_max, theta3_min <= 0 <= theta3_max and a positive finite motor range");
+        "theta2_max, theta3_min <= 0 <= theta3_max, a positive finite motor range and "
+        "theta3_fraction in (0, 1)");
   }
 }
 
@@ -126,11 +127,11 @@ std::vector<Event> CandidateEvents(const FingerClosedForm::Piece& piece,
     }
     if (c[i] != 0 || l[i] != 0) continue;
     if (piece.phase == FingerPhase::k3 && i == 2) {
-      // theta3 reaches its upper limit half way between g and motor_max.
+      // theta3 reaches its upper limit the fraction f of the way from g to motor_max.
       if (theta[2] >= p.theta_max[2]) {
         events.push_back({g, EventKind::kLimit, 2});
       } else if (g < p.motor_max) {
-        events.push_back({0.5 * (p.motor_max + g), EventKind::kLimit, 2});
+        events.push_back({g + p.theta3_fraction * (p.motor_max - g), EventKind::kLimit, 2});
       }
     } else if (piece.rate[i] > 0.0) {
       events.push_back(
@@ -255,10 +256,11 @@ Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
   // outside phase 3 (span3 = 0).
   const double moved = g - piece.g0;
   const double rest = parameters_.motor_max - g;
-  // (g - g_s) / (255 - g), which reaches 1 half way between g_s and 255; clamped there. At
-  // g = g_s = 255 nothing has moved: 0.
-  const double ratio = moved / (rest > 0.0 ? rest : 1.0);
-  const double fraction = moved > 0.0 && moved >= rest ? 1.0 : std::clamp(ratio, 0.0, 1.0);
+  // (1 - f) / f (g - g_s) / (255 - g), which reaches 1 the fraction f of the way from g_s to
+  // 255; clamped there. At g = g_s = 255 nothing has moved: 0.
+  const double scaled = parameters_.m3_scale() * moved;
+  const double ratio = scaled / (rest > 0.0 ? rest : 1.0);
+  const double fraction = moved > 0.0 && scaled >= rest ? 1.0 : std::clamp(ratio, 0.0, 1.0);
   Eigen::Vector3d theta = piece.theta0 + piece.rate * moved;
   theta[2] += piece.span3 * fraction;
   return theta;

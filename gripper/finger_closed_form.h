@@ -54,7 +54,9 @@ std::string FingerModeName(const FingerConfiguration& q);
 /// - phase 3 from g_s, where link 2 stopped (object at gob2, or its limit):
 ///   theta3 = theta3_s + (theta3_max - theta3_s) (g - g_s) / (255 - g) (decision C1: section 4's
 ///   law continued from theta3_s, theta3's value at g_s, so theta3 is continuous; the report's
-///   tables have theta3_s = theta3_min). It reaches theta3_max at g = (255 + g_s) / 2;
+///   tables have theta3_s = theta3_min). It reaches theta3_max at g = (255 + g_s) / 2; with
+///   FingerParameters::theta3_fraction f other than 1/2 the law is scaled by (1 - f) / f and
+///   reaches it at g_s + f (255 - g_s);
 /// - phase 4 (stopped) from the first of: link 3 blocked by an object (gob3), theta3 reaching
 ///   theta3_max, or the free finger fully closed against the palm at g = 240 (D3). Beyond that
 ///   the configuration no longer changes and `motor` stays at the stopping position.
@@ -62,9 +64,9 @@ std::string FingerModeName(const FingerConfiguration& q);
 /// Events at the same g are taken in the model's declaration order (contact before limit, link 1
 /// before 2 before 3), as the simulator does for events at exactly the same instant. (A contact
 /// that coincides with theta3 reaching theta3_max in phase 3, a root found numerically, may be
-/// taken in the other order by the simulator: the angles agree, the flags differ.) Every value is finite for every g in [0, 255],
-/// including g = 255 (the report's law divides by 255 - g; the pieces end before that except
-/// when g_s = 255, where theta3 stays at theta3_s).
+/// taken in the other order by the simulator: the angles agree, the flags differ.) Every value is
+/// finite for every g in [0, 255], including g = 255 (the report's law divides by 255 - g; the
+/// pieces end before that except when g_s = 255, where theta3 stays at theta3_s).
 class FingerClosedForm {
  public:
   /// Throws std::invalid_argument ("FingerClosedForm: ...") if a contact position is negative or

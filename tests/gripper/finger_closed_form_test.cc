@@ -278,19 +278,32 @@ namespace {
 
 // One truth with the independent rig simulator (tests/test_utilities/robotiq_rig.h, written
 // from the report apart from gripper/): for no object or an object on link 1 or link 2 anywhere,
-// and any g, the closed form's angles equal the rig's, and both stop the finger at the same
-// position. (Objects on link 3 and on two links at once are not in the rig.)
+// any g, and joint ranges and phase-3 fraction drawn around the report's, the closed form's
+// angles equal the rig's, and both stop the finger at the same position. (Objects on link 3 and
+// on two links at once are not in the rig.)
 RC_GTEST_PROP(FingerClosedFormProperty, EqualsTheIndependentRig, ()) {
+  const auto count = [] {
+    return *rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 1e4; });
+  };
   const int link = *rc::gen::inRange(0, 3);  // 0: no object
-  const double gob = *rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 1e4; });
-  const double g = *rc::gen::map(rc::gen::inRange(0, 2550001), [](int k) { return k / 1e4; });
+  const double gob = count();
+  const double g = count();
+  const bool report = *rc::gen::arbitrary<bool>();  // the report's constants, or others
+  FingerParameters p;
+  testing::RigFinger finger;
+  if (!report) {
+    finger.theta1_max = p.theta_max[0] = *rc::gen::inRange(50, 81);
+    finger.theta2_max = p.theta_max[1] = *rc::gen::inRange(70, 101);
+    finger.theta3_max = p.theta_max[2] = *rc::gen::inRange(30, 51);
+    finger.theta3_fraction = p.theta3_fraction = *rc::gen::inRange(20, 81) / 100.0;
+  }
   FingerContacts contacts;
   testing::RigObject object;
   if (link == 1) object.gob1 = contacts.gob[0] = gob;
   if (link == 2) object.gob2 = contacts.gob[1] = gob;
-  const FingerClosedForm closed(contacts);
-  const testing::RigFinger finger;
-  RC_LOG() << "link " << link << " gob " << gob << " g " << g << "\n";
+  const FingerClosedForm closed(contacts, p);
+  RC_LOG() << "link " << link << " gob " << gob << " g " << g << " theta_max "
+           << p.theta_max.transpose() << " f " << p.theta3_fraction << "\n";
   RC_ASSERT(std::abs(std::min(closed.stop(), 255.0) - testing::RigStopPosition(finger, object)) <
             1e-9);
   const Eigen::Vector3d theta = closed.At(g).theta;
