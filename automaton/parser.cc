@@ -794,6 +794,7 @@ class Builder {
     Automaton a(name);
     const Scope scope = ConstantScope(a.symbols());
     bool has_scenario = false;
+    std::vector<const Node*> inits;  // the mode name of each init declaration, in order
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
       if (item.is_type<var_decl>()) {
@@ -827,6 +828,7 @@ class Builder {
         TransitionDecl(item, &a);
       } else if (item.is_type<init_decl>()) {
         InitDecl(item, &a);
+        inits.push_back(item.children.at(0).get());
       } else if (item.is_type<scenario_decl>()) {
         if (has_scenario) Fail(item, "scenario declared twice");
         has_scenario = true;
@@ -847,6 +849,7 @@ class Builder {
     if (a.initial_states().empty()) {
       Fail(name_node, "automaton '" + name + "' has no initial state (add 'init MODE { ... }')");
     }
+    CheckInitialStatesComplete(a, inits);
     automata_.emplace(name, std::move(a));
     local_automata_.push_back(name);
     local_positions_.push_back(Where(name_node));
@@ -941,6 +944,23 @@ class Builder {
     std::sort(t.resets.begin(), t.resets.end(),
               [](const Reset& x, const Reset& y) { return x.slot < y.slot; });
     At(name_node ? *name_node : source, [&] { return a->AddTransition(std::move(t)); });
+  }
+
+  // Every initial state gives every continuous variable a value, also those declared after it
+  // (AddInitialState checked only the variables declared before). `inits[k]` is the mode name
+  // of the k-th initial state's declaration.
+  void CheckInitialStatesComplete(const Automaton& a, const std::vector<const Node*>& inits) const {
+    const auto states = a.initial_states();
+    for (size_t k = 0; k < states.size() && k < inits.size(); ++k) {
+      for (const VariableInfo& var : a.variables()) {
+        const bool given = std::any_of(states[k].values.begin(), states[k].values.end(),
+                                       [&](const InitialValue& v) { return v.slot == var.slot; });
+        if (!given) {
+          Fail(*inits[k], "initial state in '" + Text(*inits[k]) + "' gives no value for '" +
+                              a.symbols()[var.slot].name + "', declared after it");
+        }
+      }
+    }
   }
 
   void InitDecl(const Node& n, Automaton* a) {
