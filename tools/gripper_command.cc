@@ -12,6 +12,7 @@
 #include "automaton/expression.h"
 #include "automaton/parser.h"
 #include "gripper/finger_closed_form.h"
+#include "gripper/finger_parameters.h"
 #include "gripper/geometric_finger.h"
 #include "gripper/hand.h"
 #include "gripper/svg_figures.h"
@@ -26,6 +27,8 @@ namespace {
 using gripper::FingerClosedForm;
 using gripper::FingerConfiguration;
 using gripper::FingerContacts;
+using gripper::FingerGeometry;
+using gripper::FingerParameters;
 using gripper::GeometricFinger;
 using gripper::Obstacle;
 using json = nlohmann::ordered_json;
@@ -216,9 +219,9 @@ bool AnyGob(const FingerArgs& args) {
 // contact positions given by --gob1..3 (the others at their default). Turns a --g of -0 into 0.
 FingerContacts CheckFingerArgs(FingerArgs& args) {
   const std::vector<NamedFile> outputs = {{"--draw", args.draw}, {"--plot", args.plot}};
-  CheckDistinctFiles(
-      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
-      outputs);
+  CheckDistinctFiles(args.model.empty() ? std::vector<NamedFile>{}
+                                        : std::vector<NamedFile>{{"--model", args.model}},
+                     outputs);
   CheckOutputPlaces(outputs);
   if (args.g) {
     CheckMotor("--g", *args.g);
@@ -240,13 +243,33 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   return contacts;
 }
 
-// The finger closing on `objects` (none without objects); throws InputError if the objects are
-// invalid or the finger cannot reach them.
-std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& objects) {
+// The closed form's constants of the finger automaton of --model (joint ranges, phase-3
+// fraction), or the report's without --model. Throws InputError (exit 1) if the model is not a
+// finger automaton like spec/finger.ha.
+FingerParameters ModelParameters(const FingerArgs& args) {
+  if (args.model.empty()) return {};
+  const System model = ParseModelFile(args.model);
+  if (model.components().size() != 1) {
+    throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
+                     std::to_string(model.components().size()) + " components)");
+  }
+  try {
+    const FingerParameters p = gripper::FingerParametersOf(model.components()[0].automaton);
+    FingerClosedForm check({}, p);  // the closed form's own conditions on its constants
+    return p;
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.model + ": " + UserMessage(e.what()));
+  }
+}
+
+// The finger with `parameters` closing on `objects` (none without objects); throws InputError if
+// the objects are invalid or the finger cannot reach them.
+std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& objects,
+                                               const FingerParameters& parameters) {
   std::optional<GeometricFinger> geometric;
   if (objects.empty()) return geometric;
   try {
-    geometric.emplace(objects);
+    geometric.emplace(objects, FingerGeometry(), parameters);
   } catch (const std::invalid_argument& e) {
     throw InputError(UserMessage(e.what()));
   }
@@ -509,8 +532,10 @@ int RunFinger(const FingerArgs& args_in) {
   FingerArgs args = args_in;
   const FingerContacts contacts = CheckFingerArgs(args);
   const std::vector<Obstacle> objects = ParseObjects(args.objects);
-  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects);
-  const FingerClosedForm closed = geometric ? geometric->closed_form() : FingerClosedForm(contacts);
+  const FingerParameters parameters = ModelParameters(args);
+  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
+  const FingerClosedForm closed =
+      geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
   json report = FingerReport(args, closed, geometric, objects);
   int code = 0;
   if (args.simulate) {

@@ -213,7 +213,8 @@ void AddFinger(CLI::App& app, Commands& c) {
                    "Also simulate the finger automaton closing (u = 1 to g = 255) and compare it "
                    "with the closed form (exit 5 if they differ by more than 1e-6 degrees)");
   finger->add_option("--model", a.model,
-                     "Finger automaton for --simulate (default: the bundled finger.ha)");
+                     "Finger automaton: its joint ranges and theta3_fraction set the closed form, "
+                     "and --simulate simulates it (default: the bundled finger.ha)");
 }
 
 // `hybrid hand` (gripper/): the three fingers and the spread.

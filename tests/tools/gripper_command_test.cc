@@ -301,6 +301,39 @@ TEST(HybridFinger, SimulateWithAModelThatIsNotAFingerIsExit1) {
                  {"bouncing_ball.ha", "no automaton named 'finger'"});
 }
 
+// --model sets the closed form's constants: a finger whose link 2 ends at 80 degrees and whose
+// link 3 reaches its limit 0.3 of the way from where link 2 stopped to 255. The simulation of that
+// model agrees with that closed form.
+TEST(HybridFinger, ModelSetsTheClosedFormsConstants) {
+  TempDir dir;
+  std::string text = ReadAll(HYBRID_SOURCE_DIR "/spec/finger.ha");
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{"param theta2_max [deg] = 90;",
+                                            "param theta2_max [deg] = 80;"},
+        {"param theta3_fraction = 0.5;", "param theta3_fraction = 0.3;"}}) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  }
+  const std::string model = Quote(dir.Write("changed.ha", text));
+  // Free: link 2 at m2 = 0.8 deg per count.
+  EXPECT_NEAR(Field(RunJson("finger --model " + model + " --g 200"), "theta2").get<double>(), 48.0,
+              1e-9);
+  // Link 1 blocked at 30: link 2 stops at 130, the finger at 130 + 0.3 (255 - 130) = 167.5.
+  const json j = RunJson("finger --model " + model + " --gob1 30 --g 200 --simulate");
+  EXPECT_NEAR(Field(j, "stop").get<double>(), 167.5, 1e-9) << j.dump(2);
+  EXPECT_EQ(Field(j, "simulation", "agrees"), true) << j.dump(2);
+  // Without --model: the report's constants.
+  EXPECT_NEAR(Field(RunJson("finger --g 200"), "theta2").get<double>(), 54.0, 1e-9);
+}
+
+// --model that is not a finger automaton, also without --simulate: exit 1, naming the file.
+TEST(HybridFinger, ModelThatIsNotAFingerIsExit1) {
+  const std::string spec = std::string(HYBRID_SOURCE_DIR) + "/spec/";
+  ExpectRejected("finger --g 10 --model " + Quote(spec + "thermostat.ha"), 1,
+                 {"thermostat.ha", "not a finger model", "theta1_min"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input to `hybrid finger`.
 
