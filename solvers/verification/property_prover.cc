@@ -163,8 +163,8 @@ class Meter {
       while (allowed * 2 <= left) allowed *= 2;
     }
     // The CPU-time limit of the query, from the units it may use (10 s per budget second, at
-    // least 10 s): work Z3 does not count (a search query of the finger's --modes spent 100 s on
-    // 1.8 million units, Z3's large-number arithmetic) is cut there.
+    // least 10 s): work Z3's count misses (a search query of the finger's --modes spent 100 s on
+    // 1.8 million units) is cut there.
     const bool same =
         last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
     if (!same || last_allowed_ != allowed) {

@@ -26,14 +26,14 @@ inline constexpr std::uint64_t kResourceUnitsPerBudgetSecond = 2'500'000;
 /// the same check with the same budget always gives the same verdicts. A query is given at most
 /// what is left; once nothing is left, no query runs and what is undecided stays `unknown`.
 ///
-/// A safety net bounds CPU time where Z3 does not count its work (its large-number arithmetic,
-/// some nonlinear arithmetic): with T = max(60 s, 10 s per budget second), no query starts after
-/// the process has used T of CPU time since the budget's creation, and a query given u units runs
-/// at most 10 s of CPU time per budget second of u (at least 10 s, at most T). CPU time, not
-/// wall-clock time, so that the machine's load does not change where it fires; a query it stops
-/// is `unknown`, is charged its whole allowance, and its solver gets no further query, so that
-/// what follows does not depend on where it stopped. Only the machine's speed can then change a
-/// verdict, and the reasons say when the net fired.
+/// A safety net bounds CPU time where Z3's count misses its work (some nonlinear arithmetic; a
+/// search query of the finger that allocates about 200 million times per second): with T = max(60
+/// s, 10 s per budget second), no query starts after the process has used T of CPU time since the
+/// budget's creation, and a query given u units runs at most 10 s of CPU time per budget second of
+/// u (at least 10 s, at most T). CPU time, not wall-clock time, so that the machine's load does not
+/// change where it fires; a query it stops is `unknown`, is charged its whole allowance, and its
+/// solver gets no further query, so that what follows does not depend on where it stopped. Only the
+/// machine's speed can then change a verdict, and the reasons say when the net fired.
 class SolverBudget {
  public:
   /// A budget of `seconds` budget seconds (positive and finite, at most 10^6), i.e. seconds *
