@@ -131,6 +131,41 @@ std::vector<double> RigSweep(double from, double to, double step) {
 
 namespace {
 
+// Appends the requests after `out.back()` up or down to `to` (included), stepped as `stepping`.
+void StepTo(double to, RigStepping stepping, std::mt19937_64& random, std::vector<double>& out) {
+  std::uniform_real_distribution<double> irregular(0.5, 4.0);
+  const double from = out.back();
+  const double sign = to >= from ? 1.0 : -1.0;
+  double at = from;
+  for (;;) {
+    const double step = stepping == RigStepping::kOne   ? 1.0
+                        : stepping == RigStepping::kTwo ? 2.0
+                                                        : irregular(random);
+    at += sign * step;
+    if (sign * (at - to) >= 0.0) break;
+    out.push_back(at);
+  }
+  out.push_back(to);
+}
+
+}  // namespace
+
+std::vector<double> RigProtocol(double top, RigStepping stepping, std::uint64_t seed,
+                                std::optional<double> reverse_at, double reverse_depth) {
+  if (!(top > 0.0 && top <= kMotorMax)) throw std::invalid_argument("RigProtocol: top");
+  std::mt19937_64 random(seed);
+  std::vector<double> out = {0.0};
+  if (reverse_at && *reverse_at > 0.0 && *reverse_at < top) {
+    StepTo(*reverse_at, stepping, random, out);
+    StepTo(std::max(0.0, *reverse_at - reverse_depth), stepping, random, out);
+  }
+  StepTo(top, stepping, random, out);
+  StepTo(0.0, stepping, random, out);
+  return out;
+}
+
+namespace {
+
 std::string Cell(double value) {
   if (std::isnan(value)) return "";
   char text[32];

@@ -89,6 +89,17 @@ std::vector<RigSample> RigRun(const std::vector<double>& requests, const RigFing
 /// Requests from `from` to `to` (either direction) in steps of `step` > 0, both ends included.
 std::vector<double> RigSweep(double from, double to, double step);
 
+/// How a protocol steps the request: by 1 count, by 2, or by irregular amounts (0.5 to 4 counts).
+enum class RigStepping { kOne, kTwo, kIrregular };
+
+/// The requests of one run of the report's protocol: from 0 up to `top` and back to 0, stepped
+/// as `stepping` says (irregular steps drawn with `seed`). With `reverse_at` in (0, top), the
+/// run also reverses once on the way up: up to reverse_at, down by `reverse_depth` (not below 0),
+/// then up again to top. Every request lies in [0, 255].
+std::vector<double> RigProtocol(double top, RigStepping stepping, std::uint64_t seed,
+                                std::optional<double> reverse_at = std::nullopt,
+                                double reverse_depth = 20.0);
+
 /// The rows of `samples` as CSV lines of the measured-data format (gripper/measured_data.h)
 /// with the optional `position` column: run,g,position,theta1,theta2,theta3[,gob,contact_link]
 /// (gob and contact_link when `contact_link` is 1 or 2; `gob` is then the object's position for

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace hybrid::testing {
@@ -177,6 +178,32 @@ TEST(RobotiqRig, SweepAndCsv) {
   EXPECT_EQ(RigCsvHeader(true), "run,g,position,theta1,theta2,theta3,gob,contact_link\n");
   EXPECT_EQ(RigCsvRows("a", run, object, 1), "a,20,20,10,0,-10,30,1\na,60,60,15,27,-42,30,1\n");
   EXPECT_THROW(RigCsvRows("a", run, object, 2), std::invalid_argument);
+}
+
+TEST(RobotiqRig, ProtocolsCloseReverseAndReopen) {
+  const auto one = RigProtocol(255, RigStepping::kOne, 1);
+  EXPECT_EQ(one.size(), 511u);  // 0..255 and back
+  EXPECT_EQ(one[255], 255);
+  EXPECT_EQ(one.back(), 0);
+  const auto two = RigProtocol(255, RigStepping::kTwo, 1);
+  EXPECT_EQ(two[127], 254);
+  EXPECT_EQ(two[128], 255);  // the top is always a request
+  const auto irregular = RigProtocol(250, RigStepping::kIrregular, 3, 120.0, 30.0);
+  int reversals = 0;
+  for (size_t k = 1; k < irregular.size(); ++k) {
+    const double step = std::abs(irregular[k] - irregular[k - 1]);
+    EXPECT_GT(step, 0.0);
+    EXPECT_LE(step, 4.0);
+    EXPECT_GE(irregular[k], 0.0);
+    EXPECT_LE(irregular[k], 250.0);
+    if (k + 1 < irregular.size() &&
+        (irregular[k] - irregular[k - 1]) * (irregular[k + 1] - irregular[k]) < 0) {
+      ++reversals;
+    }
+  }
+  EXPECT_EQ(reversals, 3);  // up to 120, down to 90, up to 250, down to 0
+  EXPECT_NE(std::find(irregular.begin(), irregular.end(), 90.0), irregular.end());
+  EXPECT_EQ(RigProtocol(250, RigStepping::kIrregular, 3, 120.0, 30.0), irregular);  // seeded
 }
 
 }  // namespace
