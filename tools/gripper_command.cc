@@ -243,22 +243,28 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   return contacts;
 }
 
-// The closed form's constants of the finger automaton of --model (joint ranges, phase-3
-// fraction), or the report's without --model. Throws InputError (exit 1) if the model is not a
-// finger automaton like spec/finger.ha.
-FingerParameters ModelParameters(const FingerArgs& args) {
-  if (args.model.empty()) return {};
+// The finger automaton of --model, if given. Throws InputError (exit 1) if the file holds more
+// than one automaton.
+std::optional<Automaton> FingerModel(const FingerArgs& args) {
+  if (args.model.empty()) return std::nullopt;
   const System model = ParseModelFile(args.model);
   if (model.components().size() != 1) {
     throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
                      std::to_string(model.components().size()) + " components)");
   }
+  return model.components()[0].automaton;
+}
+
+// The closed form's constants of `model` (joint ranges, phase-3 fraction), or the report's
+// without one. Throws InputError (exit 1) if it is not a finger automaton like spec/finger.ha.
+FingerParameters ModelParameters(const std::optional<Automaton>& model, const std::string& file) {
+  if (!model) return {};
   try {
-    const FingerParameters p = gripper::FingerParametersOf(model.components()[0].automaton);
+    const FingerParameters p = gripper::FingerParametersOf(*model);
     FingerClosedForm check({}, p);  // the closed form's own conditions on its constants
     return p;
   } catch (const std::invalid_argument& e) {
-    throw InputError(args.model + ": " + UserMessage(e.what()));
+    throw InputError(file + ": " + UserMessage(e.what()));
   }
 }
 
@@ -301,21 +307,16 @@ json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
   return report;
 }
 
-// `hybrid finger --simulate`: the finger automaton of --model (with the geometric contact guards
-// of `geometric`, else with the contact positions `contacts`) closing at u = 1 up to 255,
+// `hybrid finger --simulate`: `model`, the finger automaton of --model (with the geometric contact
+// guards of `geometric`, else with the contact positions `contacts`) closing at u = 1 up to 255,
 // compared with `closed`. Throws InputError if --model is not a finger model.
-Comparison SimulateFinger(const FingerArgs& args, const std::optional<GeometricFinger>& geometric,
+Comparison SimulateFinger(const FingerArgs& args, const Automaton& model,
+                          const std::optional<GeometricFinger>& geometric,
                           const FingerContacts& contacts, const FingerClosedForm& closed) {
-  const System model = ParseModelFile(args.model);
-  if (model.components().size() != 1) {
-    throw InputError(args.model + ": not a finger model like spec/finger.ha (it has " +
-                     std::to_string(model.components().size()) + " components)");
-  }
-  CheckFingerModel(model.components()[0].automaton, args.model);
+  CheckFingerModel(model, args.model);
   System system("finger");
   try {
-    system = System::Of(geometric ? geometric->ContactAutomaton(model.components()[0].automaton)
-                                  : model.components()[0].automaton);
+    system = System::Of(geometric ? geometric->ContactAutomaton(model) : model);
   } catch (const std::invalid_argument& e) {
     throw InputError(args.model + ": " + e.what());
   }
@@ -532,14 +533,15 @@ int RunFinger(const FingerArgs& args_in) {
   FingerArgs args = args_in;
   const FingerContacts contacts = CheckFingerArgs(args);
   const std::vector<Obstacle> objects = ParseObjects(args.objects);
-  const FingerParameters parameters = ModelParameters(args);
+  const std::optional<Automaton> model = FingerModel(args);
+  const FingerParameters parameters = ModelParameters(model, args.model);
   const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
   const FingerClosedForm closed =
       geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
   json report = FingerReport(args, closed, geometric, objects);
   int code = 0;
   if (args.simulate) {
-    const Comparison c = SimulateFinger(args, geometric, contacts, closed);
+    const Comparison c = SimulateFinger(args, *model, geometric, contacts, closed);
     report["simulation"] = SimulationJson(c);
     const bool agrees = Agrees(c);
     if (!agrees) code = kExitDisagrees;

@@ -20,10 +20,10 @@ Automaton BundledFinger() {
 }
 
 TEST(FingerParametersOf, TheBundledFingerHasTheReportsConstants) {
+  // The joint ranges of ../shared/robotiq/kinematics.md (Klamp't limits).
   const FingerParameters p = FingerParametersOf(BundledFinger());
-  const FingerParameters report;
-  EXPECT_EQ(p.theta_min, report.theta_min);
-  EXPECT_EQ(p.theta_max, report.theta_max);
+  EXPECT_EQ(p.theta_min, Eigen::Vector3d(0, 0, -55));
+  EXPECT_EQ(p.theta_max, Eigen::Vector3d(70, 90, 43));
   EXPECT_EQ(p.theta3_fraction, 0.5);
   EXPECT_EQ(p.motor_max, 255.0);
 }
