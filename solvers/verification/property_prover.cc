@@ -279,9 +279,13 @@ class JobRun {
   // Adds to `trace` the values s0 gives the variables that initial state `start` sets in a box.
   void AddInitialValues(int start, const SmtEncoding::PathStep& s0, Trace& trace) const;
   // Adds to `trace` the input schedule of `path`: one step piece per flow segment of positive
-  // duration, then a short tail with the last input held.
+  // duration, the values a jump's guard reads from the jump's instant, then a short tail with
+  // the last input held.
   void AddInputSchedule(const std::vector<SmtEncoding::PathStep>& path, int depth,
                         Trace& trace) const;
+  // Sets in `current` the inputs that the guard of `jump`'s transition reads to the jump's
+  // values; whether any changed.
+  bool GuardInputs(const SmtEncoding::PathStep& jump, std::vector<double>& current) const;
   // Replays `trace` (of the path of `depth` steps in `model`) for `c`: if it replays, decides `c`
   // violated (reachable for `reach`) with it; false otherwise.
   bool ReplayPath(const z3::model& model, int depth, Candidate& c, Trace trace);
@@ -441,20 +445,22 @@ void JobRun::AddInputSchedule(const std::vector<SmtEncoding::PathStep>& path, in
     }
     t += duration;
   };
+  // The input held: a flow's, then at a jump the values its guard reads (the jump happens at
+  // that instant, where the input takes them; a flow that follows at the same instant with
+  // other values overrides them, and then the replay decides).
+  std::vector<double> current(ni, 0.0);
   for (int k = 0; k < depth; ++k) {
-    if (path[k].flow && path[k].duration > 0) add_piece(path[k].input, path[k].duration);
+    if (path[k].flow && path[k].duration > 0) {
+      current = path[k].input;
+      add_piece(current, path[k].duration);
+    } else if (!path[k].flow && path[k].transition >= 0) {
+      if (GuardInputs(path[k], current)) add_piece(current, 0.0);
+    }
   }
   // A short tail with the last input held, so that events due exactly at the end of the path
   // happen (an input that changed there would decide them instead).
-  std::vector<double> last(ni, 0.0);
-  for (int k = depth - 1; k >= 0; --k) {
-    if (path[k].flow && path[k].duration > 0) {
-      last = path[k].input;
-      break;
-    }
-  }
   const double tail = std::max(1e-6, 1e-6 * t);
-  add_piece(last, tail);
+  add_piece(current, tail);
   trace.inputs.until = t;
   for (auto& s : signals) {
     if (s.points.empty()) s.points.emplace_back(0.0, 0.0);
@@ -462,12 +468,30 @@ void JobRun::AddInputSchedule(const std::vector<SmtEncoding::PathStep>& path, in
   }
 }
 
+bool JobRun::GuardInputs(const SmtEncoding::PathStep& jump, std::vector<double>& current) const {
+  const hybrid::Transition& tr = a_.transitions()[static_cast<std::size_t>(jump.transition)];
+  bool changed = false;
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    const int slot = a_.inputs()[i].slot;
+    bool read = false;
+    for (const Comparison& c : tr.guard.comparisons) {
+      for (int s : c.Residual().Slots()) read = read || s == slot;
+    }
+    if (read && current[i] != jump.input[i]) {
+      current[i] = jump.input[i];
+      changed = true;
+    }
+  }
+  return changed;
+}
+
 bool JobRun::ReplayPath(const z3::model& model, int depth, Candidate& c, Trace trace) {
   ++c.replays;
   bool replayed = false;
   try {
     replayed = ReplayTrace(system_, c.goal->original, trace);
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    if (std::getenv("HYBRID_CHECK_DEBUG")) std::cerr << "replay failed: " << e.what() << "\n";
   }
   if (!replayed) {
     if (std::getenv("HYBRID_CHECK_DEBUG")) {

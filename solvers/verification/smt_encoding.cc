@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -276,6 +277,7 @@ void SmtEncoding::Classify() {
     } else {
       info.flow_class = FlowClass::kGeneral;
       ClassifySeparable(flows, info);
+      if (info.flow_class == FlowClass::kGeneral) ConstantDrifts(flows, info);
     }
     modes_.push_back(std::move(info));
   }
@@ -310,6 +312,16 @@ bool SmtEncoding::ConstantRates(const Flows& flows, ModeInfo& info) const {
     if (!constant_rate) break;
   }
   return constant_rate;
+}
+
+void SmtEncoding::ConstantDrifts(const Flows& flows, ModeInfo& info) const {
+  info.drift.assign(var_slots_.size(), 0.0);
+  info.constant_drift.assign(var_slots_.size(), false);
+  for (const auto& [v, f] : flows) {
+    if (!f.is_constant()) continue;
+    info.drift[v] = f.constant();
+    info.constant_drift[v] = true;
+  }
 }
 
 void SmtEncoding::ClassifySeparable(const Flows& flows, ModeInfo& info) const {
@@ -758,6 +770,11 @@ z3::expr SmtEncoding::Flow(int k, int mode) {
         out = out && Num(ctx_, input_lo_[i]) * a.d <= a.v[i] &&
               a.v[i] <= Num(ctx_, input_hi_[i]) * a.d;
       }
+      for (int v : info.moving) {
+        if (info.constant_drift[v]) {
+          out = out && b.x[v] == a.x[v] + Num(ctx_, info.drift[v]) * a.d;
+        }
+      }
       break;
   }
   return out && NoUrgentGuardOnSegment(k, mode);
@@ -884,6 +901,15 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   std::vector<double> dir(var_slots_.size(), 0.0);
   if (info.flow_class == FlowClass::kConstantRate) {
     if (!StraightSegment(info, a, const_sigma, dir)) return ctx_.bool_val(true);
+  } else if (info.flow_class == FlowClass::kGeneral || info.flow_class == FlowClass::kStill) {
+    // sigma = d for the variables with a constant flow; a guard that reads another moving
+    // variable (NaN direction) is not encoded.
+    const_sigma = a.d;
+    for (int v : info.moving) {
+      dir[v] = !info.constant_drift.empty() && info.constant_drift[v]
+                   ? info.drift[v]
+                   : std::numeric_limits<double>::quiet_NaN();
+    }
   } else if (info.flow_class != FlowClass::kSeparable) {
     return ctx_.bool_val(true);
   }
@@ -952,7 +978,9 @@ std::optional<std::vector<SmtEncoding::GuardAtom>> SmtEncoding::GuardAtoms(
     for (const auto& [slot, coef] : aff->terms) {
       const int v = var_index_[slot];
       if (v < 0 || !moving[v]) continue;
-      if (const_sigma) {
+      if (const_sigma && std::isnan(dir[v])) {
+        ok = false;  // a variable the encoding does not follow along the segment
+      } else if (const_sigma) {
         beta += coef * dir[v];
         beta_q = beta_q + Num(ctx_, coef) * Num(ctx_, dir[v]);
       } else {

@@ -34,7 +34,9 @@ enum class FlowClass {
   /// max(., eps)), v1 - v0 = K (Phi(w1) - Phi(w0)) / c exactly.
   kSeparable,
   /// Anything else: the moving variables may take any values allowed by the invariant (a sound
-  /// over-approximation).
+  /// over-approximation), except those whose flow is a constant, x' = c, which follow
+  /// x1 = x0 + c d exactly (e.g. a motor driven at a set speed beside a finger whose rates read
+  /// a variable).
   kGeneral,
 };
 
@@ -54,7 +56,8 @@ std::string FlowClassName(FlowClass c);
 /// - urgency: an urgent transition whose guard holds somewhere on the segment (before its end)
 ///   forbids the segment. Encoded exactly where every state comparison of the guard is affine
 ///   with constant coefficients along the segment (kConstantRate with one input and no drift,
-///   or drift and no input; kSeparable when the comparisons read one moving variable); other
+///   or drift and no input; kSeparable when the comparisons read one moving variable; kGeneral
+///   when the comparisons read only variables with a constant flow); other
 ///   urgent transitions are not encoded (sound: more paths);
 /// - lazy transitions, declaration-order priority and Zeno limits are not encoded (more paths).
 ///
@@ -165,6 +168,9 @@ class SmtEncoding {
     int driver = -1;
     double driver_rate = 0.0;
     std::vector<SeparableFlow> separable;
+    // kGeneral: by variable index, whether the flow is a constant (x' = drift[x]), which the
+    // encoding follows exactly whatever the other flows are (x1 = x0 + drift d).
+    std::vector<bool> constant_drift;
   };
   // The nonzero flows of a mode: (variable index, right-hand side with nominal parameters folded).
   using Flows = std::vector<std::pair<int, Expression>>;
@@ -263,6 +269,8 @@ class SmtEncoding {
   bool ConstantRates(const Flows& flows, ModeInfo& info) const;
   // Makes `info` kSeparable if its flows are: one input u, a driver w' = c u, others K phi(w) u.
   void ClassifySeparable(const Flows& flows, ModeInfo& info) const;
+  // kGeneral: records the flows that are constants (ModeInfo::constant_drift).
+  void ConstantDrifts(const Flows& flows, ModeInfo& info) const;
   // The separable form of variable v's flow f (input slot u, driver slot w, still: slots that do
   // not move in the mode), or nullopt if f has none.
   std::optional<SeparableFlow> Separate(int v, const Expression& f, int u, int w,

@@ -255,6 +255,39 @@ TEST(SmtEncoding, LazyGuardDoesNotForbidTheSegment) {
   EXPECT_EQ(step.Check("a", {{"x", 0}, {"y", 0}}, "a", {{"x", 10}, {"y", 20}}), z3::sat);
 }
 
+// A mode whose flows are not all constant rates (x' = k v with v a variable: kGeneral) still
+// follows a variable with a constant flow (m' = 2) exactly, and an urgent guard that reads only
+// that variable stops the segment; one that reads x is not encoded (x is not followed).
+constexpr std::string_view kMotorModel = R"(
+automaton motor {
+  param k = 3;
+  var x, m, v, target;
+  mode run { x' = k * v; m' = 2; }
+  mode held { }
+  transition arrive: run -> held { guard m >= target; }
+  transition far: run -> held { guard x >= 100; }
+  init run { x = 0; m = 0; v = 1; target = 10; }
+}
+)";
+
+TEST(SmtEncoding, GeneralModeFollowsConstantFlowsExactly) {
+  const Automaton a = ParseAutomaton(kMotorModel, "motor.ha");
+  StepChecker step(a);
+  // m moves at exactly 2: 0 -> 4 takes d = 2; x is free (kGeneral).
+  EXPECT_EQ(step.Check("run", {{"m", 0}, {"x", 0}, {"target", 10}}, "run", {{"m", 4}, {"x", 77}}),
+            z3::sat);
+  EXPECT_EQ(step.Check("run", {{"m", 0}, {"target", 10}}, "run", {{"m", -1}}), z3::unsat);
+  // The urgent guard m >= target stops the segment at m = 10.
+  EXPECT_EQ(step.Check("run", {{"m", 0}, {"target", 10}}, "run", {{"m", 10}}), z3::sat);
+  EXPECT_EQ(step.Check("run", {{"m", 0}, {"target", 10}}, "run", {{"m", 10.5}}), z3::unsat);
+  // x >= 100 is not encoded: a segment may end with x past it (sound: more paths).
+  EXPECT_EQ(step.Check("run", {{"m", 0}, {"x", 0}, {"target", 10}}, "run", {{"m", 1}, {"x", 150}}),
+            z3::sat);
+  // The mode is kGeneral: the constant flow is followed inside it.
+  SmtEncoding& enc = step.encoding();
+  EXPECT_EQ(enc.flow_class(*a.FindMode("run")), FlowClass::kGeneral);
+}
+
 // Kept for the whole run: deleting a Z3 context that holds the finger's encoding takes about a
 // second (Z3 4.8.12), which would dominate the tests.
 StepChecker& FingerChecker() {
