@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace hybrid {
@@ -89,16 +90,52 @@ std::shared_ptr<const FingerPredictor::Entry> FingerPredictor::SimulatorFor(
   return cache_.emplace(key, std::move(sim)).first->second;
 }
 
+std::vector<double> MotorPositions(std::span<const double> requests,
+                                   std::span<const ControllerStop> stops) {
+  std::vector<double> motor(requests.size());
+  std::optional<double> held;
+  size_t next = 0;
+  for (size_t k = 0; k < requests.size(); ++k) {
+    while (next < stops.size() && stops[next].index <= k) {
+      if (stops[next].index == k) held = stops[next].motor;
+      ++next;
+    }
+    if (held && requests[k] < *held) held.reset();  // a more open request: follow it
+    motor[k] = held ? *held : requests[k];
+  }
+  return motor;
+}
+
 FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEffects& e) const {
+  // Where the finger's g lags the drive by more than this (counts), it has stalled.
+  constexpr double kStallGap = 1e-3;
+  constexpr int kMaxPasses = 16;
+  std::vector<ControllerStop> stops;
+  FingerPrediction p;
+  for (int pass = 0;; ++pass) {
+    p = PredictAlong(run, e, MotorPositions(run.g, stops));
+    if (p.status != SimulationStatus::kCompleted || pass + 1 >= kMaxPasses) break;
+    size_t k = stops.empty() ? 0 : stops.back().index + 1;
+    while (k < p.drive.size() && !(p.drive[k] - p.model_g[k] > kStallGap)) ++k;
+    if (k == p.drive.size()) break;
+    // The motor stopped where the engaged transmission (q = p - offset) put the finger's g.
+    stops.push_back({k, std::clamp(p.model_g[k] + e.motor_offset, 0.0, kMotorMax)});
+  }
+  return p;
+}
+
+FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const FingerEffects& e,
+                                               std::vector<double> motor) const {
   const size_t n = run.g.size();
   FingerPrediction p;
-  p.drive = DrivePositions(run.g, e.backlash, e.motor_offset);
+  p.drive = DrivePositions(motor, e.backlash, e.motor_offset);
+  p.motor = std::move(motor);
   for (auto& v : p.theta) v.assign(n, kNaN);
   p.mode.assign(n, -1);
   p.direction.assign(n, 1);
   for (size_t k = 0; k < n; ++k) {
-    const double before = k == 0 ? 0.0 : run.g[k - 1];
-    const double step = run.g[k] - before;
+    const double before = k == 0 ? 0.0 : p.motor[k - 1];
+    const double step = p.motor[k] - before;
     p.direction[k] = step > 0 ? 1 : step < 0 ? -1 : (k == 0 ? 1 : p.direction[k - 1]);
   }
   // Time = path length of the drive; the input is the drive's direction on each piece.

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -23,31 +24,49 @@ struct FingerPrediction {
   /// Direction of travel of the motor at each sample: +1 closing, -1 opening (a sample where g
   /// does not change keeps the previous direction; the first one counts as closing).
   std::vector<int> direction;
-  /// The finger's drive position at each sample (DrivePositions).
+  /// The motor position at each sample: where the controller has driven the motor for the run's
+  /// request (MotorPositions with the stops the simulation found).
+  std::vector<double> motor;
+  /// The finger's drive position at each sample (DrivePositions of `motor`).
   std::vector<double> drive;
-  /// The model's own motor position g at each sample. It equals `drive` until the finger stops
-  /// the motor (phase 4: the motor stalls); a real motor's measured g stalls there too.
+  /// The model's own motor position g at each sample (equal to `drive`: the controller stops
+  /// the motor where the finger stalls).
   std::vector<double> model_g;
   /// kCompleted, or why the run stopped early (later samples are NaN, mode -1).
   SimulationStatus status = SimulationStatus::kCompleted;
   std::string message;
 };
 
-/// Runs the finger automaton driven by a measured run's motor positions, under FingerEffects.
+/// Where the controller stopped the motor because the finger could move no further: at the
+/// sample `index` (the first whose request went past the stop), at motor position `motor`.
+struct ControllerStop {
+  size_t index = 0;
+  double motor = 0.0;
+};
+
+/// The motor positions the gripper's controller reaches for the position requests r_0, r_1, ...
+/// (settled samples, the report's protocol; section 2): p_k = r_k, except that from a stop's
+/// sample on the motor stays at the stop while the request is not more open than it
+/// (r_k >= stop), and follows the request again from the first r_k < stop. `stops` in order of
+/// index.
+std::vector<double> MotorPositions(std::span<const double> requests,
+                                   std::span<const ControllerStop> stops);
+
+/// Runs the finger automaton driven by a measured run's position requests, under FingerEffects.
 ///
-/// The motor path g_0, g_1, ... (from the open finger at g = 0) is mapped to the finger's drive
+/// The run's `g` are position requests (the report's protocol: each sample taken once the finger
+/// has settled). The controller moves the motor to each request, and stops it where the finger
+/// stalls (phase 4), until a more open request (MotorPositions); the stops are found by
+/// simulating: a pass along the requests, then again with each stall found (where the finger's
+/// g lags the drive) made a controller stop, at most 16 passes. The motor path
+/// p_0, p_1, ... (from the open finger at 0) is mapped to the finger's drive
 /// positions q_k by DrivePositions (backlash, motor offset); the automaton, with the dynamic
 /// effects applied (ApplyDynamicEffects) and the run's object at gob<link> = gob - d (the object
 /// touches at the same motor position; clipped to [0, 256]), is simulated with input u = +-1
 /// along q, so that time is the drive's path length and each sample is recorded at its position
 /// on the path (the model is rate-independent: every flow is proportional to u). Sensor biases
-/// are added to the angles. This equals simulating ExtendFingerModel's automaton with the motor
-/// path (tests/gripper/finger_predictor_test.cc checks it to 1e-6 deg) whenever the motor does
-/// not travel past a point where the finger stalled it (phase 4), as a physical motor cannot.
-/// Data that do (the motor's g goes on past the stall) are still predicted: the finger stays
-/// stopped, reverses when g does, and stops at the ends of the motor range; the extended
-/// automaton's g_motor instead stalls with the finger, so after such over-travel the two may
-/// differ by the over-travel.
+/// are added to the angles. This equals simulating ExtendFingerModel's automaton along the
+/// motor path `motor` (tests/gripper/finger_predictor_test.cc checks it to 1e-6 deg).
 ///
 /// Simulators are built once per distinct (dynamic effects, object) and cached (at most 256;
 /// the cache is emptied when full); Predict is safe to call from several threads.
@@ -92,6 +111,9 @@ class FingerPredictor {
   };
   std::shared_ptr<const Entry> SimulatorFor(const MeasuredRun& run,
                                             const FingerEffects& effects) const;
+  // The prediction along the motor path `motor` (one position per sample of `run`).
+  FingerPrediction PredictAlong(const MeasuredRun& run, const FingerEffects& effects,
+                                std::vector<double> motor) const;
   Automaton finger_;
   Options options_;
   mutable std::mutex mutex_;

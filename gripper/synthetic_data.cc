@@ -130,10 +130,8 @@ double Rippled(double g, const HiddenEffects& hidden) {
 
 // The drive position (the automaton's g) at which the finger, closing from open on `run`'s
 // object, stops the motor (enters phase 4, where g has no flow), if it does by `reach`; nullopt
-// otherwise. Found by bisection, to 1e-9 counts from below, on the mode the predictor reaches
-// closing the drive from 0 to q (backlash and offset left out: the finger follows q). A drive
-// that went on past this point would leave the finger behind: the model's g lags it and reaches
-// 0 before the drive does when the finger reopens.
+// otherwise: where the predictor's controller stops the motor for the one request `reach`
+// (backlash and offset left out: the finger follows the drive), a hair (1e-9 counts) below.
 std::optional<double> StallDrive(const FingerPredictor& predictor, const MeasuredRun& run,
                                  const FingerEffects& effects, double reach) {
   FingerEffects dynamics = effects;
@@ -145,20 +143,13 @@ std::optional<double> StallDrive(const FingerPredictor& predictor, const Measure
   if (run.gob) trip.gob = std::clamp(*run.gob - effects.motor_offset, 0.0, 256.0);
   trip.contact_link = run.contact_link;
   for (auto& theta : trip.theta) theta.assign(1, kNaN);
-  const int g_slot = *predictor.finger().symbols().Find("g");
-  const auto stopped = [&](double q) {
-    trip.g = {q};
-    const FingerPrediction p = predictor.Predict(trip, dynamics);
-    if (p.status != SimulationStatus::kCompleted || p.mode[0] < 0) return true;
-    return !predictor.finger().modes()[p.mode[0]].FlowOf(g_slot).has_value();
-  };
-  if (!stopped(reach)) return std::nullopt;
-  double lo = 0.0, hi = reach;
-  while (hi - lo > 1e-9) {
-    const double mid = 0.5 * (lo + hi);
-    (stopped(mid) ? hi : lo) = mid;
+  trip.g = {reach};
+  const FingerPrediction p = predictor.Predict(trip, dynamics);
+  if (p.status != SimulationStatus::kCompleted) {
+    throw std::runtime_error("synthesize: the model stopped early: " + p.message);
   }
-  return lo;
+  if (!(p.motor[0] < reach)) return std::nullopt;
+  return std::max(0.0, p.motor[0] - 1e-9);
 }
 
 // The measured motor path of `run` for the commanded path `command` (0 up to the top and back):
