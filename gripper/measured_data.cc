@@ -21,9 +21,12 @@ namespace hybrid {
 namespace {
 
 // The columns a file may have; the first five are required.
-enum Field { kRun, kG, kTheta1, kTheta2, kTheta3, kGob, kContactLink, kFieldCount };
+enum Field { kRun, kG, kTheta1, kTheta2, kTheta3, kGob, kContactLink, kPosition, kFieldCount };
 constexpr std::array<std::string_view, kFieldCount> kFieldNames = {
-    "run", "g", "theta1", "theta2", "theta3", "gob", "contact_link"};
+    "run", "g", "theta1", "theta2", "theta3", "gob", "contact_link", "position"};
+// How far (counts) a reported motor position may lie above its request: the gripper reports
+// whole counts, so a motor at a fractional request rounds up by at most half a count.
+constexpr double kPositionRounding = 0.5;
 constexpr int kRequiredFields = 5;
 constexpr double kMaxCounts = 255.0;
 
@@ -119,6 +122,7 @@ class Reader {
     std::array<double, 3> theta = {kNaN, kNaN, kNaN};
     std::optional<double> gob;
     std::optional<int> contact_link;
+    double position = kNaN;
   };
 
   [[noreturn]] void Fail(int line, int column, const std::string& message) const {
@@ -246,9 +250,18 @@ class Reader {
             row.contact_link = static_cast<int>(link);
           }
           break;
+        case kPosition:
+          if (!cell.empty()) row.position = ParseCounts(cell, column, field);
+          break;
         case kFieldCount:
           break;
       }
+    }
+    if (row.position > row.g + kPositionRounding) {
+      FailCell(ColumnOf(kPosition), kPosition,
+               "the motor (" + FormatNumber(row.position) +
+                   ") is past the request g = " + FormatNumber(row.g) +
+                   "; the controller never drives the motor beyond the request");
     }
     return row;
   }
@@ -301,6 +314,7 @@ class Reader {
     }
 
     run.g.push_back(row.g);
+    if (column_of_[kPosition] >= 0) run.position.push_back(row.position);
     for (int j = 0; j < 3; ++j) run.theta[j].push_back(row.theta[j]);
     run.lines.push_back(line_);
   }

@@ -6,10 +6,15 @@
 // File format. A CSV file (comma-separated, no quoting) with a header row naming its columns in
 // any order:
 //   run            required; the run's label (any non-empty text, e.g. `1` or `free_a`)
-//   g              required; the motor position, counts, finite, in [0, 255]; never empty
+//   g              required; the position request at which the sample was taken once the finger
+//                  had settled (the report's protocol), counts, finite, in [0, 255]; never empty
 //   theta1..theta3 required; the joint angles, degrees, finite; an empty cell is a missing sample
 //   gob            optional; motor position of first contact with an object, counts, in [0, 255]
 //   contact_link   optional; the link (1 or 2) that touches the object
+//   position       optional; the motor position the gripper reports, counts, in [0, 255]; never
+//                  more than half a count above the request g (the controller does not drive
+//                  the motor past the request; the gripper reports whole counts); an empty cell
+//                  is a missing report
 // `gob` and `contact_link` come together (a header with one and not the other is an error); on
 // each row both are empty (a free-space run) or both are given (a contact run), and they are
 // constant within a run. Any other column is an error naming it, so that typos are caught.
@@ -39,8 +44,11 @@ inline constexpr int kMinRunSamples = 10;
 struct MeasuredRun {
   /// The run's label (the `run` column), non-empty.
   std::string label;
-  /// Motor positions, counts; finite, in [0, 255].
+  /// Position requests, counts; finite, in [0, 255].
   std::vector<double> g;
+  /// The motor positions the gripper reported (the `position` column), one per sample, NaN
+  /// where missing; empty when the file has no such column.
+  std::vector<double> position;
   /// Joint angles theta1..theta3, degrees; NaN marks a missing sample, other values are finite.
   std::array<std::vector<double>, 3> theta;
   /// Motor position of first contact with an object, counts, in [0, 255]; empty for a

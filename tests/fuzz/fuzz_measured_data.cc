@@ -3,7 +3,9 @@
 // reads. Every input either throws DataError (line and column not negative, a message about the
 // data) or gives runs that keep the documented invariants: a non-empty label, at least
 // kMinRunSamples samples, g finite in [0, 255], angles finite or NaN (missing), gob and
-// contact_link set together with gob in [0, 255] and contact_link 1 or 2, increasing lines.
+// contact_link set together with gob in [0, 255] and contact_link 1 or 2, increasing lines,
+// positions (when the file has the column) one per sample, missing or in [0, 255] and at most half
+// a count above the request.
 // CleanOutliers keeps missing samples missing and present ones present and finite.
 
 #include <cmath>
@@ -32,6 +34,15 @@ void CheckRun(const hybrid::MeasuredRun& run) {
   for (size_t i = 0; i < n; ++i) {
     if (!(run.g[i] >= 0.0 && run.g[i] <= 255.0)) FuzzFail("g outside [0, 255]");
     if (i > 0 && !(run.lines[i] > run.lines[i - 1])) FuzzFail("lines do not increase");
+  }
+  if (!run.position.empty() && run.position.size() != n) {
+    FuzzFail("positions and samples differ in number");
+  }
+  for (size_t i = 0; i < run.position.size(); ++i) {
+    const double p = run.position[i];
+    if (!std::isnan(p) && !(p >= 0.0 && p <= 255.0 && p <= run.g[i] + 0.5)) {
+      FuzzFail("a position outside [0, 255] or past the request");
+    }
   }
   if (run.gob.has_value() != run.contact_link.has_value()) {
     FuzzFail("gob and contact_link not set together");

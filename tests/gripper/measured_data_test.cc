@@ -216,6 +216,47 @@ TEST(ReadMeasuredData, ReadsSeveralRunsWithOptionalColumns) {
   EXPECT_EQ(data.samples(), 33);
 }
 
+// The optional `position` column: the motor position the gripper reports, one per sample (NaN
+// where empty); absent, the run has no positions.
+TEST(ReadMeasuredData, ReadsTheReportedMotorPosition) {
+  std::string text = "run,g,position,theta1,theta2,theta3\n";
+  for (int i = 0; i < 12; ++i) {
+    const int request = 230 + 2 * i;  // past the palm stop at 240: the motor stays there
+    const std::string position = i == 5 ? "" : std::to_string(std::min(request, 240));
+    text += "1," + std::to_string(request) + "," + position + ",70,90,-55\n";
+  }
+  const MeasuredData data = Read(text);
+  const MeasuredRun& run = data.runs.at(0);
+  ASSERT_EQ(run.position.size(), 12u);
+  EXPECT_EQ(run.position[0], 230.0);
+  EXPECT_EQ(run.position[11], 240.0);
+  EXPECT_EQ(run.g[11], 252.0);
+  EXPECT_TRUE(std::isnan(run.position[5]));
+  EXPECT_TRUE(Read(std::string(kHeader) + Rows("1", 10)).runs[0].position.empty());
+}
+
+TEST(ReadMeasuredDataErrors, PositionPastTheRequestOrOutOfRange) {
+  const std::string header = "run,g,theta1,theta2,theta3,position\n";
+  const std::string rows = Rows("1", 3, ",0") + "1,100,10,20,30,%\n" + Rows("1", 10, ",0");
+  auto with = [&](const std::string& position) {
+    std::string text = header + rows;
+    text.replace(text.find('%'), 1, position);
+    return text;
+  };
+  // Half a count of rounding is allowed; more is a motor ahead of its request.
+  EXPECT_NO_THROW(Read(with("100.5")));
+  EXPECT_TRUE(
+      FailsAt(with("101"), 5, 6, "column 'position': the motor (101) is past the request g = 100"));
+  EXPECT_TRUE(FailsAt(with("256"), 5, 6, "column 'position': outside [0, 255]"));
+  EXPECT_TRUE(FailsAt(with("-1"), 5, 6, "column 'position': outside [0, 255]"));
+  EXPECT_TRUE(FailsAt(with("x"), 5, 6, "column 'position': not a number"));
+}
+
+TEST(ReadMeasuredDataErrors, RequestOutsideTheMotorRange) {
+  EXPECT_TRUE(FailsAt(WithRow("1,255.5,10,20,30"), 5, 2, "column 'g': outside [0, 255]"));
+  EXPECT_TRUE(FailsAt(WithRow("1,-2,10,20,30"), 5, 2, "column 'g': outside [0, 255]"));
+}
+
 TEST(ReadMeasuredDataFile, ReadsAFile) {
   TempDir dir;
   const std::string path = dir.Write("runs.csv", std::string(kHeader) + Rows("1", 10)).string();
@@ -278,6 +319,9 @@ TEST(ReadMeasuredDataErrors, UnknownColumnIsNamed) {
   EXPECT_TRUE(
       FailsAt("run,g,theta1,theta2,theta3,temperature\n", 1, 6, "unknown column 'temperature'"));
   EXPECT_TRUE(FailsAt("run,G,theta1,theta2,theta3\n", 1, 2, "unknown column 'G'"));
+  EXPECT_TRUE(FailsAt("run,g,theta1,theta2,theta3,motor\n", 1, 6,
+                      "(the columns are run, g, theta1, theta2, theta3, gob, contact_link, "
+                      "position)"));
 }
 
 TEST(ReadMeasuredDataErrors, EmptyColumnName) {
