@@ -52,6 +52,7 @@
 #include "gripper/measured_data.h"
 #include "gripper/synthetic_data.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/robotiq_rig.h"
 
 namespace hybrid {
 namespace {
@@ -575,6 +576,91 @@ TEST(DiagnosisDetectability, Sweep) {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   std::cout << "peak resident memory: " << usage.ru_maxrss / 1024 << " MB\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Data from the independent rig (tests/test_utilities/robotiq_rig.h): the report's protocol,
+// requests that close past the stop and reopen, the controller as the manual describes it. The
+// diagnosis sees only the CSV.
+
+// One data set like `hybrid synthesize`'s default design: 4 free runs, 3 against link 1 (gob 80,
+// 80, 100), 3 against link 2 (170, 170, 190), each the report's protocol up to 255 and back
+// (stepped as `stepping`, with a reversal on the way up when `reverse`), noise `noise_deg` on
+// every angle and 1% missing cells, drawn from `seed`. The CSV gives the object as the motor
+// position of first contact (the drive's contact plus the motor offset).
+std::string RigDataCsv(const testing::RigFinger& finger, const testing::RigEffects& effects,
+                       std::uint64_t seed, testing::RigStepping stepping, bool reverse,
+                       double noise_deg = 0.7) {
+  struct RunSpec {
+    int link;
+    double gob;
+  };
+  const std::vector<RunSpec> runs = {{0, 0},  {0, 0},   {0, 0},   {0, 0},   {1, 80},
+                                     {1, 80}, {1, 100}, {2, 170}, {2, 170}, {2, 190}};
+  std::string csv = testing::RigCsvHeader(true);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    testing::RigObject object, reported;
+    if (runs[r].link == 1)
+      object.gob1 = runs[r].gob, reported.gob1 = runs[r].gob + effects.motor_offset;
+    if (runs[r].link == 2)
+      object.gob2 = runs[r].gob, reported.gob2 = runs[r].gob + effects.motor_offset;
+    const std::optional<double> reverse_at =
+        reverse ? std::optional<double>(60.0 + 15.0 * static_cast<double>(r)) : std::nullopt;
+    const std::vector<double> requests =
+        testing::RigProtocol(255, stepping, seed * 31 + r, reverse_at, 25.0);
+    testing::RigMeasurement m;
+    m.noise_deg = noise_deg;
+    m.missing_fraction = 0.01;
+    m.seed = seed * 1009 + r;
+    const auto samples = testing::RigRun(requests, finger, object, effects, m);
+    csv += testing::RigCsvRows("run" + std::to_string(r), samples, reported, runs[r].link, true);
+  }
+  return csv;
+}
+
+Diagnosis DiagnoseCsv(const std::string& csv) {
+  std::istringstream in(csv);
+  MeasuredData read = ReadMeasuredData(in, "rig.csv");
+  const FingerPredictor predictor(Finger(), FingerPredictor::FastOptions());
+  return Diagnose(predictor, std::move(read), Options());
+}
+
+// Clean rig data whose requests close past the stop (the palm at 240, link 3 at its limit with
+// an object) and reopen: nothing to explain, whatever the stepping.
+TEST(DiagnoseRigTest, CleanDataPastTheStopIsNone) {
+  for (const auto stepping :
+       {testing::RigStepping::kOne, testing::RigStepping::kTwo, testing::RigStepping::kIrregular}) {
+    const Diagnosis d =
+        DiagnoseCsv(RigDataCsv({}, {}, 5, stepping, stepping != testing::RigStepping::kOne));
+    EXPECT_EQ(d.cause, std::vector<std::string>{"none"})
+        << "stepping " << static_cast<int>(stepping) << ": " << Describe(d);
+  }
+}
+
+// Exploration: HYBRID_DIAGNOSE_RIG="kind size" diagnoses rig data with one hidden effect.
+TEST(DiagnoseRigTest, Explore) {
+  const std::vector<std::string> args = Split(Env("HYBRID_DIAGNOSE_RIG"));
+  if (args.size() < 2) GTEST_SKIP() << "set HYBRID_DIAGNOSE_RIG=kind,size[,seed,stepping,reverse]";
+  testing::RigFinger finger;
+  testing::RigEffects effects;
+  const std::string kind = args[0];
+  const double size = std::stod(args[1]);
+  const std::uint64_t seed = args.size() > 2 ? std::stoull(args[2]) : 1;
+  const auto stepping = static_cast<testing::RigStepping>(args.size() > 3 ? std::stoi(args[3]) : 0);
+  const bool reverse = args.size() > 4 && args[4] == "1";
+  if (kind == "backlash") effects.backlash = size;
+  if (kind == "motor_offset") effects.motor_offset = size;
+  if (kind == "theta1_max") finger.theta1_max += size;
+  if (kind == "theta2_max") finger.theta2_max += size;
+  if (kind == "theta3_max") finger.theta3_max += size;
+  if (kind == "theta1_bias") effects.bias[0] = size;
+  if (kind == "theta2_bias") effects.bias[1] = size;
+  if (kind == "theta3_bias") effects.bias[2] = size;
+  if (kind == "compliance_link1") effects.compliance[0] = size;
+  if (kind == "compliance_link2") effects.compliance[1] = size;
+  if (kind == "theta3_fraction") finger.theta3_fraction += size;
+  const Diagnosis d = DiagnoseCsv(RigDataCsv(finger, effects, seed, stepping, reverse));
+  std::cout << "rig " << kind << " " << size << " seed " << seed << ": " << Describe(d) << "\n";
 }
 
 }  // namespace

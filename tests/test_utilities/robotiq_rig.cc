@@ -181,8 +181,8 @@ std::string RigCsvHeader(bool contact_columns) {
 }
 
 std::string RigCsvRows(const std::string& run, const std::vector<RigSample>& samples,
-                       const RigObject& object, int contact_link) {
-  std::string contact;
+                       const RigObject& object, int contact_link, bool contact_columns) {
+  std::string contact = contact_columns ? ",," : "";
   if (contact_link == 1 || contact_link == 2) {
     const std::optional<double>& gob = contact_link == 1 ? object.gob1 : object.gob2;
     if (!gob) throw std::invalid_argument("RigCsvRows: no object on that link");

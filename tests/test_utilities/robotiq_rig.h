@@ -103,9 +103,9 @@ std::vector<double> RigProtocol(double top, RigStepping stepping, std::uint64_t 
 /// The rows of `samples` as CSV lines of the measured-data format (gripper/measured_data.h)
 /// with the optional `position` column: run,g,position,theta1,theta2,theta3[,gob,contact_link]
 /// (gob and contact_link when `contact_link` is 1 or 2; `gob` is then the object's position for
-/// that link). No header.
+/// that link; two empty cells for a free run when `contact_columns`). No header.
 std::string RigCsvRows(const std::string& run, const std::vector<RigSample>& samples,
-                       const RigObject& object, int contact_link);
+                       const RigObject& object, int contact_link, bool contact_columns = false);
 
 /// The header that goes with RigCsvRows: with or without the contact columns.
 std::string RigCsvHeader(bool contact_columns);
