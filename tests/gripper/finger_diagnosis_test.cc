@@ -653,15 +653,15 @@ const std::vector<RigKind>& RigKinds() {
   static const std::vector<RigKind> kinds = {
       {"backlash", kBacklash, 1, 0.6, 15},
       {"motor_offset", P{Cause::kMotorOffset, 0}, 0, 0.3, 15},
-      {"theta1_max", P{Cause::kJointRange, 0}, 0, 0.2, 15},
-      {"theta2_max", P{Cause::kJointRange, 1}, 0, 0.2, 15},
+      {"theta1_max", P{Cause::kJointRange, 0}, 0, 0.2, 10},
+      {"theta2_max", P{Cause::kJointRange, 1}, 0, 0.2, 10},
       {"theta3_max", P{Cause::kJointRange, 2}, 0, 0.5, 10},
-      {"theta1_bias", P{Cause::kSensorBias, 0}, 0, 0.1, 5},
-      {"theta2_bias", P{Cause::kSensorBias, 1}, 0, 0.1, 5},
-      {"theta3_bias", kTheta3Bias, 0, 0.1, 5},
+      {"theta1_bias", P{Cause::kSensorBias, 0}, 0, 0.2, 5},
+      {"theta2_bias", P{Cause::kSensorBias, 1}, 0, 0.2, 5},
+      {"theta3_bias", kTheta3Bias, 0, 0.2, 5},
       {"compliance_link1", P{Cause::kCompliance, 0}, 1, 0.008, 0.1},
-      {"compliance_link2", P{Cause::kCompliance, 1}, 1, 0.008, 0.1},
-      {"theta3_fraction", P{Cause::kTheta3Law, 0}, 0, 0.005, 0.15},
+      {"compliance_link2", P{Cause::kCompliance, 1}, 1, 0.016, 0.1},
+      {"theta3_fraction", P{Cause::kTheta3Law, 0}, 0, 0.005, 0.12},
       {"none", std::nullopt, 1, 0, 0},
   };
   return kinds;
@@ -709,10 +709,9 @@ TEST(DiagnosisRigProperty, NamesTheHiddenEffectOnRigData) {
     const RigKind& k = kinds[draw(rc::gen::inRange<size_t>(0, kinds.size()))];
     const int sign = k.sign != 0 ? k.sign : draw(rc::gen::element(1, -1));
     const int step = draw(rc::gen::inRange<int>(0, kSizeSteps + 1));
-    const double size =
-        k.parameter ? k.threshold * std::pow(k.high / k.threshold,
-                                             static_cast<double>(step) / kSizeSteps)
-                    : 0.0;
+    const double size = k.parameter ? k.threshold * std::pow(k.high / k.threshold,
+                                                             static_cast<double>(step) / kSizeSteps)
+                                    : 0.0;
     const auto seed = draw(rc::gen::inRange<std::uint64_t>(1, 1000000));
     const auto stepping = static_cast<testing::RigStepping>(draw(rc::gen::inRange(0, 3)));
     const bool reverse = draw(rc::gen::arbitrary<bool>());
@@ -725,8 +724,7 @@ TEST(DiagnosisRigProperty, NamesTheHiddenEffectOnRigData) {
     hits += hit;
     if (!hit) {
       misses << "    " << k.name << " " << sign * size << " seed " << seed << " stepping "
-             << static_cast<int>(stepping) << " reverse " << reverse << ": " << Describe(d)
-             << "\n";
+             << static_cast<int>(stepping) << " reverse " << reverse << ": " << Describe(d) << "\n";
     }
     RC_ASSERT(k.parameter || hit);  // clean data never get a cause
   };

@@ -164,7 +164,7 @@ TEST(FingerPredictorTest, RequestsPastTheStopFollowTheIndependentRig) {
   };
   for (const Case& c : {Case{{}, {}, 0, 0}, Case{80, {}, 0, 0}, Case{{}, 170, 0, 0},
                         Case{60, {}, 6, 0}, Case{{}, 200, 0, 5}, Case{100, {}, 4, -3},
-                        Case{{}, 170, 15, 0}}) {
+                        Case{{}, 170, 15, 0}, Case{80, {}, 6, 0}, Case{100, {}, 8, 0}}) {
     testing::RigObject object;
     object.gob1 = c.gob1;
     object.gob2 = c.gob2;
