@@ -466,6 +466,8 @@ Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effect
   AddFingerTransitions(out, dyn, ids, measured);
   AddInitialStates(out, dyn, ids, measured, play, effects, initial_finger, kApi);
   for (const Property& p : dyn.properties()) out.AddProperty(p);
+  // The finger's default scenario drives the motor (u) the same way: the model runs as written.
+  if (dyn.scenario()) out.SetScenario(*dyn.scenario());
   return out;
 }
 

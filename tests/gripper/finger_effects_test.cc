@@ -13,6 +13,7 @@
 
 #include "automaton/parser.h"
 #include "automaton/printer.h"
+#include "solvers/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {
@@ -116,6 +117,27 @@ TEST(ExtendFingerModelTest, ThreeCopiesOfEachModeAndPrintable) {
       EXPECT_EQ(m.flows[0].first, gm);
     }
   }
+}
+
+// The extended model runs as written: it keeps the finger's scenario (close for 255 s, hold,
+// open for 240 s), and with a play of 6 counts the finger stays 6 counts closed when the motor
+// is back at 0 (the play of DrivePositions: q = 0 + b).
+TEST(ExtendFingerModelTest, KeepsTheScenarioAndRunsWithoutOptions) {
+  FingerEffects e;
+  e.backlash = 6.0;
+  const Automaton extended = ExtendFingerModel(Finger(), e, std::nullopt);
+  ASSERT_TRUE(extended.scenario().has_value());
+  const System system = ParseModel(PrintAutomaton(extended), "extended.ha");
+  const Simulator simulator(system);
+  const SimulationResult r = simulator.Run(SimulationOptions{});
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  const auto& names = simulator.variable_names();
+  auto at_end = [&](const std::string& name) {
+    return r.samples.back().x[std::find(names.begin(), names.end(), name) - names.begin()];
+  };
+  EXPECT_NEAR(at_end("g_motor"), 0.0, 1e-9);
+  EXPECT_NEAR(at_end("g"), 6.0, 1e-6);
+  EXPECT_NEAR(at_end("theta1"), 3.0, 1e-6);  // m1 * 6
 }
 
 TEST(ExtendFingerModelTest, EarlyMotorNeedsTheFingersStartState) {
