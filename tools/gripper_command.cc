@@ -228,6 +228,10 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
     *args.g += 0.0;  // -0 -> 0
   }
   for (double g : args.draw_at) CheckMotor("--at", g);
+  for (double& r : args.requests) {
+    CheckMotor("--requests", r);
+    r += 0.0;  // -0 -> 0
+  }
   FingerContacts contacts;
   for (int i = 0; i < 3; ++i) {
     if (!args.gob[i]) continue;
@@ -237,8 +241,8 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   if (AnyGob(args) && !args.objects.empty()) {
     throw std::invalid_argument("--gob1..3 and --object cannot be combined");
   }
-  if (!args.g && args.draw.empty() && args.plot.empty()) {
-    throw std::invalid_argument("nothing to do: give --g, --draw or --plot");
+  if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty()) {
+    throw std::invalid_argument("nothing to do: give --g, --requests, --draw or --plot");
   }
   return contacts;
 }
@@ -290,6 +294,23 @@ std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& obje
 
 // The report of `hybrid finger` before any simulation: the configuration at --g (if given), the
 // contacts that take effect, where the finger stops and the objects.
+// The settled state after each request of --requests: the controller drives the motor to the
+// request and stops it where the finger stalls (closed.stop()); it stays there until a request
+// below the stop (docs/finger_model.md, "The controller"). The closed form has no hysteresis, so
+// the angles are its configuration at the motor's position; the status is the firmware's (2:
+// stopped while closing, 3: at the request).
+json RequestHistoryJson(const std::vector<double>& requests, const FingerClosedForm& closed) {
+  json out = json::array();
+  for (const double r : requests) {
+    json entry = ConfigurationJson(r, closed.At(r));
+    entry.erase("g");
+    entry["request"] = r;
+    entry["status"] = r >= closed.stop() ? 2 : 3;
+    out.push_back(std::move(entry));
+  }
+  return out;
+}
+
 json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
                   const std::optional<GeometricFinger>& geometric,
                   const std::vector<Obstacle>& objects) {
@@ -297,6 +318,7 @@ json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
   if (geometric) by = geometric->blocked_by();
   json report;
   if (args.g) report = ConfigurationJson(*args.g, closed.At(*args.g));
+  if (!args.requests.empty()) report["requests"] = RequestHistoryJson(args.requests, closed);
   report["contacts"] = ContactsJson(closed, by, {"", "", ""});
   report["stop"] = StopJson(closed.stop());
   if (!objects.empty()) {
@@ -364,6 +386,17 @@ std::string FingerText(const FingerArgs& args, const FingerClosedForm& closed, c
         << "\n"
         << "theta1 = " << Fixed(q.theta[0]) << " deg\ntheta2 = " << Fixed(q.theta[1])
         << " deg\ntheta3 = " << Fixed(q.theta[2]) << " deg\n";
+  }
+  if (report.contains("requests")) {
+    out << "request    motor  status     theta1     theta2     theta3  mode\n";
+    for (const json& e : report.at("requests")) {
+      char line[160];
+      std::snprintf(line, sizeof line, "%7.2f  %7.2f  %6d  %9.4f  %9.4f  %9.4f  %s\n",
+                    e["request"].get<double>(), e["motor"].get<double>(), e["status"].get<int>(),
+                    e["theta1"].get<double>(), e["theta2"].get<double>(), e["theta3"].get<double>(),
+                    e["mode"].get<std::string>().c_str());
+      out << line;
+    }
   }
   out << "contacts:";
   if (report.at("contacts").empty()) out << " none";

@@ -11,6 +11,7 @@ namespace hybrid::cli {
 /// Options of `hybrid finger` (see docs/cli.md).
 struct FingerArgs {
   std::optional<double> g;                   ///< commanded motor position (required unless drawing)
+  std::vector<double> requests;              ///< --requests: a history of position requests
   std::array<std::optional<double>, 3> gob;  ///< --gob1..3 when given
   std::vector<std::string> objects;          ///< --object descriptions (finger frame)
   bool json = false;

@@ -203,6 +203,10 @@ void AddFinger(CLI::App& app, Commands& c) {
                      "An object in the finger plane (metres; x towards the palm centre, y along "
                      "the open finger, origin at joint 1): circle:X,Y,R or "
                      "segment:X1,Y1,X2,Y2[,R]; repeatable");
+  AddNumberListOption(finger, "--requests", &a.requests,
+                      "A history of position requests R1,R2,... (each in [0, 255]): the settled "
+                      "motor position, controller status and angles after each, as the gripper's "
+                      "controller drives the motor (it stops where the finger stalls)");
   finger->add_flag("--json", a.json, "Machine-readable output");
   finger->add_option("--draw", a.draw, "Write an SVG drawing of the finger (see --at)");
   AddNumberListOption(finger, "--at", &a.draw_at,

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "tests/test_utilities/command_line.h"
+#include "tests/test_utilities/robotiq_rig.h"
 
 namespace hybrid {
 namespace {
@@ -325,6 +326,43 @@ TEST(HybridFinger, ModelSetsTheClosedFormsConstants) {
   EXPECT_EQ(Field(j, "simulation", "agrees"), true) << j.dump(2);
   // Without --model: the report's constants.
   EXPECT_NEAR(Field(RunJson("finger --g 200"), "theta2").get<double>(), 54.0, 1e-9);
+}
+
+// --requests: the settled state after each request of a history that closes past the stop and
+// reopens, against the independent rig (motor min(request, stop), the rig's angles), with an
+// object on link 1 and with a model whose theta3 fraction is 0.3; the firmware status is 2
+// while the request is at or past the stop, 3 otherwise.
+TEST(HybridFinger, RequestHistoryFollowsTheIndependentRig) {
+  TempDir dir;
+  std::string text = ReadAll(HYBRID_SOURCE_DIR "/spec/finger.ha");
+  const std::string from = "param theta3_fraction = 0.5;";
+  text.replace(text.find(from), from.size(), "param theta3_fraction = 0.3;");
+  const std::string model = Quote(dir.Write("fraction.ha", text));
+  const std::vector<double> requests = {60, 150, 255, 240, 200, 170, 120, 0};
+  testing::RigFinger finger;
+  finger.theta3_fraction = 0.3;
+  testing::RigObject object;
+  object.gob1 = 80;
+  const auto rig = testing::RigRun(requests, finger, object, {}, {});
+  const json j =
+      RunJson("finger --model " + model + " --gob1 80 --requests 60,150,255,240,200,170,120,0");
+  const json& history = Field(j, "requests");
+  ASSERT_EQ(history.size(), requests.size()) << j.dump(2);
+  const double stop = testing::RigStopPosition(finger, object);
+  for (size_t k = 0; k < requests.size(); ++k) {
+    SCOPED_TRACE("request " + std::to_string(requests[k]));
+    EXPECT_EQ(history[k]["request"].get<double>(), requests[k]);
+    EXPECT_NEAR(history[k]["motor"].get<double>(), std::min(requests[k], stop), 1e-9);
+    EXPECT_EQ(history[k]["status"].get<int>(), requests[k] >= stop ? 2 : 3);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(history[k]["theta" + std::to_string(i + 1)].get<double>(), rig[k].theta[i], 1e-9);
+    }
+  }
+  const Result bad = RunHybrid("finger --requests 10,256");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--requests must be a motor position in [0, 255] (got 256)"),
+            std::string::npos)
+      << bad.err;
 }
 
 // --model that is not a finger automaton, also without --simulate: exit 1, naming the file.
