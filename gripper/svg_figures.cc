@@ -488,6 +488,54 @@ AngleCurves SampleAngles(const FingerClosedForm& closed_form) {
 
 // Gridlines with their value (data-g, data-theta), ticks and numbers, the frame and the axis
 // titles.
+// Widens `c`'s angle range (multiples of kThetaStep) to hold the measured samples in range.
+void WidenForMeasured(AngleCurves& c, const std::vector<MeasuredSeries>& measured) {
+  for (const MeasuredSeries& run : measured) {
+    for (int k = 0; k < 3; ++k) {
+      for (size_t i = 0; i < run.g.size() && i < run.theta[k].size(); ++i) {
+        const double g = run.g[i], theta = run.theta[k][i];
+        if (!std::isfinite(theta) || !(g >= 0.0 && g <= c.g_max)) continue;
+        c.lo = std::min(c.lo, kThetaStep * std::floor(theta / kThetaStep));
+        c.hi = std::max(c.hi, kThetaStep * std::ceil(theta / kThetaStep));
+      }
+    }
+  }
+}
+
+// The measured samples as dots in the joints' colours.
+void DrawMeasured(SvgPlot& svg, const AngleCurves& c, const std::vector<MeasuredSeries>& measured) {
+  svg.Group("class=\"measured\" fill-opacity=\"0.5\"");
+  for (int k = 0; k < 3; ++k) {
+    svg.Group("class=\"measured theta" + std::to_string(k + 1) + "\" fill=\"" + kLinkColours[k] +
+              "\"");
+    for (const MeasuredSeries& run : measured) {
+      for (size_t i = 0; i < run.g.size() && i < run.theta[k].size(); ++i) {
+        const double g = run.g[i], theta = run.theta[k][i];
+        if (!std::isfinite(theta) || !(g >= 0.0 && g <= c.g_max)) continue;
+        svg.Marker(c.X(g), c.Y(theta), 1.6);
+      }
+    }
+    svg.EndGroup();
+  }
+  svg.EndGroup();
+}
+
+// Dotted vertical lines at the contact positions given to the closed form (the report's g_ob).
+void DrawContactLines(SvgPlot& svg, const AngleCurves& c, const FingerContacts& contacts) {
+  svg.Group("class=\"gob\"");
+  for (int i = 0; i < 3; ++i) {
+    const double gob = contacts.gob[i];
+    if (!(gob >= 0.0 && gob <= c.g_max)) continue;
+    const double x = c.X(gob);
+    svg.Line(x, kPlotTop, x, kPlotTop + kPlotHeight,
+             "class=\"gob\" stroke=\"#777777\" stroke-dasharray=\"2 3\"");
+    svg.TextMarkup(x + 4, kPlotTop + kPlotHeight - 8 - 14 * i,
+                   "g_ob link " + std::to_string(i + 1) + " = " + Label(gob),
+                   "class=\"gob\" text-anchor=\"start\"");
+  }
+  svg.EndGroup();
+}
+
 void DrawAngleAxes(SvgPlot& svg, const AngleCurves& c) {
   constexpr double kBottom = kPlotTop + kPlotHeight;
   svg.Group("class=\"axes\"");
@@ -631,15 +679,27 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
   return svg.Finish();
 }
 
-std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title) {
-  const AngleCurves curves = SampleAngles(closed_form);
+std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title,
+                         const std::vector<MeasuredSeries>& measured) {
+  AngleCurves curves = SampleAngles(closed_form);
+  WidenForMeasured(curves, measured);
   SvgPlot svg = OpenSvg(kPlotPageWidth, kPlotPageHeight, title);
   svg.TextMarkup(kPlotLeft + kPlotWidth / 2, kPlotTop - 18, Escape(title),
                  "class=\"title\" font-size=\"15\" text-anchor=\"middle\"");
   DrawAngleAxes(svg, curves);
   if (std::isfinite(closed_form.stop())) DrawStopLine(svg, curves, closed_form.stop());
+  DrawContactLines(svg, curves, closed_form.contacts());
+  if (!measured.empty()) DrawMeasured(svg, curves, measured);
   DrawAngleCurves(svg, curves);
   DrawAngleLegend(svg);
+  if (!measured.empty()) {
+    const double x = kPlotLeft + kPlotWidth + 16, y = kPlotTop + 12 + 3 * 22 + 8;
+    svg.TextMarkup(x, y, "dots: measured", "class=\"key\"");
+    svg.TextMarkup(
+        x, y + 16,
+        "(" + std::to_string(measured.size()) + " run" + (measured.size() == 1 ? "" : "s") + ")",
+        "class=\"key\"");
+  }
   return svg.Finish();
 }
 

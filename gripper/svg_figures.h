@@ -68,6 +68,13 @@ struct HandFrame {
 /// if `frames` is empty or a frame's g or angle is not finite.
 std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frames);
 
+/// Measured samples of one run, drawn over AnglePlotSvg's curves: the position request g
+/// (counts) of each sample and its angles theta1..3 (degrees; NaN where missing).
+struct MeasuredSeries {
+  std::vector<double> g;
+  std::array<std::vector<double>, 3> theta;
+};
+
 /// The joint angles theta1, theta2, theta3 (degrees) of `closed_form` against the motor
 /// position g in [0, motor_max] counts (like figures 5.2 and 5.4 of the report), titled
 /// `title` (escaped for XML; control characters become spaces).
@@ -78,10 +85,17 @@ std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frame
 /// at motor_max and at every piece's end points (closed_form.pieces()), merged and sorted, so
 /// the corners are exact; samples closer than 1e-9 counts to an earlier one are dropped.
 /// Gridlines carry their value (data-g, data-theta). If closed_form.stop() is finite a dashed
-/// vertical line (class "stop") marks it, labelled "motor stops (g = <stop>)".
+/// vertical line (class "stop") marks it, labelled "motor stops (g = <stop>)". Every contact
+/// position given to the closed form (closed_form.contacts(), the report's g_ob) within the
+/// range gets a dotted vertical line (class "gob"), labelled "g_ob link <i> = <g>".
+/// `measured` samples (figures 5.2 and 5.4 overlay the runs) are small dots in the joints'
+/// colours (class "measured theta<k>"), at their request g; samples outside [0, motor_max] or
+/// missing are left out, and the y range widens to hold the others. The legend then adds
+/// "dots: measured" and "(<n> runs)".
 ///
 /// Returns a standalone SVG document (ending in "</svg>\n"); coordinates in pixels with two
 /// decimals, so the output is deterministic. Does not throw (apart from std::bad_alloc).
-std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title);
+std::string AnglePlotSvg(const FingerClosedForm& closed_form, const std::string& title,
+                         const std::vector<MeasuredSeries>& measured = {});
 
 }  // namespace hybrid::gripper

@@ -15,6 +15,7 @@
 #include "gripper/finger_parameters.h"
 #include "gripper/geometric_finger.h"
 #include "gripper/hand.h"
+#include "gripper/measured_data.h"
 #include "gripper/svg_figures.h"
 #include "solvers/simulation/simulator.h"
 #include "tools/options.h"
@@ -219,9 +220,10 @@ bool AnyGob(const FingerArgs& args) {
 // contact positions given by --gob1..3 (the others at their default). Turns a --g of -0 into 0.
 FingerContacts CheckFingerArgs(FingerArgs& args) {
   const std::vector<NamedFile> outputs = {{"--draw", args.draw}, {"--plot", args.plot}};
-  CheckDistinctFiles(args.model.empty() ? std::vector<NamedFile>{}
-                                        : std::vector<NamedFile>{{"--model", args.model}},
-                     outputs);
+  std::vector<NamedFile> inputs;
+  if (!args.model.empty()) inputs.push_back({"--model", args.model});
+  if (!args.data.empty()) inputs.push_back({"--data", args.data});
+  CheckDistinctFiles(inputs, outputs);
   CheckOutputPlaces(outputs);
   if (args.g) {
     CheckMotor("--g", *args.g);
@@ -240,6 +242,9 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   }
   if (AnyGob(args) && !args.objects.empty()) {
     throw std::invalid_argument("--gob1..3 and --object cannot be combined");
+  }
+  if (!args.data.empty() && args.plot.empty()) {
+    throw UsageError("--data needs --plot (it overlays the runs on the plot)");
   }
   if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty()) {
     throw std::invalid_argument("nothing to do: give --g, --requests, --draw or --plot");
@@ -349,6 +354,37 @@ Comparison SimulateFinger(const FingerArgs& args, const Automaton& model,
                          [&](int, double g) { return closed.At(g).theta; });
 }
 
+// The runs of --data whose object is the finger's: a run against link i at gob when only --gobi
+// = gob is given, free runs when no --gobN is (none with --object). Throws InputError (exit 1)
+// when no run matches; the file's errors are DataError (exit 1, with line and column).
+std::vector<gripper::MeasuredSeries> OverlaidRuns(const FingerArgs& args,
+                                                  const FingerContacts& contacts) {
+  std::vector<gripper::MeasuredSeries> out;
+  if (args.data.empty()) return out;
+  const MeasuredData data = ReadMeasuredDataFile(args.data);
+  std::string wanted = "free space";
+  int given = 0, link = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!(contacts.gob[i] <= 255.0)) continue;
+    ++given;
+    link = i + 1;
+    wanted = "gob" + std::to_string(link) + " = " + FormatNumber(contacts.gob[i]);
+  }
+  for (const MeasuredRun& run : data.runs) {
+    const bool matches = args.objects.empty() &&
+                         (given == 0 ? !run.contact_link
+                                     : given == 1 && run.contact_link == link && run.gob &&
+                                           std::abs(*run.gob - contacts.gob[link - 1]) <= 1e-9);
+    if (matches) out.push_back({run.g, run.theta});
+  }
+  if (out.empty()) {
+    throw InputError(args.data + ": no run has the finger's object (" +
+                     (args.objects.empty() ? wanted : std::string("--object")) +
+                     "): --data overlays the runs measured with it");
+  }
+  return out;
+}
+
 // The files of `hybrid finger`: --draw (the finger at the frames' motor positions) and --plot
 // (the joint angles against g), as (path, SVG) pairs.
 std::vector<std::pair<std::string, std::string>> FingerFiles(
@@ -371,7 +407,8 @@ std::vector<std::pair<std::string, std::string>> FingerFiles(
         title += ", gob" + std::to_string(i + 1) + " = " + FormatNumber(contacts.gob[i]);
       }
     }
-    files.emplace_back(args.plot, gripper::AnglePlotSvg(closed, title));
+    files.emplace_back(args.plot,
+                       gripper::AnglePlotSvg(closed, title, OverlaidRuns(args, contacts)));
   }
   return files;
 }

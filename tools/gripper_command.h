@@ -18,6 +18,7 @@ struct FingerArgs {
   std::string draw;             ///< SVG of the finger at `draw_at`
   std::vector<double> draw_at;  ///< motor positions of the drawing's panels
   std::string plot;             ///< SVG plot of theta1..3 against g
+  std::string data;             ///< measured runs to overlay on --plot
   bool simulate = false;        ///< also simulate the automaton and compare
   std::string model;            ///< the finger automaton for --simulate
 };

@@ -213,6 +213,9 @@ void AddFinger(CLI::App& app, Commands& c) {
                       "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)");
   finger->add_option("--plot", a.plot,
                      "Write an SVG plot of theta1..3 against g (as the report's figure 5.4)");
+  finger->add_option("--data", a.data,
+                     "Measured runs (the CSV of `hybrid diagnose`) to overlay on --plot: the runs "
+                     "whose object is the finger's (--gobN; free runs without)");
   finger->add_flag("--simulate", a.simulate,
                    "Also simulate the finger automaton closing (u = 1 to g = 255) and compare it "
                    "with the closed form (exit 5 if they differ by more than 1e-6 degrees)");

@@ -223,6 +223,30 @@ TEST(AnglePlotSvgTest, FreeSpaceCurvesAxesAndStop) {
   EXPECT_EQ(Count(svg, "<polyline"), 3);
 }
 
+// Measured runs over the curves (figures 5.2 and 5.4): one dot per present sample in range and
+// joint, at its g and angle; the y range widens for an angle below -60; g_ob is marked.
+TEST(AnglePlotSvgTest, MeasuredRunsAreDotsAndTheContactIsMarked) {
+  FingerContacts contacts;
+  contacts.gob[0] = 80.0;
+  MeasuredSeries run;
+  run.g = {0, 100, 200, 300};  // 300 lies outside the range: left out
+  run.theta = {std::vector<double>{0, 40, 40, 40}, std::vector<double>{0, 18, NAN, 90},
+               std::vector<double>{0, -70, 10, 0}};
+  const std::string svg = AnglePlotSvg(FingerClosedForm(contacts), "gob1 = 80", {run});
+  ExpectWellShaped(svg);
+  EXPECT_EQ(Count(svg, "<circle"), 3 + 2 + 3);
+  EXPECT_NE(svg.find(">dots: measured</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">(1 run)</text>"), std::string::npos);
+  EXPECT_EQ(Lines(svg, "class=\"grid\" data-theta=\"-80\"").size(), 1u);  // widened for -70
+  const auto gob = Lines(svg, "class=\"gob\"");
+  ASSERT_EQ(gob.size(), 1u);
+  const double x0 = GridX(svg, "0"), x250 = GridX(svg, "250");
+  EXPECT_NEAR(gob[0].x1, x0 + 80.0 / 250.0 * (x250 - x0), 0.02);
+  EXPECT_NE(svg.find(">g_ob link 1 = 80</text>"), std::string::npos);
+  // Without measured runs: no dots.
+  EXPECT_EQ(Count(AnglePlotSvg(FingerClosedForm(contacts), "t"), "<circle"), 0);
+}
+
 TEST(AnglePlotSvgTest, BreakpointsOffTheGridAreSampledSoCornersAreExact) {
   // Link 1 blocked at 123.3: phase 2' to 223.3, phase 3 until theta3_max at 239.15.
   FingerContacts contacts;

@@ -365,6 +365,26 @@ TEST(HybridFinger, RequestHistoryFollowsTheIndependentRig) {
       << bad.err;
 }
 
+// --data overlays the runs measured with the finger's object on --plot: the demo's runs against
+// link 1 at 80 (two of them), dots in the plot; another object, no --plot, or --plot naming
+// the data are refused.
+TEST(HybridFinger, DataOverlaysTheRunsWithTheFingersObject) {
+  TempDir dir;
+  const std::string data = Quote(std::string(HYBRID_SOURCE_DIR) + "/data/finger_demo.csv");
+  const std::string plot = (dir.path() / "p.svg").string();
+  const Result r = RunHybrid("finger --gob1 80 --plot " + Quote(plot) + " --data " + data);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string svg = ReadAll(plot);
+  EXPECT_NE(svg.find(">(2 runs)</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">g_ob link 1 = 80</text>"), std::string::npos);
+  const Result other = RunHybrid("finger --gob1 81 --plot " + Quote(plot) + " --data " + data);
+  EXPECT_EQ(other.exit_code, 1);
+  EXPECT_NE(other.err.find("no run has the finger's object (gob1 = 81)"), std::string::npos)
+      << other.err;
+  EXPECT_EQ(RunHybrid("finger --g 3 --data " + data).exit_code, 2);
+  EXPECT_EQ(RunHybrid("finger --plot " + data + " --data " + data).exit_code, 2);
+}
+
 // --model that is not a finger automaton, also without --simulate: exit 1, naming the file.
 TEST(HybridFinger, ModelThatIsNotAFingerIsExit1) {
   const std::string spec = std::string(HYBRID_SOURCE_DIR) + "/spec/";
