@@ -105,34 +105,35 @@ constexpr double kRunWidth = 800, kLeft = 64, kRight = 16, kRunPanel = 150, kRun
 constexpr double kTop = 62, kStrip = 50;
 
 // One panel of a run: joint j's measured samples as dots, the baseline model dashed and the
-// extended model solid, against the sample index.
+// extended model solid, against the request g (the report's figures; the curves retrace on
+// reopening); samples without a finite g are left out.
 void DrawRunPanel(SvgPlot& svg, const RunCurves& run, int j, const PlotArea& a,
-                  const std::vector<double>& index) {
+                  const std::vector<double>& g) {
   svg.Group("class=\"panel\" id=\"" + std::string(kJoint[j]) + "\"");
-  svg.Axes(a, "", WithUnit(kJoint[j], "deg"));
+  svg.Axes(a, j == 2 ? WithUnit("request g", "counts") : "", WithUnit(kJoint[j], "deg"));
   svg.Group("class=\"measured\" fill=\"" + std::string(kGrey) + "\"");
-  for (std::size_t i = 0; i < index.size(); ++i) {
+  for (std::size_t i = 0; i < g.size(); ++i) {
     const double v = At(run.measured[j], i);
-    if (std::isfinite(v)) svg.Marker(a.X(static_cast<double>(i)), a.Y(v), kDot);
+    if (std::isfinite(v) && std::isfinite(g[i])) svg.Marker(a.X(g[i]), a.Y(v), kDot);
   }
   svg.EndGroup();
   svg.Group("class=\"baseline\" fill=\"none\" stroke=\"" + std::string(kBlue) +
             "\" stroke-width=\"1.5\" stroke-dasharray=\"" + kDash +
             "\" stroke-linecap=\"round\" stroke-linejoin=\"round\"");
-  svg.Series(a, index, run.baseline[j]);
+  svg.Series(a, g, run.baseline[j]);
   svg.EndGroup();
   svg.Group("class=\"extended\" fill=\"none\" stroke=\"" + std::string(kRed) +
             "\" stroke-width=\"1.5\" stroke-linecap=\"round\" stroke-linejoin=\"round\"");
-  svg.Series(a, index, run.extended[j]);
+  svg.Series(a, g, run.extended[j]);
   svg.EndGroup();
   svg.EndGroup();
 }
 
-// The strip under a run's panels: g against the sample index.
+// The strip under a run's panels: the protocol, the request g against the sample index.
 void DrawMotorStrip(SvgPlot& svg, const RunCurves& run, const PlotArea& a,
                     const std::vector<double>& index) {
   svg.Group("class=\"motor\"");
-  svg.Axes(a, "sample", "g", AxesStyle{8, 2, 14});
+  svg.Axes(a, "sample", WithUnit("g", "counts"), AxesStyle{8, 2, 14});
   svg.Group("fill=\"none\" stroke=\"#333333\" stroke-width=\"1.2\" stroke-linecap=\"round\"");
   svg.Series(a, index, run.g);
   svg.EndGroup();
@@ -144,14 +145,15 @@ std::string RunFile(const RunCurves& run) {
   const double strip_top = kTop + 3 * (kRunPanel + kRunGap);
   const double height = strip_top + kStrip + 44;
   const std::size_t n = RunLength(run);
-  std::vector<double> index(n);
-  for (std::size_t i = 0; i < n; ++i) index[i] = static_cast<double>(i);
-  Extent x_extent;
-  if (n > 0) {
-    x_extent.Add(0.0);
-    x_extent.Add(static_cast<double>(n - 1));
+  std::vector<double> index(n), g(n);
+  Extent index_extent, g_extent;
+  for (std::size_t i = 0; i < n; ++i) {
+    index[i] = static_cast<double>(i);
+    index_extent.Add(index[i]);
+    g[i] = At(run.g, i);
+    g_extent.Add(g[i]);
   }
-  const Range x_range = x_extent.Padded();
+  const Range x_range = g_extent.Padded();
 
   SvgPlot svg = OpenReport(kRunWidth, height);
   Title(svg, kRunWidth, "Run " + run.label);
@@ -168,12 +170,12 @@ std::string RunFile(const RunCurves& run) {
     DrawRunPanel(svg, run, j,
                  PlotArea{kLeft, kTop + j * (kRunPanel + kRunGap), plot_width, kRunPanel, x_range,
                           y.Padded()},
-                 index);
+                 g);
   }
-  Extent g;
-  for (double v : run.g) g.Add(v);
-  DrawMotorStrip(svg, run, PlotArea{kLeft, strip_top, plot_width, kStrip, x_range, g.Padded()},
-                 index);
+  DrawMotorStrip(
+      svg, run,
+      PlotArea{kLeft, strip_top, plot_width, kStrip, index_extent.Padded(), g_extent.Padded()},
+      index);
   return svg.Finish();
 }
 
