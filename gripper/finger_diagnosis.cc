@@ -157,10 +157,13 @@ Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
   Diagnosis d = DiagnoseCleaned(predictor, data, std::move(base), std::move(outliers), options, &m);
   // Second pass: the rule looks at changes beyond the model's, and where an effect is large the
   // baseline's residual itself changes fast (e.g. a play of 6 counts on reopening from the stop
-  // in phase 3): clean again against the best candidate's prediction, and diagnose again if
-  // that changes which samples are outliers.
+  // in phase 3), genuine samples are clamped and the diagnosis says `unexplained` though a
+  // candidate fits. Then clean again against the best candidate's prediction, and diagnose again
+  // if that changes which samples are outliers.
   const std::optional<ParameterValues> best = BestCandidate(m);
-  if (!best || d.outliers.entries.empty()) return d;
+  if (!best || d.outliers.entries.empty() || d.cause != std::vector<std::string>{"unexplained"}) {
+    return d;
+  }
   const FingerDiagnosisModel probe(predictor, raw, baseline);
   const FingerEffects effects = probe.Effects(*best);
   std::vector<FingerPrediction> fitted(raw.runs.size());
