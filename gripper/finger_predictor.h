@@ -1,10 +1,10 @@
 #pragma once
 
 #include <array>
-#include <span>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
