@@ -153,6 +153,16 @@ TEST(FingerPredictorTest, OffsetShiftsTheCurveAndKeepsTheContactPosition) {
   EXPECT_NEAR(p.theta[1][159], 0.9 * 2.0, 1e-6);
 }
 
+// The controller's motor path for given stops: held at a stop from its sample while the request
+// is not below it, following the request again from the first one below.
+TEST(MotorPositionsTest, HoldsAtAStopUntilAMoreOpenRequest) {
+  const std::vector<double> requests = {100, 250, 255, 240, 239, 250, 100, 230, 254, 0};
+  const std::vector<ControllerStop> stops = {{1, 240.0}, {8, 220.5}};
+  EXPECT_EQ(MotorPositions(requests, stops),
+            (std::vector<double>{100, 240, 240, 240, 239, 250, 100, 230, 220.5, 0}));
+  EXPECT_EQ(MotorPositions(requests, {}), requests);
+}
+
 // The report's protocol (requests up to 255, past the stop, and back; one reversal on the way up)
 // against the independent rig: the motor is the rig's min(request, stop) and the angles are the
 // rig's, for no object, an object on link 1 and one on link 2, with play and offset.
