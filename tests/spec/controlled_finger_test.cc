@@ -177,6 +177,34 @@ TEST(ControlledFingerTest, ObjectOnLink1StopsTheMotorWhereTheRigStops) {
   EXPECT_EQ(s.status[2], 2);  // 230 is not below where it stopped
 }
 
+// No chattering: requests that differ from where the motor holds by less than the deadband (0.5
+// count) do not move it, and a request inside the deadband below a stop does not reopen.
+TEST(ControlledFingerTest, RequestsWithinTheDeadbandDoNotMoveTheMotor) {
+  const System system = ControlledFinger();
+  const Simulator simulator(system);
+  SimulationOptions options;
+  options.until = 10;
+  const int slot = *system.symbols().Find("request");
+  const std::vector<InputSignal> signals = {
+      InputSignal{slot,
+                  InputSignal::Shape::kStep,
+                  {{0, 100}, {2, 100.3}, {3, 99.8}, {4, 255}, {6, 239.7}, {7, 239.4}, {8, 100}}}};
+  const SimulationResult r = simulator.Run(options, signals);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  std::vector<std::string> moves;
+  for (const EventRecord& e : r.events) {
+    for (const std::string& t : e.transitions) {
+      if (t == "ctl.read_closes" || t == "ctl.read_opens" || t == "ctl.stopped_opens") {
+        moves.push_back(t + "@" + std::to_string(static_cast<int>(e.time)));
+      }
+    }
+  }
+  // Closing to 100 at t = 0, to 255 at t = 4 (stopped at 240); 239.7 is within the deadband of
+  // the stop, 239.4 is not; then opening to 100.
+  EXPECT_EQ(moves, (std::vector<std::string>{"ctl.read_closes@0", "ctl.read_closes@4",
+                                             "ctl.stopped_opens@7", "ctl.read_opens@8"}));
+}
+
 // The default scenario closes to 255, holds and reopens to 0.
 TEST(ControlledFingerTest, DefaultScenarioClosesHoldsAndReopens) {
   const System system = ControlledFinger();
