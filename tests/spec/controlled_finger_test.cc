@@ -84,7 +84,9 @@ TEST(ControlledFingerTest, DrivenFingerDiffersFromTheFingerOnlyWhereDocumented) 
     EXPECT_EQ(d.guard.comparisons.size(), f.guard.comparisons.size()) << d.name;
     const bool enters_phase4 = blocked(driven, d.target) && !blocked(driven, d.source);
     EXPECT_EQ(d.label == "stall", enters_phase4) << d.name;
-    if (!enters_phase4) EXPECT_EQ(d.label, f.label) << d.name;
+    if (!enters_phase4) {
+      EXPECT_EQ(d.label, f.label) << d.name;
+    }
     stalls += enters_phase4;
   }
   EXPECT_EQ(stalls, 19);
