@@ -101,12 +101,9 @@ void Translate(const ModelDiagnosis& m, const FingerDiagnosisModel& model, const
   }
 }
 
-}  // namespace
-
-namespace {
-
-// The setting of the significant candidate with the largest gain, if any.
-std::optional<ParameterValues> BestCandidate(const ModelDiagnosis& m) {
+// The effects of the significant candidate of `m` with the largest gain, if any.
+std::optional<FingerEffects> BestCandidate(const ModelDiagnosis& m,
+                                           const FingerDiagnosisModel& model) {
   const ParameterFit* best = nullptr;
   for (const ParameterFit& f : m.candidates) {
     if (f.significant && (!best || f.gain > best->gain)) best = &f;
@@ -116,7 +113,7 @@ std::optional<ParameterValues> BestCandidate(const ModelDiagnosis& m) {
   for (size_t i = 0; i < best->parameters.size(); ++i) {
     values.emplace_back(best->parameters[i], best->values[i]);
   }
-  return values;
+  return model.Effects(values);
 }
 
 bool SameSamples(const OutlierReport& a, const OutlierReport& b) {
@@ -128,10 +125,12 @@ bool SameSamples(const OutlierReport& a, const OutlierReport& b) {
   return true;
 }
 
-// One diagnosis of `cleaned` data (with `outliers` the cleaning's report).
+// One diagnosis of `cleaned` data (`outliers`: what the cleaning changed), and in `best` the
+// effects of its best significant candidate.
 Diagnosis DiagnoseCleaned(const FingerPredictor& predictor, const MeasuredData& cleaned,
                           std::vector<FingerPrediction> base, OutlierReport outliers,
-                          const FingerDiagnosisOptions& options, ModelDiagnosis* raw) {
+                          const FingerDiagnosisOptions& options,
+                          std::optional<FingerEffects>* best) {
   Diagnosis d;
   d.outliers = std::move(outliers);
   d.noise = EstimateNoiseFloor(cleaned);
@@ -139,8 +138,9 @@ Diagnosis DiagnoseCleaned(const FingerPredictor& predictor, const MeasuredData& 
   const FingerDiagnosisModel model(predictor, cleaned, std::move(base));
   const ChannelNoise noise{{d.noise.variance.begin(), d.noise.variance.end()},
                            {d.noise.dof.begin(), d.noise.dof.end()}};
-  *raw = DiagnoseModel(model, model.Runs(), noise, options);
-  Translate(*raw, model, cleaned, d);
+  const ModelDiagnosis m = DiagnoseModel(model, model.Runs(), noise, options);
+  Translate(m, model, cleaned, d);
+  *best = BestCandidate(m, model);
   return d;
 }
 
@@ -149,34 +149,28 @@ Diagnosis DiagnoseCleaned(const FingerPredictor& predictor, const MeasuredData& 
 Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
                    const FingerDiagnosisOptions& options) {
   if (data.runs.empty()) throw std::invalid_argument("Diagnose: the data have no runs");
-  const MeasuredData raw = data;
-  std::vector<FingerPrediction> base = BaselinePredictions(predictor, data, options.threads);
-  const std::vector<FingerPrediction> baseline = base;
-  OutlierReport outliers = CleanAgainstModel(data, base, options.outlier_threshold);
-  ModelDiagnosis m;
-  Diagnosis d = DiagnoseCleaned(predictor, data, std::move(base), std::move(outliers), options, &m);
+  const std::vector<FingerPrediction> base = BaselinePredictions(predictor, data, options.threads);
+  MeasuredData cleaned = data;
+  OutlierReport outliers = CleanAgainstModel(cleaned, base, options.outlier_threshold);
+  std::optional<FingerEffects> best;
+  Diagnosis d = DiagnoseCleaned(predictor, cleaned, base, std::move(outliers), options, &best);
   // Second pass: the rule looks at changes beyond the model's, and where an effect is large the
   // baseline's residual itself changes fast (e.g. a play of 6 counts on reopening from the stop
   // in phase 3), genuine samples are clamped and the diagnosis says `unexplained` though a
-  // candidate fits. Then clean again against the best candidate's prediction, and diagnose again
-  // if that changes which samples are outliers.
-  const std::optional<ParameterValues> best = BestCandidate(m);
+  // candidate fits. Then clean the measured data again against the best candidate's prediction,
+  // and diagnose again if that changes which samples are outliers.
   if (!best || d.outliers.entries.empty() || d.cause != std::vector<std::string>{"unexplained"}) {
     return d;
   }
-  const FingerDiagnosisModel probe(predictor, raw, baseline);
-  const FingerEffects effects = probe.Effects(*best);
-  std::vector<FingerPrediction> fitted(raw.runs.size());
-  ParallelFor(static_cast<int>(raw.runs.size()), options.threads,
-              [&](int r) { fitted[r] = predictor.Predict(raw.runs[r], effects); });
+  std::vector<FingerPrediction> fitted(data.runs.size());
+  ParallelFor(static_cast<int>(data.runs.size()), options.threads,
+              [&](int r) { fitted[r] = predictor.Predict(data.runs[r], *best); });
   for (const FingerPrediction& f : fitted) {
     if (f.status != SimulationStatus::kCompleted) return d;
   }
-  MeasuredData again = raw;
-  OutlierReport second = CleanAgainstModel(again, fitted, options.outlier_threshold);
+  OutlierReport second = CleanAgainstModel(data, fitted, options.outlier_threshold);
   if (SameSamples(second, d.outliers)) return d;
-  ModelDiagnosis m2;
-  return DiagnoseCleaned(predictor, again, baseline, std::move(second), options, &m2);
+  return DiagnoseCleaned(predictor, data, base, std::move(second), options, &best);
 }
 
 }  // namespace hybrid

@@ -486,19 +486,25 @@ AngleCurves SampleAngles(const FingerClosedForm& closed_form) {
   return curves;
 }
 
-// Gridlines with their value (data-g, data-theta), ticks and numbers, the frame and the axis
-// titles.
+// Calls visit(g, theta) for joint k's present samples of `measured` within [0, g_max].
+template <typename Visit>
+void ForEachMeasured(const std::vector<MeasuredSeries>& measured, int k, double g_max,
+                     Visit visit) {
+  for (const MeasuredSeries& run : measured) {
+    for (size_t i = 0; i < run.g.size() && i < run.theta[k].size(); ++i) {
+      const double g = run.g[i], theta = run.theta[k][i];
+      if (std::isfinite(theta) && g >= 0.0 && g <= g_max) visit(g, theta);
+    }
+  }
+}
+
 // Widens `c`'s angle range (multiples of kThetaStep) to hold the measured samples in range.
 void WidenForMeasured(AngleCurves& c, const std::vector<MeasuredSeries>& measured) {
-  for (const MeasuredSeries& run : measured) {
-    for (int k = 0; k < 3; ++k) {
-      for (size_t i = 0; i < run.g.size() && i < run.theta[k].size(); ++i) {
-        const double g = run.g[i], theta = run.theta[k][i];
-        if (!std::isfinite(theta) || !(g >= 0.0 && g <= c.g_max)) continue;
-        c.lo = std::min(c.lo, kThetaStep * std::floor(theta / kThetaStep));
-        c.hi = std::max(c.hi, kThetaStep * std::ceil(theta / kThetaStep));
-      }
-    }
+  for (int k = 0; k < 3; ++k) {
+    ForEachMeasured(measured, k, c.g_max, [&](double, double theta) {
+      c.lo = std::min(c.lo, kThetaStep * std::floor(theta / kThetaStep));
+      c.hi = std::max(c.hi, kThetaStep * std::ceil(theta / kThetaStep));
+    });
   }
 }
 
@@ -508,13 +514,8 @@ void DrawMeasured(SvgPlot& svg, const AngleCurves& c, const std::vector<Measured
   for (int k = 0; k < 3; ++k) {
     svg.Group("class=\"measured theta" + std::to_string(k + 1) + "\" fill=\"" + kLinkColours[k] +
               "\"");
-    for (const MeasuredSeries& run : measured) {
-      for (size_t i = 0; i < run.g.size() && i < run.theta[k].size(); ++i) {
-        const double g = run.g[i], theta = run.theta[k][i];
-        if (!std::isfinite(theta) || !(g >= 0.0 && g <= c.g_max)) continue;
-        svg.Marker(c.X(g), c.Y(theta), 1.6);
-      }
-    }
+    ForEachMeasured(measured, k, c.g_max,
+                    [&](double g, double theta) { svg.Marker(c.X(g), c.Y(theta), 1.6); });
     svg.EndGroup();
   }
   svg.EndGroup();
@@ -536,6 +537,8 @@ void DrawContactLines(SvgPlot& svg, const AngleCurves& c, const FingerContacts& 
   svg.EndGroup();
 }
 
+// Gridlines with their value (data-g, data-theta), ticks and numbers, the frame and the axis
+// titles.
 void DrawAngleAxes(SvgPlot& svg, const AngleCurves& c) {
   constexpr double kBottom = kPlotTop + kPlotHeight;
   svg.Group("class=\"axes\"");

@@ -146,7 +146,7 @@ std::optional<double> StallDrive(const FingerPredictor& predictor, const Measure
   trip.g = {reach};
   const FingerPrediction p = predictor.Predict(trip, dynamics);
   if (p.status != SimulationStatus::kCompleted) {
-    throw std::runtime_error("synthesize: the model stopped early: " + p.message);
+    Fail("run '" + run.label + "': the prediction did not complete: " + p.message);
   }
   if (!(p.motor[0] < reach)) return std::nullopt;
   return std::max(0.0, p.motor[0] - 1e-9);

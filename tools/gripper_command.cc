@@ -297,8 +297,6 @@ std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& obje
   return geometric;
 }
 
-// The report of `hybrid finger` before any simulation: the configuration at --g (if given), the
-// contacts that take effect, where the finger stops and the objects.
 // The settled state after each request of --requests: the controller drives the motor to the
 // request and stops it where the finger stalls (closed.stop()); it stays there until a request
 // below the stop (docs/finger_model.md, "The controller"). The closed form has no hysteresis, so
@@ -316,6 +314,9 @@ json RequestHistoryJson(const std::vector<double>& requests, const FingerClosedF
   return out;
 }
 
+// The report of `hybrid finger` before any simulation: the configuration at --g (if given), the
+// settled states after --requests, the contacts that take effect, where the finger stops and the
+// objects.
 json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
                   const std::optional<GeometricFinger>& geometric,
                   const std::vector<Obstacle>& objects) {

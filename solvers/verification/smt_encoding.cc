@@ -901,17 +901,13 @@ z3::expr SmtEncoding::NoUrgentGuardOnSegment(int k, int mode) {
   std::vector<double> dir(var_slots_.size(), 0.0);
   if (info.flow_class == FlowClass::kConstantRate) {
     if (!StraightSegment(info, a, const_sigma, dir)) return ctx_.bool_val(true);
-  } else if (info.flow_class == FlowClass::kGeneral || info.flow_class == FlowClass::kStill) {
-    // sigma = d for the variables with a constant flow; a guard that reads another moving
-    // variable (NaN direction) is not encoded.
+  } else if (info.flow_class != FlowClass::kSeparable) {
+    // kGeneral and kStill: sigma = d for the variables with a constant flow; a guard that reads
+    // another moving variable (NaN direction) is not encoded. (kStill moves nothing.)
     const_sigma = a.d;
     for (int v : info.moving) {
-      dir[v] = !info.constant_drift.empty() && info.constant_drift[v]
-                   ? info.drift[v]
-                   : std::numeric_limits<double>::quiet_NaN();
+      dir[v] = info.constant_drift[v] ? info.drift[v] : std::numeric_limits<double>::quiet_NaN();
     }
-  } else if (info.flow_class != FlowClass::kSeparable) {
-    return ctx_.bool_val(true);
   }
   std::vector<bool> moving(var_slots_.size(), false);
   for (int v : info.moving) moving[v] = true;

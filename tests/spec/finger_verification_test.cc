@@ -12,6 +12,7 @@
 #include "solvers/verification/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
+#include "tests/test_utilities/trace_states.h"
 
 namespace hybrid {
 namespace {
@@ -110,18 +111,11 @@ TEST_P(FingerMutantTest, ComesBackViolatedWithATraceTheSimulatorReplays) {
 
   // Replay independently: the trace's parameters and inputs on a fresh simulator, and the
   // property evaluated at every recorded state.
-  const Trace& t = *results[0].trace;
-  System copy = mutant;
-  for (const auto& [name, value] : t.parameters) copy.SetParameter(name, value);
-  for (const auto& [name, value] : t.initial_values) copy.SetInitialValue(name, value);
-  const Simulator simulator(copy);
-  SimulationOptions sim;
-  sim.until = t.inputs.until;
-  sim.sample_step = t.inputs.until / 1000;
-  const SimulationResult run = simulator.Run(sim, t.inputs.inputs);
   bool violated = false;
-  for (const StateSample& s : run.samples)
-    violated = violated || IsTarget(simulator, property, s, 1e-6);
+  testing::ForEachTraceState(mutant, *results[0].trace, 1000,
+                             [&](const Simulator& simulator, const StateSample& s) {
+                               violated = violated || IsTarget(simulator, property, s, 1e-6);
+                             });
   EXPECT_TRUE(violated) << m.name << ": the trace does not violate " << m.property;
 }
 

@@ -19,6 +19,7 @@
 #include "solvers/verification/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
+#include "tests/test_utilities/trace_states.h"
 
 namespace hybrid {
 namespace {
@@ -330,16 +331,10 @@ TEST(PropertySamplerTest, TankViolationAndWitnessReplay) {
         << name << ": " << r.reason;
     ExpectReplays(system, property, r);
     // Independently: simulate the trace's inputs and find the state by hand.
-    const Trace& t = *r.trace;
-    const Simulator sim(system);
-    SimulationOptions options;
-    options.until = t.inputs.until;
-    options.sample_step = t.inputs.until / 1000;
-    const SimulationResult run = sim.Run(options, t.inputs.inputs);
     bool hit = false;
-    for (const StateSample& s : run.samples) {
+    testing::ForEachTraceState(system, *r.trace, 1000, [&](const Simulator&, const StateSample& s) {
       hit = hit || (property.kind == Property::Kind::kReach ? s.x[0] >= 7.0 - 1e-6 : s.x[0] > 6.0);
-    }
+    });
     EXPECT_TRUE(hit) << name;
   }
 }

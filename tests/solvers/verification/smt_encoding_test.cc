@@ -257,15 +257,18 @@ TEST(SmtEncoding, LazyGuardDoesNotForbidTheSegment) {
 
 // A mode whose flows are not all constant rates (x' = k v with v a variable: kGeneral) still
 // follows a variable with a constant flow (m' = 2) exactly, and an urgent guard that reads only
-// that variable stops the segment; one that reads x is not encoded (x is not followed).
+// that variable stops the segment; one that reads x is not encoded (x is not followed). In a mode
+// where nothing moves (`wait`), an urgent guard that holds allows no flow at all.
 constexpr std::string_view kMotorModel = R"(
 automaton motor {
   param k = 3;
   var x, m, v, target;
   mode run { x' = k * v; m' = 2; }
   mode held { }
+  mode wait { }
   transition arrive: run -> held { guard m >= target; }
   transition far: run -> held { guard x >= 100; }
+  transition go: wait -> run { guard target >= 5; }
   init run { x = 0; m = 0; v = 1; target = 10; }
 }
 )";
@@ -286,6 +289,10 @@ TEST(SmtEncoding, GeneralModeFollowsConstantFlowsExactly) {
   // The mode is kGeneral: the constant flow is followed inside it.
   SmtEncoding& enc = step.encoding();
   EXPECT_EQ(enc.flow_class(*a.FindMode("run")), FlowClass::kGeneral);
+  // kStill: waiting is a flow only while `go` is not due.
+  EXPECT_EQ(enc.flow_class(*a.FindMode("wait")), FlowClass::kStill);
+  EXPECT_EQ(step.Check("wait", {{"target", 10}}, "wait", {{"target", 10}}), z3::unsat);
+  EXPECT_EQ(step.Check("wait", {{"target", 1}}, "wait", {{"target", 1}}), z3::sat);
 }
 
 // Kept for the whole run: deleting a Z3 context that holds the finger's encoding takes about a
