@@ -240,7 +240,13 @@ struct automaton_decl : seq<kw_automaton, must<ident_tok>, must<lbrace>, star<au
                             must<automaton_body_end>> {};
 
 struct instance_alias : seq<equals, must<ident_tok>> {};
-struct instance_item : seq<kw_instance, must<ident_tok>, opt<instance_alias>, must<semi>> {};
+// `{ g = A.g; stall = A.stall; }`: names of the automaton bound to names of the system.
+struct bind_item : seq<ident_tok, must<equals>, must<name_tok>, must<semi>> {};
+struct binds_end : rbrace {};
+struct binds : seq<lbrace, star<bind_item>, must<binds_end>> {};
+struct instance_end : sor<semi, binds> {};
+struct instance_item : seq<kw_instance, must<ident_tok>, opt<instance_alias>, must<instance_end>> {
+};
 struct share_item : seq<kw_share, must<name_tok>, star<comma, must<name_tok>>, must<semi>> {};
 struct system_item : sor<instance_item, share_item, property_decl, scenario_decl> {};
 struct system_body_end : rbrace {};
@@ -361,6 +367,10 @@ template <>
 inline constexpr auto kMessage<system_body_end> =
     "expected 'instance', 'share', 'property', 'scenario' or '}' closing the system";
 template <>
+inline constexpr auto kMessage<instance_end> = "expected ';' or '{' binding names (x = A.y;)";
+template <>
+inline constexpr auto kMessage<binds_end> = "expected a bind 'x = A.y;' or '}'";
+template <>
 inline constexpr auto kMessage<string_literal> = "expected a quoted file name";
 template <>
 inline constexpr auto kMessage<close_quote> = "unterminated string";
@@ -396,8 +406,8 @@ using selector = parse_tree::selector<
         discrete_value, flow, invariant, mode_decl, transition_name, source_mode, target_mode,
         guard, assignment, reset, label, urgency, transition_decl, init_point, init_range,
         init_item, init_decl, point, signal_shape, until_item, signal_item, scenario_decl, horizon,
-        property_decl, automaton_decl, instance_alias, instance_item, share_item, system_decl,
-        import_decl, power, arguments>,
+        property_decl, automaton_decl, instance_alias, bind_item, binds, instance_item, share_item,
+        system_decl, import_decl, power, arguments>,
     parse_tree::fold_one::on<sum, product, and_predicate, predicate>>;
 
 template <class Rule>
@@ -993,6 +1003,33 @@ class Builder {
     At(mode_node, [&] { a->AddInitialState(std::move(s)); });
   }
 
+  // `instance A = automaton;`, `instance automaton;`, either with `{ x = B.y; ... }`.
+  void InstanceItem(const Node& item, System& s) {
+    const Node& first = *item.children.at(0);
+    std::string instance;
+    const Node* automaton_node = &first;
+    std::map<std::string, std::string> binds;
+    for (size_t i = 1; i < item.children.size(); ++i) {
+      const Node& child = *item.children[i];
+      if (child.is_type<grammar::instance_alias>()) {
+        instance = Text(first);
+        automaton_node = child.children.at(0).get();
+        continue;
+      }
+      for (const auto& bind : child.children) {
+        const Node& from = *bind->children.at(0);
+        if (!binds.emplace(Text(from), Text(*bind->children.at(1))).second) {
+          Fail(from, "'" + Text(from) + "' bound twice");
+        }
+      }
+    }
+    auto it = automata_.find(Text(*automaton_node));
+    if (it == automata_.end()) {
+      Fail(*automaton_node, "unknown automaton '" + Text(*automaton_node) + "'");
+    }
+    At(first, [&] { s.AddComponent(instance, it->second, std::move(binds)); });
+  }
+
   void SystemDecl(const Node& n) {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
     const Node& name_node = *n.children.at(0);
@@ -1004,18 +1041,7 @@ class Builder {
         if (!s.components().empty()) Fail(item, "'share' must come before the first 'instance'");
         for (const auto& id : item.children) s.Share(Text(*id));
       } else if (item.is_type<instance_item>()) {
-        const Node& first = *item.children.at(0);
-        std::string instance;
-        const Node* automaton_node = &first;
-        if (item.children.size() > 1) {
-          instance = Text(first);
-          automaton_node = item.children.at(1)->children.at(0).get();
-        }
-        auto it = automata_.find(Text(*automaton_node));
-        if (it == automata_.end()) {
-          Fail(*automaton_node, "unknown automaton '" + Text(*automaton_node) + "'");
-        }
-        At(first, [&] { s.AddComponent(instance, it->second); });
+        InstanceItem(item, s);
       } else if (item.is_type<property_decl>()) {
         if (s.components().empty()) Fail(item, "declare the instances before the properties");
         Property p = PropertyOf(item, PropertyScope(s.symbols()),

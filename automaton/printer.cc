@@ -134,7 +134,8 @@ std::string PrintAutomaton(const Automaton& a) {
 std::string PrintSystem(const System& system) {
   const auto components = system.components();
   if (components.size() == 1 && components[0].instance.empty() &&
-      components[0].source.name() == system.name() && system.shared().empty()) {
+      components[0].source.name() == system.name() && system.shared().empty() &&
+      components[0].binds.empty()) {
     return PrintAutomaton(components[0].source);
   }
   std::ostringstream out;
@@ -155,7 +156,14 @@ std::string PrintSystem(const System& system) {
   for (const Component& c : components) {
     out << "  instance ";
     if (!c.instance.empty()) out << c.instance << " = ";
-    out << c.source.name() << ";\n";
+    out << c.source.name();
+    if (c.binds.empty()) {
+      out << ";\n";
+      continue;
+    }
+    out << " {";
+    for (const auto& [from, to] : c.binds) out << " " << from << " = " << to << ";";
+    out << " }\n";
   }
   if (system.scenario()) PrintScenario(*system.scenario(), system.symbols(), "  ", out);
   for (const Property& p : system.properties()) PrintProperty(p, "  ", out);

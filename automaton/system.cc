@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <map>
 #include <stdexcept>
 
@@ -158,6 +159,37 @@ void CheckNewInstance(std::span<const Component> components, const std::string& 
     if (c.instance == instance) {
       Fail(instance.empty() ? "two unnamed instances (at most one instance may keep its names)"
                             : "duplicate instance '" + instance + "'");
+    }
+  }
+}
+
+// Throws unless every name `binds` binds is a symbol or a transition label of `a`, not shared,
+// and bound to a name.
+void CheckBinds(const Automaton& a, const std::map<std::string, std::string>& binds,
+                const std::set<std::string>& shared) {
+  for (const auto& [from, to] : binds) {
+    const bool label = std::any_of(a.transitions().begin(), a.transitions().end(),
+                                   [&](const Transition& t) { return t.label == from; });
+    if (!a.symbols().Find(from) && !label) {
+      Fail("bind '" + from + "': '" + a.name() + "' has no variable, input, parameter or label '" +
+           from + "'");
+    }
+    if (shared.count(from)) Fail("bind '" + from + "': the name is shared; it cannot be bound");
+    if (to.empty()) Fail("bind '" + from + "': bound to an empty name");
+  }
+}
+
+// Throws if `rename` gives two symbols of `a` one name (two binds to one name, or a bind to the
+// name another symbol takes anyway).
+void CheckDistinctNames(const Automaton& a,
+                        const std::function<std::string(const std::string&)>& rename) {
+  std::map<std::string, std::string> seen;  // new name -> old name
+  for (int s = 0; s < a.symbols().size(); ++s) {
+    const std::string& old = a.symbols()[s].name;
+    auto [it, added] = seen.emplace(rename(old), old);
+    if (!added) {
+      Fail("'" + it->second + "' and '" + old + "' of '" + a.name() + "' would both be named '" +
+           it->first + "'");
     }
   }
 }
@@ -515,12 +547,16 @@ System System::Of(const Automaton& automaton) {
 
 void System::Share(std::string name) { shared_.insert(std::move(name)); }
 
-void System::AddComponent(std::string instance, const Automaton& automaton) {
+void System::AddComponent(std::string instance, const Automaton& automaton,
+                          std::map<std::string, std::string> binds) {
   CheckNewInstance(components_, instance);
+  CheckBinds(automaton, binds, shared_);
   auto rename = [&](const std::string& n) {
+    if (auto it = binds.find(n); it != binds.end()) return it->second;
     return instance.empty() || shared_.count(n) ? n : instance + "." + n;
   };
-  Component c{instance, Renamed(automaton, rename, rename), {}, automaton};
+  CheckDistinctNames(automaton, rename);
+  Component c{instance, Renamed(automaton, rename, rename), {}, automaton, std::move(binds)};
   const SymbolTable& local = c.automaton.symbols();
   const std::vector<double> parameters = c.automaton.ParameterEnvironment();
   for (int s = 0; s < local.size(); ++s) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <set>
 #include <span>
 #include <string>
@@ -20,16 +21,20 @@ struct Component {
   std::vector<int> global_slot;
   /// The automaton as declared, before renaming (what a printer writes back).
   Automaton source;
+  /// Names of `source` (symbols or transition labels) bound to the System names they take in
+  /// place of the default renaming (`g` -> `A.g`); see System::AddComponent.
+  std::map<std::string, std::string> binds;
   friend bool operator==(const Component&, const Component&) = default;
 };
 
 /// Parallel composition of automata.
 ///
 /// Names: a component added with instance name `A` has every symbol `x` and every transition
-/// label `l` renamed to `A.x` and `A.l`, unless the name is shared (Share); a component with an
-/// empty instance name keeps its names. Equal names after renaming denote one thing: shared
-/// variables are one state variable (at most one component may give it a flow), shared inputs one
-/// input, shared parameters must agree.
+/// label `l` renamed to `A.x` and `A.l`, unless the name is shared (Share) or bound (a bind
+/// `x -> B.y` gives it the name `B.y`, so one instance can read another's variable and
+/// synchronise on its labels); a component with an empty instance name keeps its names. Equal names
+/// after renaming denote one thing: shared variables are one state variable (at most one component
+/// may give it a flow), shared inputs one input, shared parameters must agree.
 ///
 /// Semantics: the state is the tuple of component modes plus the union of the variables. A
 /// transition with an empty label, or with a label no other component uses, is taken alone
@@ -48,11 +53,15 @@ class System {
   /// Declares `name` (a symbol or a label) shared by every component added afterwards.
   void Share(std::string name);
   /// Adds a renamed copy of `automaton` (see the class comment); parameter ranges are renamed
-  /// with it. Throws std::invalid_argument ("System::AddComponent: ...") on a duplicate instance
-  /// name, a shared name used with different kinds, a shared variable given a flow by two
-  /// components, or a shared parameter whose value or declared range (evaluated; both absent
-  /// counts as equal) differs from the one it already has.
-  void AddComponent(std::string instance, const Automaton& automaton);
+  /// with it. `binds` maps names of `automaton` (a symbol, a transition label, or both) to the
+  /// System names they take instead of the default renaming. Throws std::invalid_argument on a
+  /// duplicate instance name, a shared name used with different kinds, a shared variable given a
+  /// flow by two components, a shared parameter whose value or declared range (evaluated; both
+  /// absent counts as equal) differs from the one it already has, a bind of a name `automaton`
+  /// does not declare or of a shared name, or binds that give two symbols of `automaton` one
+  /// name.
+  void AddComponent(std::string instance, const Automaton& automaton,
+                    std::map<std::string, std::string> binds = {});
   /// A system-level property over System slots; `in` atoms name component modes qualified by the
   /// instance (`A.open`) or, for an unqualified component, plainly.
   void AddProperty(Property property);

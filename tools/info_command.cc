@@ -147,8 +147,11 @@ json ComponentJson(const System& s, int c, json& warnings) {
   }
   json properties = json::array();
   for (const auto& p : a.properties()) properties.push_back(PropertyJson(p));
+  json binds = json::object();
+  for (const auto& [from, to] : comp.binds) binds[from] = to;
   return {{"instance", comp.instance},
           {"automaton", a.name()},
+          {"binds", binds},
           {"variables", VariablesJson(a, env)},
           {"discrete_variables", discrete},
           {"inputs", InputsJson(a, env)},
@@ -203,6 +206,12 @@ void ComponentText(const json& c, std::ostringstream& out) {
   out << "\n"
       << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
       << c["automaton"].get<std::string>() << "\n";
+  if (!c["binds"].empty()) {
+    out << "  binds:";
+    for (const auto& [from, to] : c["binds"].items())
+      out << " " << from << " = " << to.get<std::string>() << ";";
+    out << "\n";
+  }
   out << "  variables (" << c["variables"].size() << "):";
   for (const auto& v : c["variables"]) {
     out << " " << v["name"].get<std::string>();

@@ -241,7 +241,8 @@ TEST_P(SpecRoundTripTest, PrintThenParseGivesAnEqualSystem) {
 
 INSTANTIATE_TEST_SUITE_P(Spec, SpecRoundTripTest,
                          ::testing::Values("finger.ha", "bouncing_ball.ha", "thermostat.ha",
-                                           "hand.ha"),
+                                           "hand.ha", "controller.ha", "driven_finger.ha",
+                                           "controlled_finger.ha", "controlled_hand.ha"),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            std::string name = info.param.substr(0, info.param.find('.'));
                            return name;

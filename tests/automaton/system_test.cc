@@ -129,6 +129,79 @@ TEST(System, InstanceNamesPrefixSymbolsAndLabels) {
   EXPECT_EQ(c.source.transitions()[0].label, "full");
 }
 
+TEST(System, BindsNameOneInstanceAfterAnother) {
+  // The controller's motor position and label become the plant's: one variable, one label.
+  System s("pair");
+  s.AddComponent("A", Toggle("plant", "p", "x", "go"));
+  const Automaton controller = Parse(R"(
+automaton controller {
+  var y;
+  mode c0 { }
+  mode c1 { }
+  transition c0 -> c1 { guard y >= 1; label go; }
+  init c0 { y = 0; }
+})");
+  s.AddComponent("ctl", controller, {{"y", "A.x"}, {"go", "A.go"}});
+  const Component& c = s.components()[1];
+  EXPECT_EQ(SymbolNames(c.automaton.symbols()), (std::vector<std::string>{"A.x"}));
+  EXPECT_EQ(SymbolNames(s.symbols()), (std::vector<std::string>{"A.x"}));
+  EXPECT_EQ(c.global_slot, (std::vector<int>{0}));
+  EXPECT_EQ(c.automaton.transitions()[0].label, "A.go");
+  EXPECT_EQ(c.binds.at("y"), "A.x");
+  EXPECT_EQ(s.QualifiedModeName(1, ModeId(0)), "ctl.c0");
+}
+
+TEST(System, BoundNamesSynchroniseLikeSharedOnes) {
+  // Two plant-controller pairs: each controller synchronises with its own plant only, where
+  // `share go` would join all four.
+  System s("pairs");
+  const Automaton plant = Toggle("plant", "p", "x", "go", /*lazy=*/true);
+  const Automaton controller = Toggle("controller", "c", "y", "go", /*lazy=*/true);
+  s.AddComponent("A", plant);
+  s.AddComponent("B", plant);
+  s.AddComponent("ctlA", controller, {{"go", "A.go"}});
+  s.AddComponent("ctlB", controller, {{"go", "B.go"}});
+  const Automaton p = s.Product();
+  // Labelled product transitions, without their "tN_" prefix.
+  std::set<std::string> joint;
+  for (const Transition& t : p.transitions()) {
+    if (!t.label.empty()) joint.insert(t.name.substr(t.name.find('_') + 1));
+  }
+  EXPECT_EQ(joint,
+            (std::set<std::string>{"A_p0_to_p1__ctlA_c0_to_c1", "B_p0_to_p1__ctlB_c0_to_c1"}));
+}
+
+TEST(System, BindErrors) {
+  const Automaton plant = Toggle("plant", "p", "x", "go");
+  System s("pair");
+  s.Share("go");
+  s.AddComponent("A", plant);
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddComponent("B", plant, {{"z", "A.x"}});
+            }),
+            "bind 'z': 'plant' has no variable, input, parameter or label 'z'");
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddComponent("B", plant, {{"go", "A.go"}});
+            }),
+            "bind 'go': the name is shared; it cannot be bound");
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddComponent("B", plant, {{"x", ""}});
+            }),
+            "bind 'x': bound to an empty name");
+  // Both instances would give A.x a flow.
+  EXPECT_NE(InvalidArgument([&] {
+              s.AddComponent("B", plant, {{"x", "A.x"}});
+            }).find("flow"),
+            std::string::npos);
+  EXPECT_EQ(s.components().size(), 1u);
+  const Automaton two =
+      Parse("automaton two { var x; var y; mode m { x' = 1; } init m { x = 0; y = 0; } }");
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddComponent("C", two, {{"x", "C.y"}});
+            }),
+            "'x' and 'y' of 'two' would both be named 'C.y'");
+}
+
 TEST(System, EmptyInstanceNameKeepsNames) {
   const Automaton tank = Parse(kTank);
   System s("plant");
