@@ -725,6 +725,21 @@ void System::SetScenario(Scenario scenario) {
   scenario_ = std::move(scenario);
 }
 
+System System::Restricted(std::span<const int> which) const {
+  System out(name_);
+  out.shared_ = shared_;
+  for (const int c : which) {
+    Component copy = components_.at(static_cast<std::size_t>(c));
+    for (int& g : copy.global_slot) {
+      const Symbol& symbol = symbols_[g];
+      const auto found = out.symbols_.Find(symbol.name);
+      g = found ? *found : out.symbols_.Add(symbol);
+    }
+    out.components_.push_back(std::move(copy));
+  }
+  return out;
+}
+
 Automaton System::Product(int max_modes) const {
   if (components_.empty()) Fail("system '" + name_ + "' has no components");
   Automaton out(name_);

@@ -107,6 +107,12 @@ class System {
   /// std::invalid_argument ("System::Product: ...") past `max_modes` modes.
   Automaton Product(int max_modes = 100000) const;
 
+  /// The system of components `which` (indices into components()) alone, with their names,
+  /// shared names and binds, and no properties or scenario; its slots are numbered afresh in the
+  /// order the components first use them (look a name up in symbols() to map them back). Throws
+  /// std::out_of_range for an index out of range.
+  System Restricted(std::span<const int> which) const;
+
   friend bool operator==(const System&, const System&) = default;
 
  private:

@@ -9,8 +9,10 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 
 #include "solvers/verification/cpu_watchdog.h"
 #include "solvers/verification/smt_encoding.h"
@@ -1019,39 +1021,123 @@ void AddGoal(int c, const Property& q, int i, const Property& p,
   jobs[c].goals.push_back({q, i, p, {}});
 }
 
-// Adds property number i (`p`, which reads `in MODE` atoms if `reads_modes`) to the product job,
-// making the product on first use; or leaves it `unknown` when the product is too large or the
-// property reads modes.
-void AddProductGoal(const System& system, const Property& p, int i, bool reads_modes,
-                    int max_product_modes, std::vector<CheckResult>& results,
-                    std::optional<Automaton>& product, Job& product_job) {
-  if (!product) {
-    try {
-      product = system.Product(max_product_modes);
-    } catch (const std::invalid_argument& e) {
-      results[i].verdict = Verdict::kUnknown;
-      results[i].reason = std::string(
-                              "the property reads several components and their "
-                              "product is too large: ") +
-                          e.what();
-      return;
+// The product of a group of components and the job that asks it the properties that read
+// them; the product is made on first use.
+struct ProductJob {
+  std::optional<Automaton> automaton;
+  std::string failure;  // why the product could not be made
+  Job job;
+};
+// Keyed by the components (ascending indices); a map, so that job.automaton stays valid.
+using ProductJobs = std::map<std::vector<int>, ProductJob>;
+
+// For each component, a representative of its interaction group: the least set of components
+// closed under sharing a variable (continuous or discrete) or a synchronisation label. Groups
+// meet only through inputs (free in a check) and parameters (constants), so a property that
+// reads some groups is decided by the product of those groups alone.
+std::vector<int> InteractionGroups(const System& system) {
+  const auto components = system.components();
+  std::vector<int> parent(components.size());
+  for (std::size_t c = 0; c < parent.size(); ++c) parent[c] = static_cast<int>(c);
+  auto find = [&](int c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  };
+  std::map<int, int> slot_user;           // System slot -> a component that has it
+  std::map<std::string, int> label_user;  // label -> a component that uses it
+  for (int c = 0; c < static_cast<int>(components.size()); ++c) {
+    for (const int g : components[c].global_slot) {
+      const SymbolKind kind = system.symbols()[g].kind;
+      if (kind != SymbolKind::kVariable && kind != SymbolKind::kDiscrete) continue;
+      const auto [it, added] = slot_user.emplace(g, c);
+      if (!added) parent[find(c)] = find(it->second);
     }
+    for (const Transition& t : components[c].automaton.transitions()) {
+      if (t.label.empty()) continue;
+      const auto [it, added] = label_user.emplace(t.label, c);
+      if (!added) parent[find(c)] = find(it->second);
+    }
+  }
+  std::vector<int> group(components.size());
+  for (std::size_t c = 0; c < group.size(); ++c) group[c] = find(static_cast<int>(c));
+  return group;
+}
+
+// The components of the interaction groups of `comps`, ascending.
+std::vector<int> GroupsOf(const std::vector<int>& group, const std::set<int>& comps) {
+  std::set<int> representatives;
+  for (const int c : comps) representatives.insert(group[c]);
+  std::vector<int> out;
+  for (std::size_t c = 0; c < group.size(); ++c) {
+    if (representatives.count(group[c])) out.push_back(static_cast<int>(c));
+  }
+  return out;
+}
+
+// Makes the product of components `which` into `pj` (automaton and to_system), or records why
+// it cannot be made.
+void MakeProduct(const System& system, const std::vector<int>& which, int max_product_modes,
+                 ProductJob& pj) {
+  const System restricted = system.Restricted(which);
+  try {
+    pj.automaton = restricted.Product(max_product_modes);
+  } catch (const std::invalid_argument& e) {
+    pj.failure = std::string(
+                     "the property reads several components and their product is too "
+                     "large: ") +
+                 e.what();
+    return;
+  }
+  for (int s = 0; s < restricted.symbols().size(); ++s) {
+    pj.job.to_system.push_back(*system.symbols().Find(restricted.symbols()[s].name));
+  }
+}
+
+// `p` (System slots) over the slots of a job whose slot i is System slot to_system[i].
+Property OverJobSlots(const Property& p, const std::vector<int>& to_system, int system_slots) {
+  std::vector<int> local(static_cast<std::size_t>(system_slots), -1);
+  for (std::size_t s = 0; s < to_system.size(); ++s) local[to_system[s]] = static_cast<int>(s);
+  Property q = p;
+  q.predicate = Remap(
+      p.predicate,
+      [&](const Expression& e) {
+        return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
+          return Expression::Symbol(name, local.at(slot));
+        });
+      },
+      [](const std::string& m) { return m; });
+  return q;
+}
+
+// Adds property number i (`p`, which reads `in MODE` atoms if `reads_modes`) to the job of the
+// product of components `which`, making the product on first use; or leaves it `unknown` when
+// the product is too large or the property reads modes.
+void AddProductGoal(const System& system, const Property& p, int i, bool reads_modes,
+                    const std::vector<int>& which, int max_product_modes,
+                    std::vector<CheckResult>& results, ProductJobs& products) {
+  ProductJob& pj = products[which];
+  if (!pj.automaton && pj.failure.empty()) MakeProduct(system, which, max_product_modes, pj);
+  if (!pj.automaton) {
+    results[i].verdict = Verdict::kUnknown;
+    results[i].reason = pj.failure;
+    return;
   }
   if (reads_modes) {
     results[i].verdict = Verdict::kUnknown;
     results[i].reason = "`in MODE` atoms over several components are not supported";
     return;
   }
-  product_job.goals.push_back({p, i, p, {}});
+  pj.job.goals.push_back({OverJobSlots(p, pj.job.to_system, system.symbols().size()), i, p, {}});
 }
 
 // Sorts `properties` into jobs: one per component for a property that reads only that
-// component's own variables (in its slots and mode names), the product job for the others (made
-// on demand in `product`), or a verdict right away (`unknown`) when neither is possible.
+// component's own variables (in its slots and mode names), a product job for the others (the
+// product of the interaction groups the property reads), or a verdict right away (`unknown`)
+// when neither is possible.
 void PlanJobs(const System& system, std::span<const Property> properties, int max_product_modes,
-              std::vector<CheckResult>& results, std::vector<Job>& jobs,
-              std::optional<Automaton>& product, Job& product_job) {
+              std::vector<CheckResult>& results, std::vector<Job>& jobs, ProductJobs& products) {
   const std::vector<std::vector<int>> owners = SlotOwners(system);
+  const std::vector<int> group = InteractionGroups(system);
   std::map<std::string, std::vector<int>> asked;  // goals by their text (see AddGoal)
   for (std::size_t i = 0; i < properties.size(); ++i) {
     const Property& p = properties[i];
@@ -1067,8 +1153,8 @@ void PlanJobs(const System& system, std::span<const Property> properties, int ma
       AddGoal(c, Localise(system, c, p), static_cast<int>(i), p, asked, jobs);
       continue;
     }
-    AddProductGoal(system, p, static_cast<int>(i), !modes.empty(), max_product_modes, results,
-                   product, product_job);
+    AddProductGoal(system, p, static_cast<int>(i), !modes.empty(), GroupsOf(group, comps),
+                   max_product_modes, results, products);
   }
 }
 
@@ -1137,39 +1223,45 @@ int SameInstance(const System& system, const std::vector<Job>& jobs, int c) {
   return same;
 }
 
-// Copies the results of component `same`'s job to component `c`'s, each trace renamed and
-// replayed for `c` (a trace that does not replay leaves the property `unknown`).
-void CopyShared(const System& system, const std::vector<Job>& jobs, int c, int same,
-                Clock::time_point start, std::vector<CheckResult>& results) {
-  const auto components = system.components();
-  const Job& job = jobs[c];
-  const std::string from = components[same].instance + ".", to = components[c].instance + ".";
-  auto rename = [&](const std::string& name) {
-    return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
-  };
-  for (std::size_t g = 0; g < job.goals.size(); ++g) {
-    const int src = jobs[same].goals[g].result;
-    if (src < 0 || job.goals[g].result < 0) continue;
-    std::vector<int> targets = job.goals[g].also;
-    targets.insert(targets.begin(), job.goals[g].result);
+// Where one job's proof serves for another: the names of the first mapped to the second's
+// (`rename`), component indices likewise (`component`), and how the proof is named in reasons.
+struct SharedProof {
+  std::function<std::string(const std::string&)> rename;
+  std::map<int, int> component;
+  std::string source;  // "instance A", "instances A, ctlA"
+  std::string target;
+  std::string why;  // ", an instance of the same automaton"
+};
+
+// Copies the results of job `from` to job `to` (which asks the same questions), each trace
+// renamed and replayed for `to` (a trace that does not replay leaves the property `unknown`).
+void CopyResults(const System& system, const Job& from, const Job& to, const SharedProof& how,
+                 Clock::time_point start, std::vector<CheckResult>& results) {
+  for (std::size_t g = 0; g < to.goals.size(); ++g) {
+    const int src = from.goals[g].result;
+    if (src < 0 || to.goals[g].result < 0) continue;
+    std::vector<int> targets = to.goals[g].also;
+    targets.insert(targets.begin(), to.goals[g].result);
     for (int dst : targets) {
       CheckResult r = results[src];
       r.property = results[dst].property;
       r.kind = results[dst].kind;
       if (r.trace) {
         Trace t = *r.trace;
-        for (auto& [name, v] : t.parameters) name = rename(name);
-        for (auto& [name, v] : t.initial_values) name = rename(name);
+        for (auto& [name, v] : t.parameters) name = how.rename(name);
+        for (auto& [name, v] : t.initial_values) name = how.rename(name);
         for (auto& [component, index] : t.initial_states) {
-          if (component == same) component = c;
+          if (auto it = how.component.find(component); it != how.component.end()) {
+            component = it->second;
+          }
         }
         for (InputSignal& in : t.inputs.inputs) {
-          const auto slot = system.symbols().Find(rename(system.symbols()[in.slot].name));
+          const auto slot = system.symbols().Find(how.rename(system.symbols()[in.slot].name));
           if (slot) in.slot = *slot;
         }
         bool ok = false;
         try {
-          ok = ReplayTrace(system, job.goals[g].original, t);
+          ok = ReplayTrace(system, to.goals[g].original, t);
         } catch (const std::exception&) {
         }
         if (ok) {
@@ -1177,16 +1269,102 @@ void CopyShared(const System& system, const std::vector<Job>& jobs, int c, int s
         } else {
           r.trace.reset();
           r.verdict = Verdict::kUnknown;
-          r.reason = "the trace found for instance " + components[same].instance +
-                     " does not replay for " + components[c].instance;
+          r.reason = "the trace found for " + how.source + " does not replay for " + how.target;
         }
       }
-      r.reason += " (the proof for instance " + components[same].instance +
-                  ", an instance of the same automaton)";
+      r.reason += " (the proof for " + how.source + how.why + ")";
       r.seconds = Since(start);
       results[dst] = std::move(r);
     }
   }
+}
+
+// Copies the results of component `same`'s job to component `c`'s (CopyResults).
+void CopyShared(const System& system, const std::vector<Job>& jobs, int c, int same,
+                Clock::time_point start, std::vector<CheckResult>& results) {
+  const auto components = system.components();
+  const std::string from = components[same].instance + ".", to = components[c].instance + ".";
+  SharedProof how;
+  how.rename = [from, to](const std::string& name) {
+    return name.rfind(from, 0) == 0 ? to + name.substr(from.size()) : name;
+  };
+  how.component = {{same, c}};
+  how.source = "instance " + components[same].instance;
+  how.target = "instance " + components[c].instance;
+  how.why = ", an instance of the same automaton";
+  CopyResults(system, jobs[same], jobs[c], how, start, results);
+}
+
+// "A, ctlA"
+std::string InstanceList(const System& system, const std::vector<int>& which) {
+  std::string out;
+  for (const int c : which) {
+    out += (out.empty() ? "" : ", ") + system.components()[c].instance;
+  }
+  return out;
+}
+
+// How the proof for the product of components `a` serves for that of `b`, or nullopt: a[i] and
+// b[i] must be named instances of one automaton (as set), bound alike up to the instance names.
+std::optional<SharedProof> Corresponding(const System& system, const std::vector<int>& a,
+                                         const std::vector<int>& b) {
+  const auto components = system.components();
+  if (a.size() != b.size() || a == b) return std::nullopt;
+  auto prefixes = std::make_shared<std::map<std::string, std::string>>();  // "A." -> "B."
+  SharedProof how;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Component& ca = components[a[i]];
+    const Component& cb = components[b[i]];
+    if (ca.instance.empty() || cb.instance.empty() || !(ca.source == cb.source)) {
+      return std::nullopt;
+    }
+    (*prefixes)[ca.instance + "."] = cb.instance + ".";
+    how.component[a[i]] = b[i];
+  }
+  how.rename = [prefixes](const std::string& name) {
+    for (const auto& [from, to] : *prefixes) {
+      if (name.rfind(from, 0) == 0) return to + name.substr(from.size());
+    }
+    return name;
+  };
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto& binds_a = components[a[i]].binds;
+    const auto& binds_b = components[b[i]].binds;
+    if (binds_a.size() != binds_b.size()) return std::nullopt;
+    for (const auto& [name, bound] : binds_a) {
+      const auto it = binds_b.find(name);
+      if (it == binds_b.end() || it->second != how.rename(bound)) return std::nullopt;
+    }
+  }
+  how.source = "instances " + InstanceList(system, a);
+  how.target = "instances " + InstanceList(system, b);
+  how.why = ", instances of the same automata bound alike";
+  return how;
+}
+
+// Whether jobs `x` and `y`, over products that correspond slot for slot, ask the same questions
+// (compared by slot: their names differ by the instance names).
+bool SameQuestions(const Job& x, const Job& y) {
+  if (x.goals.size() != y.goals.size()) return false;
+  auto by_slot = [](const Predicate& p) {
+    return Remap(
+        p,
+        [](const Expression& e) {
+          return e.Substitute([](const std::string&, int slot) -> std::optional<Expression> {
+            return Expression::Symbol("s" + std::to_string(slot), slot);
+          });
+        },
+        [](const std::string& m) { return m; });
+  };
+  for (std::size_t g = 0; g < x.goals.size(); ++g) {
+    const Property& a = x.goals[g].property;
+    const Property& b = y.goals[g].property;
+    if (a.kind != b.kind || a.horizon != b.horizon ||
+        !(by_slot(a.predicate) == by_slot(b.predicate))) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -1230,9 +1408,8 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
   std::vector<CheckResult> results(properties.size());
   const auto components = system.components();
   std::vector<Job> jobs(components.size());
-  std::optional<Automaton> product;
-  Job product_job;
-  PlanJobs(system, properties, options_.max_product_modes, results, jobs, product, product_job);
+  ProductJobs products;
+  PlanJobs(system, properties, options_.max_product_modes, results, jobs, products);
   std::vector<int> same(components.size(), -1);
   int runs = 0;  // jobs that need a check of their own
   for (int c = 0; c < static_cast<int>(components.size()); ++c) {
@@ -1245,10 +1422,23 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
     same[c] = SameInstance(system, jobs, c);
     if (same[c] < 0) ++runs;
   }
-  if (product && !product_job.goals.empty()) {
-    product_job.automaton = &*product;
-    for (int s = 0; s < system.symbols().size(); ++s) product_job.to_system.push_back(s);
-    ++runs;
+  // Product jobs whose proof another's serves for: (job, the earlier job, how).
+  std::vector<std::tuple<const Job*, const Job*, SharedProof>> copies;
+  std::set<const Job*> copied;
+  for (auto& [which, pj] : products) {
+    if (pj.job.goals.empty()) continue;
+    pj.job.automaton = &*pj.automaton;
+    for (const auto& [earlier, pe] : products) {
+      if (earlier == which) break;
+      if (pe.job.goals.empty() || copied.count(&pe.job)) continue;
+      auto how = Corresponding(system, earlier, which);
+      if (how && SameQuestions(pe.job, pj.job)) {
+        copies.emplace_back(&pj.job, &pe.job, std::move(*how));
+        copied.insert(&pj.job);
+        break;
+      }
+    }
+    if (!copied.count(&pj.job)) ++runs;
   }
   // Each job gets an equal share of what is left of the budget; what one leaves goes on.
   auto run = [&](const Job& job) {
@@ -1263,7 +1453,10 @@ std::vector<CheckResult> PropertyProver::Check(const System& system,
       CopyShared(system, jobs, c, same[c], start, results);
     }
   }
-  if (product && !product_job.goals.empty()) run(product_job);
+  for (const auto& [which, pj] : products) {
+    if (!pj.job.goals.empty() && !copied.count(&pj.job)) run(pj.job);
+  }
+  for (const auto& [job, from, how] : copies) CopyResults(system, *from, *job, how, start, results);
   // The gate of every verdict that rests on a trace: a fresh replay.
   for (std::size_t i = 0; i < properties.size(); ++i) {
     ConfirmTrace(system, properties[i], results[i]);
