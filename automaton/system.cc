@@ -555,8 +555,15 @@ void System::AddComponent(std::string instance, const Automaton& automaton,
     if (auto it = binds.find(n); it != binds.end()) return it->second;
     return instance.empty() || shared_.count(n) ? n : instance + "." + n;
   };
-  CheckDistinctNames(automaton, rename);
-  Component c{instance, Renamed(automaton, rename, rename), {}, automaton, std::move(binds)};
+  // An unnamed instance without binds keeps every name: a plain copy (System::Of does this for
+  // every automaton it is given, e.g. each model a diagnosis simulates).
+  const bool keeps_names = instance.empty() && binds.empty();
+  if (!keeps_names) CheckDistinctNames(automaton, rename);
+  Component c{instance,
+              keeps_names ? automaton : Renamed(automaton, rename, rename),
+              {},
+              automaton,
+              std::move(binds)};
   const SymbolTable& local = c.automaton.symbols();
   const std::vector<double> parameters = c.automaton.ParameterEnvironment();
   for (int s = 0; s < local.size(); ++s) {

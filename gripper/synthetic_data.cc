@@ -13,9 +13,8 @@ namespace hybrid {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The top of the motor path of a free-space run and of a run with an object (counts).
-constexpr double kFreeTop = 230.0;
-constexpr double kContactTop = 255.0;
+// The top of the requests of every run (counts): the report closed each run to 255.
+constexpr double kTop = 255.0;
 // Size of an outlier's jump on theta3 (deg).
 constexpr double kOutlierMin = 10.0;
 constexpr double kOutlierMax = 25.0;
@@ -105,9 +104,6 @@ constexpr double kFineGrid = 1048576.0;  // 2^20
 // `v` rounded to a multiple of 1 / kGrid.
 double OnGrid(double v) { return std::round(v * kGrid) / kGrid; }
 
-// The largest multiple of 1 / kGrid that is at most `v` (v >= 0).
-double OnGridBelow(double v) { return std::floor(v * kGrid) / kGrid; }
-
 // Motor path of `samples` (even) samples: 0 up to `top` on the first half, back on the second.
 std::vector<double> MotorPath(int samples, double top) {
   const int half = samples / 2;
@@ -128,65 +124,21 @@ double Rippled(double g, const HiddenEffects& hidden) {
   return std::clamp(std::round((g + ripple) * kFineGrid) / kFineGrid, 0.0, 255.0);
 }
 
-// The drive position (the automaton's g) at which the finger, closing from open on `run`'s
-// object, stops the motor (enters phase 4, where g has no flow), if it does by `reach`; nullopt
-// otherwise: where the predictor's controller stops the motor for the one request `reach`
-// (backlash and offset left out: the finger follows the drive), a hair (1e-9 counts) below.
-std::optional<double> StallDrive(const FingerPredictor& predictor, const MeasuredRun& run,
-                                 const FingerEffects& effects, double reach) {
-  FingerEffects dynamics = effects;
-  dynamics.backlash = 0.0;
-  dynamics.motor_offset = 0.0;
-  dynamics.sensor_bias = {0.0, 0.0, 0.0};
-  MeasuredRun trip;
-  trip.label = run.label;
-  if (run.gob) trip.gob = std::clamp(*run.gob - effects.motor_offset, 0.0, 256.0);
-  trip.contact_link = run.contact_link;
-  for (auto& theta : trip.theta) theta.assign(1, kNaN);
-  trip.g = {reach};
-  const FingerPrediction p = predictor.Predict(trip, dynamics);
-  if (p.status != SimulationStatus::kCompleted) {
-    Fail("run '" + run.label + "': the prediction did not complete: " + p.message);
+// The motor positions the gripper reports for `run` (whole counts, as the firmware reports
+// them), from the motor positions `motor` the predictor found for the rippled requests `driven`
+// (FingerPrediction::motor): the request where the motor reached it; where the controller held
+// the motor at a stop, that stop taken back from drive to motor coordinates (m + ripple(m) = the
+// stop, solved by one fixed-point step: the ripple's slope is small), never above the request.
+std::vector<double> ReportedPositions(const MeasuredRun& run, const MeasuredRun& driven,
+                                      const std::vector<double>& motor,
+                                      const HiddenEffects& hidden) {
+  std::vector<double> position(run.g.size());
+  for (size_t k = 0; k < run.g.size(); ++k) {
+    double m = run.g[k];
+    if (motor[k] != driven.g[k]) m = std::min(m, motor[k] - (Rippled(motor[k], hidden) - motor[k]));
+    position[k] = std::clamp(std::round(m), 0.0, 255.0);
   }
-  if (!(p.motor[0] < reach)) return std::nullopt;
-  return std::max(0.0, p.motor[0] - 1e-9);
-}
-
-// The measured motor path of `run` for the commanded path `command` (0 up to the top and back):
-// the motor stops where the finger stops it (StallDrive) and stays there until the command
-// comes back below.
-std::vector<double> MeasuredPath(const FingerPredictor& predictor, const MeasuredRun& run,
-                                 const HiddenEffects& hidden, std::vector<double> command) {
-  const double d = hidden.finger.motor_offset;
-  double reach = 0.0;  // the largest drive position the command asks for
-  for (const double g : command)
-    reach = std::max(reach, std::clamp(Rippled(g, hidden) - d, 0.0, 255.0));
-  const std::optional<double> stall = StallDrive(predictor, run, hidden.finger, reach);
-  if (!stall) return command;
-  // The motor stops at the first commanded g whose drive reaches the stall: h(g) = g + ripple
-  // = stall + d, solved on the first step of the command that crosses it.
-  const double target = *stall + d;
-  const auto h = [&](double g) { return Rippled(g, hidden); };
-  const size_t half = command.size() / 2;
-  double stop = command[half - 1];
-  for (size_t k = 1; k < half; ++k) {
-    if (h(command[k]) < target) continue;
-    double lo = command[k - 1], hi = command[k];
-    if (h(lo) >= target) {
-      stop = lo;
-      break;
-    }
-    while (hi - lo > 1e-12 * std::max(1.0, hi)) {
-      const double mid = 0.5 * (lo + hi);
-      if (mid <= lo || mid >= hi) break;
-      (h(mid) < target ? lo : hi) = mid;
-    }
-    stop = lo;
-    break;
-  }
-  stop = OnGridBelow(stop);  // still short of the stall
-  for (double& g : command) g = std::min(g, stop);
-  return command;
+  return position;
 }
 
 // `v` with at most 6 decimals and no trailing zeros ("-0" written as "0").
@@ -214,7 +166,7 @@ MeasuredData Synthesize(const FingerPredictor& predictor, const HiddenEffects& h
   for (int i = 0; i < design.free_runs; ++i) {
     MeasuredRun run;
     run.label = "free" + std::to_string(i + 1);
-    run.g = MotorPath(design.samples_per_run, kFreeTop);
+    run.g = MotorPath(design.samples_per_run, kTop);
     data.runs.push_back(std::move(run));
   }
   for (int link = 1; link <= 2; ++link) {
@@ -222,31 +174,24 @@ MeasuredData Synthesize(const FingerPredictor& predictor, const HiddenEffects& h
     for (size_t i = 0; i < gobs.size(); ++i) {
       MeasuredRun run;
       run.label = "link" + std::to_string(link) + "_" + std::to_string(i + 1);
-      run.g = MotorPath(design.samples_per_run, kContactTop);
+      run.g = MotorPath(design.samples_per_run, kTop);
       run.gob = gobs[i];
       run.contact_link = link;
       data.runs.push_back(std::move(run));
     }
   }
 
-  // The model's angles with the hidden effects.
+  // The model's angles with the hidden effects, the finger behind its controller.
   const int n = design.samples_per_run;
   int line = 2;  // after the header
-  for (size_t r = 0; r < data.runs.size(); ++r) {
-    MeasuredRun& run = data.runs[r];
-    // A repeat of the previous run (same object, same command) stops at the same g.
-    const MeasuredRun* previous = r > 0 ? &data.runs[r - 1] : nullptr;
-    if (previous && previous->gob == run.gob && previous->contact_link == run.contact_link) {
-      run.g = previous->g;
-    } else {
-      run.g = MeasuredPath(predictor, run, hidden, std::move(run.g));
-    }
+  for (MeasuredRun& run : data.runs) {
     MeasuredRun driven = run;
     for (double& g : driven.g) g = Rippled(g, hidden);
     FingerPrediction p = predictor.Predict(driven, hidden.finger);
     if (p.status != SimulationStatus::kCompleted) {
       Fail("run '" + run.label + "': the prediction did not complete: " + p.message);
     }
+    run.position = ReportedPositions(run, driven, p.motor, hidden);
     run.theta = std::move(p.theta);
     if (hidden.theta3_hysteresis != 0.0) {
       for (int k = 0; k < n; ++k) {
@@ -295,7 +240,13 @@ void WriteMeasuredData(std::ostream& out, const MeasuredData& data,
       }
     }
     for (const double g : run.g) {
-      if (!std::isfinite(g)) WriteFail("run '" + label + "': a motor position is not finite");
+      if (!std::isfinite(g)) WriteFail("run '" + label + "': a position request is not finite");
+    }
+    if (!run.position.empty() && run.position.size() != run.g.size()) {
+      WriteFail("run '" + label + "': vectors of unequal length");
+    }
+    for (const double x : run.position) {
+      if (std::isinf(x)) WriteFail("run '" + label + "': a reported motor position is infinite");
     }
     if (run.gob.has_value() != run.contact_link.has_value()) {
       WriteFail("run '" + label + "': only one of gob and contact_link is set");
@@ -314,12 +265,20 @@ void WriteMeasuredData(std::ostream& out, const MeasuredData& data,
       begin = end + 1;
     }
   }
-  out << "run,g,theta1,theta2,theta3,gob,contact_link\n";
+  const bool positions = std::any_of(data.runs.begin(), data.runs.end(),
+                                     [](const MeasuredRun& run) { return !run.position.empty(); });
+  out << (positions ? "run,g,position,theta1,theta2,theta3,gob,contact_link\n"
+                    : "run,g,theta1,theta2,theta3,gob,contact_link\n");
   for (const MeasuredRun& run : data.runs) {
     const std::string object =
         run.gob ? CsvNumber(*run.gob) + "," + std::to_string(*run.contact_link) : ",";
     for (size_t k = 0; k < run.g.size(); ++k) {
       std::string row = run.label + "," + CsvNumber(run.g[k]);
+      if (positions) {
+        row += ',';
+        if (!run.position.empty() && !std::isnan(run.position[k]))
+          row += CsvNumber(run.position[k]);
+      }
       for (const auto& theta : run.theta) {
         row += ',';
         if (!std::isnan(theta[k])) row += CsvNumber(theta[k]);

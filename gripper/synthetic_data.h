@@ -44,23 +44,23 @@ inline constexpr int kMaxSyntheticFreeRuns = 10000;
 
 /// The runs of synthetic data and its measurement errors.
 struct SyntheticDesign {
-  /// Free-space runs, in [0, kMaxSyntheticFreeRuns]: g from 0 up to 230 and back to 0.
+  /// Free-space runs, in [0, kMaxSyntheticFreeRuns]: the request g from 0 up to 255 and back to
+  /// 0 (the report's protocol: past the palm stop, where the controller holds the motor at 240
+  /// for the model as declared until the request comes back below it).
   int free_runs = 4;
-  /// One run per entry (counts, in [0, 255]): an object touching link 1 at gob; g commanded from
-  /// 0 up to 255 and back to 0. The measured g stops where the finger stops the motor (the
-  /// model's phase 4, g' = 0: for the model as declared at (255 + g_s) / 2 with g_s where link 2
-  /// stopped, e.g. 217.5 for gob 80) and stays there until the command comes back below it.
+  /// One run per entry (counts, in [0, 255]): an object touching link 1 at gob; the request from
+  /// 0 up to 255 and back to 0. The controller holds the motor where the finger stops it (the
+  /// model's phase 4: for the model as declared at (255 + g_s) / 2 with g_s where link 2
+  /// stopped, e.g. 217.5 for gob 80) until the request comes back below it.
   std::vector<double> link1_gob = {80, 80, 100};
   /// The same for an object touching link 2.
   std::vector<double> link2_gob = {170, 170, 190};
   /// Samples per run: even, >= kMinRunSamples, and the rows of all runs (runs times samples)
-  /// at most kMaxSyntheticSamples. The first half closes, the commanded g evenly
-  /// spaced from 0 to the top inclusive; the second half opens through the same positions in
-  /// reverse (the top is commanded twice, once per half), so that repeated runs have identical g.
-  /// Positions are rounded to multiples of 1/64 count (as is where the motor stops), so that
-  /// WriteMeasuredData writes every g exactly and FingerPredictor's sums of path length are exact
-  /// (see Synthesize). Free runs (to 230) stay short of the free finger's stop (240 for the model
-  /// as declared); any run's measured g stops where the finger stops the motor (see link1_gob).
+  /// at most kMaxSyntheticSamples. The first half closes, the requests evenly spaced from 0 to
+  /// 255 inclusive; the second half opens through the same requests in reverse (255 is
+  /// requested twice, once per half), so that repeated runs have identical g. Requests are
+  /// rounded to multiples of 1/64 count, so that WriteMeasuredData writes every g exactly and
+  /// FingerPredictor's sums of path length are exact (see Synthesize).
   int samples_per_run = 512;
   /// Standard deviation of the Gaussian measurement noise (deg) on theta1..theta3; finite, >= 0.
   std::array<double, 3> noise_sd = {0.7, 0.7, 1.2};
@@ -74,20 +74,19 @@ struct SyntheticDesign {
 
 /// Generates the runs of `design`, in the order free runs, link-1 runs, link-2 runs, labelled
 /// "free1", "free2", .., "link1_1", .., "link2_1", ..; object runs have gob and contact_link set.
-/// For each run: the motor path g (SyntheticDesign::samples_per_run), stopped where the finger
-/// under `hidden` (its dynamics, motor offset and ripple) stops the motor (enters phase 4, where
-/// the model's g has no flow), found by bisection to 1e-9 counts on closing runs simulated by
-/// the predictor, taken from below and rounded down to a multiple of 1/64 (so up to 1/64 count
-/// short of the model's exact stop), so that the finger never waits in phase 4 (a drive that went
-/// on would leave the model's g behind: it would reach 0 before the drive when the finger reopens
-/// and the prediction would not complete, on these data or on them read back from the CSV); the
-/// angles FingerPredictor::Predict gives for `hidden.finger` on the run with the ripple added to
-/// its g (rounded to a multiple of 2^-20; the run keeps the nominal g). Positions on these grids
-/// keep the predictor's sums of path length exact: it fails on a run that returns to g = 0 after
-/// summing a few 1e-12 more on the way back than on the way out (e.g. 256 steps of 230/255 rounded
-/// to 6 decimals, up and back). Then the hysteresis (+h on the closing half, -h on the opening
-/// half); then, per sample in order and per joint theta1..theta3, Gaussian noise of sd noise_sd[j],
-/// for theta3 an outlier with outlier_probability, and a missing sample with missing_probability.
+/// Each run is taken as the report took its data: g is the position request (samples_per_run
+/// requests, 0 up to 255 and back), each sample taken once the finger settled.
+/// The angles are those FingerPredictor::Predict gives for `hidden.finger` on the run with the
+/// ripple added to its requests (rounded to a multiple of 2^-20): the finger behind its
+/// controller, which holds the motor where the finger stops it until a more open request. The
+/// `position` column is the motor position the gripper would report: the request, or where the
+/// controller holds the motor (taken back from the rippled drive, one fixed-point step), in
+/// whole counts, never above the request. Positions on these grids keep the predictor's sums of
+/// path length exact: it fails on a run that returns to g = 0 after summing a few 1e-12 more on
+/// the way back than on the way out (e.g. 256 steps of 230/255 rounded to 6 decimals, up and
+/// back). Then the hysteresis (+h on the closing half, -h on the opening half); then, per sample
+/// in order and per joint theta1..theta3, Gaussian noise of sd noise_sd[j], for theta3 an outlier
+/// with outlier_probability, and a missing sample with missing_probability.
 /// The random numbers come from a std::mt19937_64 seeded with `seed`, only through its raw
 /// output (uniforms in (0, 1) from the top 52 bits; each normal variate by Box-Muller, cosine
 /// branch, from two uniforms), so that the data are identical across standard libraries. Per
@@ -108,11 +107,13 @@ MeasuredData Synthesize(const FingerPredictor& predictor, const HiddenEffects& h
 
 /// Writes `data` in the CSV format ReadMeasuredData reads: first each line of `comment` (an
 /// element with line breaks gives several lines) prefixed with "# ", then the header
-/// `run,g,theta1,theta2,theta3,gob,contact_link`, then one row per sample. Numbers are written
-/// with at most 6 decimals, trailing zeros dropped (`%.6f`: they read back within 5e-7); a
-/// missing angle (NaN) and the gob and contact_link of a free-space run are empty cells. Throws
-/// std::invalid_argument ("cannot write measured data: ...") for what could not be read back: a
-/// label that is empty, starts with '#' or a blank, ends with a blank or holds ',', '"', '\r' or
+/// `run,g,theta1,theta2,theta3,gob,contact_link` (with `position` after g when some run has
+/// reported positions; an empty cell for a run without them or a NaN), then one row per sample.
+/// Numbers are written with at most 6 decimals, trailing zeros dropped (`%.6f`: they read back
+/// within 5e-7); a missing angle (NaN) and the gob and contact_link of a free-space run are empty
+/// cells. Throws std::invalid_argument ("cannot write measured data: ...") for what could not be
+/// read back: a label that is empty, starts with '#' or a blank, ends with a blank or holds ',',
+/// '"', '\r' or
 /// '\n'; vectors of a run of unequal lengths; a value that is infinite (or NaN other than an
 /// angle); only one of gob and contact_link set.
 void WriteMeasuredData(std::ostream& out, const MeasuredData& data,

@@ -999,6 +999,8 @@ EventLoop::EventLoop(const Simulator& simulator, const std::vector<CompiledCompo
 }
 
 SimulationResult EventLoop::Simulate() {
+  // The listed samples, the start and a few events (the vector grows past that as needed).
+  result_.samples.reserve(options_.sample_times.size() + 16);
   Record(StateSample::Kind::kStart);
   bool running = JumpAndIterate(Candidates(), EventRecord::Cause::kEnabled);
   if (running && ZenoCheck()) running = false;

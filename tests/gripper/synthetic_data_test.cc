@@ -55,7 +55,8 @@ bool SameData(const MeasuredData& a, const MeasuredData& b) {
   for (size_t r = 0; r < a.runs.size(); ++r) {
     const MeasuredRun& x = a.runs[r];
     const MeasuredRun& y = b.runs[r];
-    if (x.label != y.label || x.g != y.g || x.gob != y.gob || x.contact_link != y.contact_link) {
+    if (x.label != y.label || x.g != y.g || x.position != y.position || x.gob != y.gob ||
+        x.contact_link != y.contact_link) {
       return false;
     }
     for (int j = 0; j < 3; ++j) {
@@ -94,31 +95,34 @@ TEST(SynthesizeTest, RunsFollowTheDesign) {
       EXPECT_EQ(run.contact_link, r < 7 ? 1 : 2);
     }
     ASSERT_EQ(run.g.size(), 512u);
-    // The commanded path, evenly spaced up to the top and back through the same positions; the
-    // measured g stops where the finger stops the motor: (255 + g_s) / 2 with g_s where link 2
-    // stopped (at the object, or at its limit 100 counts after link 1 stopped).
-    const double top = r < 4 ? 230.0 : 255.0;
+    // The requests, evenly spaced up to 255 and back through the same positions (the report's
+    // protocol); the motor the gripper reports stops where the finger stops it: at the palm
+    // (240) in free space, else at (255 + g_s) / 2 with g_s where link 2 stopped (at the object,
+    // or at its limit 100 counts after link 1 stopped), and stays there until the request comes
+    // back below it; whole counts.
     const std::vector<double> g_s = {180, 180, 200, 170, 170, 190};
-    const double stop = r < 4 ? 230.0 : (255.0 + g_s[r - 4]) / 2;
+    const double stop = r < 4 ? 240.0 : (255.0 + g_s[r - 4]) / 2;
     EXPECT_EQ(run.g.front(), 0.0);
-    EXPECT_NEAR(run.g[255], stop, 1.0 / 64 + 1e-6);
-    EXPECT_LE(run.g[255], stop);
-    EXPECT_EQ(run.g[256], run.g[255]);
+    EXPECT_EQ(run.g[255], 255.0);
+    EXPECT_EQ(run.g[256], 255.0);
     EXPECT_EQ(run.g.back(), 0.0);
+    ASSERT_EQ(run.position.size(), 512u);
     for (int k = 1; k < 256; ++k) {
-      EXPECT_NEAR(run.g[k], std::min(top * k / 255.0, run.g[255]), 1.0 / 128) << "sample " << k;
+      EXPECT_NEAR(run.g[k], 255.0 * k / 255.0, 1.0 / 128) << "sample " << k;
       EXPECT_EQ(run.g[k], std::round(run.g[k] * 64) / 64);  // a multiple of 1/64
       EXPECT_EQ(run.g[511 - k], run.g[k]);                  // the same positions, opening
     }
-    // Where the motor stops, link 3 is at its limit (the model's phase 4 is about to begin).
+    for (int k = 0; k < 512; ++k) {
+      EXPECT_EQ(run.position[k], std::round(run.position[k])) << "sample " << k;
+      EXPECT_NEAR(run.position[k], std::min(run.g[k], stop), 0.5 + 1e-6) << "sample " << k;
+    }
+    // Where the motor is held, link 3 is at its limit (the finger is in phase 4).
     if (r >= 4) {
       const FingerPrediction p = Predictor().Predict(run, FingerEffects{});
       ASSERT_EQ(p.status, SimulationStatus::kCompleted) << p.message;
-      // At most 1/64 count short of the stop, where theta3 rises at (theta3_max - theta3_s)
-      // (255 - g_s) / (255 - g)^2 deg/count with theta3_s = theta3_min = -55 in these runs.
-      const double rate = 98.0 * (255.0 - g_s[r - 4]) / std::pow(255.0 - stop, 2);
-      EXPECT_LE(p.theta[2][255], 43.0);
-      EXPECT_NEAR(p.theta[2][255], 43.0, rate / 64 + 1e-6);
+      for (int k = 0; k < 512; ++k) {
+        if (run.g[k] > stop + 1e-6) EXPECT_NEAR(p.theta[2][k], 43.0, 1e-6) << "sample " << k;
+      }
     }
     // Repeated runs have identical g.
     if (r > 0 && run.gob == data.runs[r - 1].gob) {
@@ -142,7 +146,7 @@ TEST(WriteMeasuredDataTest, ReadsBackToTheSameRuns) {
   std::ostringstream out;
   WriteMeasuredData(out, data, {"synthetic data", "two\nlines"});
   const std::string text = out.str();
-  EXPECT_EQ(text.rfind("# synthetic data\n# two\n# lines\nrun,g,theta1,theta2,theta3,gob,"
+  EXPECT_EQ(text.rfind("# synthetic data\n# two\n# lines\nrun,g,position,theta1,theta2,theta3,gob,"
                        "contact_link\n",
                        0),
             0u)
@@ -160,6 +164,7 @@ TEST(WriteMeasuredDataTest, ReadsBackToTheSameRuns) {
     EXPECT_EQ(b.gob, a.gob);
     EXPECT_EQ(b.contact_link, a.contact_link);
     ASSERT_EQ(b.g.size(), a.g.size());
+    EXPECT_EQ(b.position, a.position);  // whole counts, written exactly
     for (size_t k = 0; k < a.g.size(); ++k) {
       EXPECT_NEAR(b.g[k], a.g[k], 1e-6);
       for (int j = 0; j < 3; ++j) {

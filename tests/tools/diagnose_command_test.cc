@@ -129,7 +129,8 @@ TEST(Synthesize, WritesSyntheticCsvThatDependsOnlyOnTheSeed) {
   EXPECT_TRUE(AnyContains(comments, "backlash=6")) << text.substr(0, 500);
   EXPECT_TRUE(AnyContains(comments, "theta3_bias=2.5")) << text.substr(0, 500);
   // The header row follows the comments and names the required columns first.
-  EXPECT_NE(text.find("\nrun,g,theta1,theta2,theta3"), std::string::npos) << text.substr(0, 800);
+  EXPECT_NE(text.find("\nrun,g,position,theta1,theta2,theta3"), std::string::npos)
+      << text.substr(0, 800);
   EXPECT_EQ(text, ReadAll(b)) << "the same seed gave different files";
   EXPECT_NE(text, ReadAll(c)) << "seeds 7 and 8 gave the same file";
 }
