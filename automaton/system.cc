@@ -167,9 +167,11 @@ void CheckNewInstance(std::span<const Component> components, const std::string& 
 // and bound to a name.
 void CheckBinds(const Automaton& a, const std::map<std::string, std::string>& binds,
                 const std::set<std::string>& shared) {
-  for (const auto& [from, to] : binds) {
+  for (const auto& bind : binds) {
+    const std::string& from = bind.first;
+    const std::string& to = bind.second;
     const bool label = std::any_of(a.transitions().begin(), a.transitions().end(),
-                                   [&](const Transition& t) { return t.label == from; });
+                                   [&from](const Transition& t) { return t.label == from; });
     if (!a.symbols().Find(from) && !label) {
       Fail("bind '" + from + "': '" + a.name() + "' has no variable, input, parameter or label '" +
            from + "'");
