@@ -215,8 +215,20 @@ std::vector<double> DrivePositions(std::span<const double> g, double backlash, d
   return q;
 }
 
+void CheckDynamicEffects(const FingerEffects& effects) {
+  constexpr std::string_view kApi = "ApplyDynamicEffects";
+  if (effects.theta3_fraction) {
+    const double f = *effects.theta3_fraction;
+    if (!(f > 0.0 && f < 1.0)) Fail(kApi, "theta3_fraction must lie in (0, 1)");
+  }
+  for (const double k : effects.compliance) {
+    if (!std::isfinite(k) || k < 0.0) Fail(kApi, "compliance must be finite and >= 0");
+  }
+}
+
 Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effects) {
   constexpr std::string_view kApi = "ApplyDynamicEffects";
+  CheckDynamicEffects(effects);
   const bool compliant = effects.compliance[0] != 0.0 || effects.compliance[1] != 0.0;
   Automaton out = compliant ? CopySymbols(finger) : finger;
   for (int j = 0; j < 3; ++j) {

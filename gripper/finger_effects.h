@@ -81,6 +81,11 @@ std::vector<double> DrivePositions(std::span<const double> g, double backlash, d
 /// "ApplyDynamicEffects: ..." when a name it needs is missing or a value is out of range).
 Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effects);
 
+/// Throws std::invalid_argument ("ApplyDynamicEffects: ...") unless theta3_fraction (if set)
+/// lies in (0, 1) and both compliances are finite and >= 0: the checks ApplyDynamicEffects makes
+/// of values it is given.
+void CheckDynamicEffects(const FingerEffects& effects);
+
 /// The extended model as one automaton (ApplyDynamicEffects, then the maps as automaton parts):
 /// - the transmission: a play automaton with offset composed between the motor and the finger
 ///   (product): each finger mode M becomes M_closing (engaged, g = g_motor - d), M_slack (the

@@ -15,8 +15,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // gob beyond the motor range: no object (spec/finger.ha's parameter range is [0, 256]).
 constexpr double kNoObject = 256.0;
 constexpr double kMotorMax = 255.0;
-// Simulators kept by FingerPredictor (each holds the compiled model, about 100 kB).
-constexpr size_t kMaxCached = 256;
 
 // Step-signal points with strictly increasing times: of several points at one time the last
 // holds (pieces shorter than the time's rounding vanish), and repeated values are merged.
@@ -28,12 +26,6 @@ void Normalize(std::vector<std::pair<double, double>>& points) {
     out.push_back(pt);
   }
   points = std::move(out);
-}
-
-void AppendNumber(std::string& key, double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g;", v);
-  key += buffer;
 }
 
 }  // namespace
@@ -63,31 +55,42 @@ FingerPredictor::~FingerPredictor() = default;
 const std::string& FingerPredictor::ModeName(int mode) const { return finger_.modes()[mode].name; }
 
 std::shared_ptr<const FingerPredictor::Entry> FingerPredictor::SimulatorFor(
-    const MeasuredRun& run, const FingerEffects& e) const {
-  std::array<double, 3> gob = {kNoObject, kNoObject, kNoObject};
-  if (run.gob && run.contact_link) {
-    gob[*run.contact_link - 1] = std::clamp(*run.gob - e.motor_offset, 0.0, kNoObject);
-  }
-  std::string key;
-  for (const auto& m : e.joint_max) AppendNumber(key, m ? *m : kNaN);
-  AppendNumber(key, e.theta3_fraction ? *e.theta3_fraction : kNaN);
-  for (double k : e.compliance) AppendNumber(key, k);
-  for (double v : gob) AppendNumber(key, v);
+    const FingerEffects& e) const {
+  // One simulator per structure (which links yield: compliance adds flows); the parameter values
+  // are set per run (RunParameters).
+  const std::string key =
+      std::string(e.compliance[0] != 0.0 ? "1" : "0") + (e.compliance[1] != 0.0 ? "1" : "0");
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto it = cache_.find(key);
     if (it != cache_.end()) return it->second;
   }
-  Automaton a = ApplyDynamicEffects(finger_, e);
-  for (int i = 0; i < 3; ++i) {
-    if (gob[i] != kNoObject) a.SetParameter("gob" + std::to_string(i + 1), gob[i]);
-  }
-  auto sim = std::make_shared<const Entry>(System::Of(std::move(a)));
+  FingerEffects structure;
+  structure.compliance = e.compliance;
+  auto sim = std::make_shared<const Entry>(System::Of(ApplyDynamicEffects(finger_, structure)));
   std::lock_guard<std::mutex> lock(mutex_);
-  // Bounded: a fit visits many parameter values once (entries in use stay alive through their
-  // shared_ptr).
-  if (cache_.size() >= kMaxCached) cache_.clear();
   return cache_.emplace(key, std::move(sim)).first->second;
+}
+
+std::vector<std::pair<std::string, double>> FingerPredictor::RunParameters(const MeasuredRun& run,
+                                                                           const FingerEffects& e) {
+  CheckDynamicEffects(e);
+  std::vector<std::pair<std::string, double>> values;
+  static constexpr std::array<const char*, 3> kMax = {"theta1_max", "theta2_max", "theta3_max"};
+  for (int j = 0; j < 3; ++j) {
+    if (e.joint_max[j]) values.emplace_back(kMax[j], *e.joint_max[j]);
+  }
+  if (e.theta3_fraction) values.emplace_back("theta3_fraction", *e.theta3_fraction);
+  for (int i = 0; i < 2; ++i) {
+    if (e.compliance[i] != 0.0) {
+      values.emplace_back("compliance_link" + std::to_string(i + 1), e.compliance[i]);
+    }
+  }
+  if (run.gob && run.contact_link) {
+    values.emplace_back("gob" + std::to_string(*run.contact_link),
+                        std::clamp(*run.gob - e.motor_offset, 0.0, kNoObject));
+  }
+  return values;
 }
 
 std::vector<double> MotorPositions(std::span<const double> requests,
@@ -167,7 +170,8 @@ FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const Fin
   if (t > 0.0) points.emplace_back(t, 0.0);
   options.until = t + 1.0;
   Normalize(points);
-  const std::shared_ptr<const Entry> entry = SimulatorFor(run, e);
+  options.parameters = RunParameters(run, e);
+  const std::shared_ptr<const Entry> entry = SimulatorFor(e);
   const Simulator* sim = &entry->simulator;
   const int u_slot = *sim->system().symbols().Find("u");
   const int g_index =
@@ -231,12 +235,13 @@ std::optional<FingerInitialState> FingerPredictor::StartState(const FingerEffect
   start.theta = {{{kNaN}, {kNaN}, {kNaN}}};
   const double q0 = DrivePositions(start.g, e.backlash, e.motor_offset)[0];
   if (q0 == 0.0) return std::nullopt;
-  const std::shared_ptr<const Entry> entry = SimulatorFor(start, e);
+  const std::shared_ptr<const Entry> entry = SimulatorFor(e);
   const Simulator* sim = &entry->simulator;
   SimulationOptions options;
   options.relative_tolerance = options_.relative_tolerance;
   options.absolute_tolerance = options_.absolute_tolerance;
   options.until = q0;
+  options.parameters = RunParameters(start, e);
   const int u_slot = *sim->system().symbols().Find("u");
   const std::vector<InputSignal> signals = {
       InputSignal{u_slot, InputSignal::Shape::kStep, {{0.0, 1.0}}}};

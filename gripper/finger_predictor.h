@@ -109,8 +109,12 @@ class FingerPredictor {
     System system;
     Simulator simulator;
   };
-  std::shared_ptr<const Entry> SimulatorFor(const MeasuredRun& run,
-                                            const FingerEffects& effects) const;
+  // The simulator of the finger with the flows `effects` adds (compliance), compiled once.
+  std::shared_ptr<const Entry> SimulatorFor(const FingerEffects& effects) const;
+  // The parameter values of `effects` and `run`'s object, set per run
+  // (SimulationOptions::parameters). Throws std::invalid_argument for bad effects.
+  static std::vector<std::pair<std::string, double>> RunParameters(const MeasuredRun& run,
+                                                                   const FingerEffects& effects);
   // The prediction along the motor path `motor` (one position per sample of `run`).
   FingerPrediction PredictAlong(const MeasuredRun& run, const FingerEffects& effects,
                                 std::vector<double> motor) const;

@@ -153,9 +153,16 @@ class ComponentCompiler {
  public:
   // `x_index`: System slot -> index in x (-1 for a slot that is not a continuous variable);
   // `parameter_env`: the System's slots with the parameters filled. All must outlive the compiler.
+  // `fixed`: System slot -> whether the compiled model holds the parameter there as a constant
+  // (set by Compile; see SimulationOptions::parameters).
   ComponentCompiler(const SymbolTable& symbols, const Component& comp,
-                    const std::vector<int>& x_index, const std::vector<double>& parameter_env)
-      : symbols_(symbols), comp_(comp), x_index_(x_index), parameter_env_(parameter_env) {}
+                    const std::vector<int>& x_index, const std::vector<double>& parameter_env,
+                    std::vector<char>& fixed)
+      : symbols_(symbols),
+        comp_(comp),
+        x_index_(x_index),
+        parameter_env_(parameter_env),
+        fixed_(fixed) {}
 
   // The compiled component: its modes, then its transitions (each the outgoing one of its source
   // mode, its label in the alphabet), then its first initial state (interval values at their
@@ -186,6 +193,9 @@ class ComponentCompiler {
     for (const InitialValue& v : init.values) {
       const double lo = v.range.lo.Evaluate(env);
       const double hi = v.range.hi.Evaluate(env);
+      for (const Expression* bound : {&v.range.lo, &v.range.hi}) {
+        for (const int slot : Global(*bound).Slots()) FixParameter(slot);
+      }
       cc.initial_values.emplace_back(x_index_[comp_.global_slot[v.slot]], 0.5 * (lo + hi));
     }
     return cc;
@@ -211,6 +221,10 @@ class ComponentCompiler {
           return Expression::Constant(parameter_env_[slot]);
         });
     if (const auto affine = folded.AsAffine()) {
+      // Coefficients that parameters may change: not affine with the parameters as unknowns.
+      if (!e.AsAffine()) {
+        for (const int slot : l.slots) FixParameter(slot);
+      }
       l.terms.emplace();
       for (const auto& [slot, coefficient] : affine->terms) {
         if (x_index_[slot] >= 0) l.terms->emplace_back(x_index_[slot], coefficient);
@@ -271,10 +285,15 @@ class ComponentCompiler {
     return ct;
   }
 
+  void FixParameter(int slot) const {
+    if (symbols_[slot].kind == SymbolKind::kParameter) fixed_[slot] = 1;
+  }
+
   const SymbolTable& symbols_;
   const Component& comp_;
   const std::vector<int>& x_index_;
   const std::vector<double>& parameter_env_;
+  std::vector<char>& fixed_;
 };
 
 }  // namespace
@@ -285,7 +304,58 @@ struct Simulator::Compiled {
   std::vector<int> variable_slots;  // index in x -> System slot
   std::vector<CompiledComponent> components;
   std::vector<double> parameter_env;  // System slots, parameters filled
+  // System slot -> the parameter there cannot be set per run (SimulationOptions::parameters).
+  std::vector<char> fixed;
 };
+
+namespace {
+
+// Marks in `fixed` every parameter that a fixed one is defined from (`p = 2 * q`: q changes p).
+// Definitions read only earlier parameters, so one pass backwards reaches them all.
+void FixDefiningParameters(const System& system, std::vector<char>& fixed) {
+  for (const Component& comp : system.components()) {
+    const auto& parameters = comp.automaton.parameters();
+    for (auto it = parameters.rbegin(); it != parameters.rend(); ++it) {
+      if (!fixed[comp.global_slot[it->first]]) continue;
+      for (const int slot : it->second.Slots()) fixed[comp.global_slot[slot]] = 1;
+    }
+  }
+}
+
+[[noreturn]] void BadParameter(const std::string& message) { throw std::invalid_argument(message); }
+
+// Component `comp`'s parameters evaluated with `value` (System slot -> a value set for the run)
+// in place of their definitions, into `env` (System slots), each checked as
+// Automaton::SetParameter checks: finite, and within its declared range.
+void EvaluateParameters(const Component& comp, const std::vector<std::optional<double>>& value,
+                        std::vector<double>& env) {
+  const Automaton& a = comp.automaton;
+  std::vector<double> local(static_cast<size_t>(a.symbols().size()), 0.0);
+  bool changed = false;
+  for (const auto& [slot, definition] : a.parameters()) {
+    const std::optional<double>& set = value[comp.global_slot[slot]];
+    changed = changed || set.has_value();
+    local[slot] = set ? *set : definition.Evaluate(local);
+  }
+  if (!changed) return;
+  for (const auto& [slot, definition] : a.parameters()) {
+    const std::string& name = a.symbols()[slot].name;
+    if (!std::isfinite(local[slot])) {
+      BadParameter("the parameter values of the run make '" + name + "' non-finite");
+    }
+    if (const std::optional<Range> range = a.ParameterRange(slot)) {
+      const double lo = range->lo.Evaluate(local), hi = range->hi.Evaluate(local);
+      if (!(local[slot] >= lo && local[slot] <= hi)) {
+        BadParameter("parameter '" + name + "' (" + FormatNumber(local[slot]) +
+                     ") outside its range [" + FormatNumber(lo) + ", " + FormatNumber(hi) +
+                     "] for this run");
+      }
+    }
+    env[comp.global_slot[slot]] = local[slot];
+  }
+}
+
+}  // namespace
 
 Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
   c_->system = &system;
@@ -306,10 +376,35 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
       c_->parameter_env[comp.global_slot[slot]] = local_env[slot];
     }
   }
+  c_->fixed.assign(symbols.size(), 0);
   for (const Component& comp : system.components()) {
     c_->components.push_back(
-        ComponentCompiler(symbols, comp, x_index, c_->parameter_env).Compile());
+        ComponentCompiler(symbols, comp, x_index, c_->parameter_env, c_->fixed).Compile());
   }
+  FixDefiningParameters(system, c_->fixed);
+}
+
+std::vector<double> Simulator::ParameterEnvironment(
+    std::span<const std::pair<std::string, double>> parameters) const {
+  std::vector<double> env = c_->parameter_env;
+  if (parameters.empty()) return env;
+  const System& system = *c_->system;
+  std::vector<std::optional<double>> value(static_cast<size_t>(system.symbols().size()));
+  for (const auto& [name, v] : parameters) {
+    const std::optional<int> slot = system.symbols().Find(name);
+    if (!slot || system.symbols()[*slot].kind != SymbolKind::kParameter) {
+      BadParameter("'" + name + "' is not a parameter of the model");
+    }
+    if (!std::isfinite(v)) BadParameter("value of parameter '" + name + "' is not finite");
+    if (c_->fixed[*slot]) {
+      BadParameter("parameter '" + name +
+                   "' cannot be set for a run: an initial value reads it, or it scales a "
+                   "variable in a guard or invariant (set it in the model)");
+    }
+    value[*slot] = v;
+  }
+  for (const Component& comp : system.components()) EvaluateParameters(comp, value, env);
+  return env;
 }
 
 Simulator::~Simulator() = default;
@@ -1664,7 +1759,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
     }
   }
 
-  hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env, inputs, options);
+  hybrid::Run run(c_->components, c_->variable_slots, ParameterEnvironment(options.parameters),
+                  inputs, options);
   const double t = 0.0;
   run.SetStepInputs(t);
   run.SetModes(modes);
@@ -1690,7 +1786,7 @@ std::optional<std::string> Simulator::FirstStateOutsideInvariant(
       throw std::invalid_argument("a recorded state does not fit the model (modes or variables)");
     }
   }
-  hybrid::Run run(c_->components, c_->variable_slots, c_->parameter_env,
+  hybrid::Run run(c_->components, c_->variable_slots, ParameterEnvironment(options.parameters),
                   MergedInputs(*c_->system, signals), options);
   const auto outside = StateOutsideInvariant(run, result.samples, *this);
   if (!outside) return std::nullopt;

@@ -74,6 +74,15 @@ struct SimulationOptions {
   /// Most passes of the integration loop in one run: CVODE steps, exact (constant-rate) segments
   /// and steps over short gaps, each a pass (kStepLimit beyond).
   long max_steps = 10000000;
+  /// Parameter values for this run in place of the model's, by System name ("gob1", "A.gob1"),
+  /// without compiling the model again: parameters defined from one follow it (`m1 =
+  /// theta1_max / 140`), as with Automaton::SetParameter, and the run equals one of the model
+  /// with those values set. Run throws std::invalid_argument, naming the parameter, for a name
+  /// that is not a parameter, a value that is not finite, a parameter (or one defined from it)
+  /// made non-finite or taken outside its declared range, and a parameter the compiled model
+  /// holds as a constant: one that an initial value reads, or that scales a continuous variable
+  /// in a guard or invariant (set those in the model).
+  std::vector<std::pair<std::string, double>> parameters;
 };
 
 /// Throws std::invalid_argument, with a message for the user, if the horizon `until` (the one the
@@ -264,6 +273,10 @@ class Simulator {
   /// Names of the current modes of `modes`, joined with "|" for several components.
   std::string ModeLabel(std::span<const int> modes) const;
   const System& system() const;
+  /// The values of every System slot's parameter for a run with `parameters` set
+  /// (SimulationOptions::parameters; throws as Run does), other slots 0.
+  std::vector<double> ParameterEnvironment(
+      std::span<const std::pair<std::string, double>> parameters) const;
 
  private:
   struct Compiled;

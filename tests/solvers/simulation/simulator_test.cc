@@ -2122,3 +2122,96 @@ RC_GTEST_PROP(SimulatorProperty, FingerRandomPiecewiseConstantInputsTerminate, (
 
 }  // namespace
 }  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Parameters set per run (SimulationOptions::parameters).
+
+// Every recorded state, event and status of two runs, exactly.
+void ExpectSameRun(const SimulationResult& a, const SimulationResult& b) {
+  EXPECT_EQ(a.status, b.status);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    EXPECT_EQ(a.samples[i].time, b.samples[i].time) << "sample " << i;
+    EXPECT_EQ(a.samples[i].modes, b.samples[i].modes) << "sample " << i;
+    EXPECT_TRUE(a.samples[i].x == b.samples[i].x) << "sample " << i;
+  }
+  ASSERT_EQ(a.events.size(), b.events.size());
+  for (size_t i = 0; i < a.events.size(); ++i) {
+    EXPECT_EQ(a.events[i].time, b.events[i].time) << "event " << i;
+    EXPECT_EQ(a.events[i].transitions, b.events[i].transitions) << "event " << i;
+  }
+}
+
+// The finger closing on an object with changed joint limits, theta3 fraction and object
+// position, set per run, is the run of the model with those values set in it, bit for bit
+// (derived parameters such as m1 = theta1_max / 140 follow); the model itself is unchanged.
+TEST(SimulatorParameters, ARunWithParametersSetEqualsTheModelWithThemSet) {
+  const std::string finger = SpecText("finger");
+  const std::vector<std::pair<std::string, double>> values = {
+      {"theta1_max", 64.5}, {"theta2_max", 93}, {"theta3_fraction", 0.42}, {"gob2", 150}};
+  std::string changed = finger;
+  for (const auto& [name, v] : values) changed = WithParameter(changed, name, Number(v));
+  const Model model(finger, SpecPath("finger"));
+  const Model set(changed, SpecPath("finger"));
+  SimulationOptions options;
+  options.until = 250;  // the default scenario's closing (an object makes its reopening stop)
+  options.sample_step = 1.0;
+  const SimulationResult expected = set.Run(options);
+  ASSERT_EQ(expected.status, SimulationStatus::kCompleted) << expected.message;
+  options.parameters = values;
+  ExpectSameRun(model.Run(options), expected);
+  // Without them, the model's own run.
+  options.parameters.clear();
+  SimulationResult own = model.Run(options);
+  EXPECT_NE(own.samples.back().x, expected.samples.back().x);
+  ExpectSameRun(own, Model(finger, SpecPath("finger")).Run(options));
+}
+
+TEST(SimulatorParameters, RefusedParametersNameTheParameter) {
+  const Model m(R"(automaton a {
+  param k = 2;
+  param x0 = 1;
+  param b = 3;
+  param c = 2 * b;
+  param r = 1 in [0, 2];
+  param d = 4;
+  param e = d + 1;
+  var x;
+  mode m { x' = 1; inv k * x <= 100 and x <= c + r + e; }
+  init m { x = x0; }
+})");
+  SimulationOptions options;
+  options.until = 1;
+  auto message = [&](std::vector<std::pair<std::string, double>> parameters) -> std::string {
+    options.parameters = std::move(parameters);
+    try {
+      m.Run(options);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(message({{"x", 1}}), "'x' is not a parameter of the model");
+  EXPECT_EQ(message({{"nope", 1}}), "'nope' is not a parameter of the model");
+  EXPECT_EQ(message({{"b", kNaN}}), "value of parameter 'b' is not finite");
+  EXPECT_EQ(message({{"r", 3}}), "parameter 'r' (3) outside its range [0, 2] for this run");
+  EXPECT_EQ(message({{"b", 1e308}}), "the parameter values of the run make 'c' non-finite");
+  for (const std::string fixed : {"k", "x0"}) {
+    EXPECT_EQ(message({{fixed, 1}}),
+              "parameter '" + fixed +
+                  "' cannot be set for a run: an initial value reads it, or it scales a "
+                  "variable in a guard or invariant (set it in the model)");
+  }
+  // b, r and e's definition d are free: c = 2 b and e = d + 1 follow.
+  EXPECT_EQ(message({{"b", 1}, {"r", 0.5}, {"d", 0}}), "");
+  const std::vector<double> env = m.sim.ParameterEnvironment(options.parameters);
+  EXPECT_EQ(env[*m.system.symbols().Find("c")], 2.0);
+  EXPECT_EQ(env[*m.system.symbols().Find("e")], 1.0);
+  EXPECT_EQ(env[*m.system.symbols().Find("k")], 2.0);
+}
+
+}  // namespace
+}  // namespace hybrid
