@@ -28,6 +28,73 @@ void Normalize(std::vector<std::pair<double, double>>& points) {
   points = std::move(out);
 }
 
+// The timeline of a drive path: time is the path length of the drive, the input u the drive's
+// direction on each piece (step points, returned); sets options.sample_times (one per sample)
+// and options.until (a second past the last sample, the motor stopped).
+std::vector<std::pair<double, double>> DriveTimeline(const std::vector<double>& drive,
+                                                     SimulationOptions& options) {
+  const size_t n = drive.size();
+  options.sample_times.resize(n);
+  std::vector<std::pair<double, double>> points;
+  // The timeline keeps the drive a hair (1e-9 counts) inside the motor range: the finger's g is
+  // integrated along it, and a rounding-level mismatch between the two must not reach g = 0 or
+  // 255 moving out before the input stops or reverses there.
+  constexpr double kMargin = 1e-9;
+  double t = 0.0, q = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    const double step = std::clamp(drive[k], kMargin, kMotorMax - kMargin) - q;
+    if (step != 0.0) {
+      const double sign = step > 0 ? 1.0 : -1.0;
+      if (points.empty() || points.back().second != sign) points.emplace_back(t, sign);
+      t += std::abs(step);
+      q += step;
+    }
+    options.sample_times[k] = t;
+  }
+  // The motor stops after the last sample (a run that ends at g = 0 or 255, moving out, must not
+  // end on the motor range's boundary: an input breakpoint there is decided by the next piece).
+  if (points.empty()) points.emplace_back(0.0, 0.0);
+  points.front().first = 0.0;
+  if (t > 0.0) points.emplace_back(t, 0.0);
+  options.until = t + 1.0;
+  Normalize(points);
+  return points;
+}
+
+// Runs `sim` with u following `points`. Where the finger stopped the motor (phase 4) but the
+// data's g went on, the finger's g lags the drive and may reach the end of the motor range (0 or
+// 255) before the drive turns: the finger then stays there (the extended automaton's
+// transmission goes slack) until the drive reverses. Each pass that ends on the range's boundary,
+// moving out, stops the input there to the end of that piece (at most 9 passes).
+SimulationResult RunToTheRangeEnds(const Simulator& sim, const SimulationOptions& options,
+                                   int g_index, std::vector<std::pair<double, double>> points) {
+  const int u_slot = *sim.system().symbols().Find("u");
+  SimulationResult r;
+  for (int pass = 0;; ++pass) {
+    const std::vector<InputSignal> signals = {
+        InputSignal{u_slot, InputSignal::Shape::kStep, points}};
+    r = sim.Run(options, signals);
+    if (r.status != SimulationStatus::kInvariantViolated || pass >= 8) break;
+    const StateSample& last = r.samples.back();
+    const double g_end = last.x[g_index];
+    if (!(std::abs(g_end) < 1e-6 || std::abs(g_end - kMotorMax) < 1e-6)) break;
+    // Stop the piece that moved out (a hair before the violation: it may be reported at the
+    // next breakpoint, within rounding) and keep the pieces after it.
+    const double stop = std::max(0.0, last.time - 1e-7);
+    const double outward = std::abs(g_end) < 1e-6 ? -1.0 : 1.0;
+    size_t i = 0;
+    while (i + 1 < points.size() && points[i + 1].first <= stop) ++i;
+    if (points[i].second != outward) break;
+    if (points[i].first == stop) {
+      points[i].second = 0.0;
+    } else {
+      points.insert(points.begin() + static_cast<long>(i) + 1, {stop, 0.0});
+    }
+    Normalize(points);
+  }
+  return r;
+}
+
 }  // namespace
 
 FingerPredictor::FingerPredictor(Automaton finger) : FingerPredictor(std::move(finger), {}) {}
@@ -141,70 +208,18 @@ FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const Fin
     const double step = p.motor[k] - before;
     p.direction[k] = step > 0 ? 1 : step < 0 ? -1 : (k == 0 ? 1 : p.direction[k - 1]);
   }
-  // Time = path length of the drive; the input is the drive's direction on each piece.
   SimulationOptions options;
   options.relative_tolerance = options_.relative_tolerance;
   options.absolute_tolerance = options_.absolute_tolerance;
   options.dense_checks = options_.dense_checks;
-  options.sample_times.resize(n);
-  std::vector<std::pair<double, double>> points;
-  // The timeline keeps the drive a hair (1e-9 counts) inside the motor range: the finger's g is
-  // integrated along it, and a rounding-level mismatch between the two must not reach g = 0 or
-  // 255 moving out before the input stops or reverses there.
-  constexpr double kMargin = 1e-9;
-  double t = 0.0, q = 0.0;
-  for (size_t k = 0; k < n; ++k) {
-    const double step = std::clamp(p.drive[k], kMargin, kMotorMax - kMargin) - q;
-    if (step != 0.0) {
-      const double sign = step > 0 ? 1.0 : -1.0;
-      if (points.empty() || points.back().second != sign) points.emplace_back(t, sign);
-      t += std::abs(step);
-      q += step;
-    }
-    options.sample_times[k] = t;
-  }
-  // The motor stops after the last sample (a run that ends at g = 0 or 255, moving out, must not
-  // end on the motor range's boundary: an input breakpoint there is decided by the next piece).
-  if (points.empty()) points.emplace_back(0.0, 0.0);
-  points.front().first = 0.0;
-  if (t > 0.0) points.emplace_back(t, 0.0);
-  options.until = t + 1.0;
-  Normalize(points);
   options.parameters = RunParameters(run, e);
+  std::vector<std::pair<double, double>> points = DriveTimeline(p.drive, options);
   const std::shared_ptr<const Entry> entry = SimulatorFor(e);
   const Simulator* sim = &entry->simulator;
-  const int u_slot = *sim->system().symbols().Find("u");
   const int g_index =
       static_cast<int>(std::find(sim->variable_names().begin(), sim->variable_names().end(), "g") -
                        sim->variable_names().begin());
-  // Where the finger stopped the motor (phase 4) but the data's g went on, the finger's g lags the
-  // drive and may reach the end of the motor range (0 or 255) before the drive turns: the finger
-  // then stays there (the extended automaton's transmission goes slack) until the drive reverses.
-  // Each pass that ends on the range's boundary, moving out, stops the input there to the end of
-  // that piece.
-  SimulationResult r;
-  for (int pass = 0;; ++pass) {
-    const std::vector<InputSignal> signals = {
-        InputSignal{u_slot, InputSignal::Shape::kStep, points}};
-    r = sim->Run(options, signals);
-    if (r.status != SimulationStatus::kInvariantViolated || pass >= 8) break;
-    const StateSample& last = r.samples.back();
-    const double g_end = last.x[g_index];
-    if (!(std::abs(g_end) < 1e-6 || std::abs(g_end - kMotorMax) < 1e-6)) break;
-    // Stop the piece that moved out (a hair before the violation: it may be reported at the
-    // next breakpoint, within rounding) and keep the pieces after it.
-    const double stop = std::max(0.0, last.time - 1e-7);
-    const double outward = std::abs(g_end) < 1e-6 ? -1.0 : 1.0;
-    size_t i = 0;
-    while (i + 1 < points.size() && points[i + 1].first <= stop) ++i;
-    if (points[i].second != outward) break;
-    if (points[i].first == stop) {
-      points[i].second = 0.0;
-    } else {
-      points.insert(points.begin() + static_cast<long>(i) + 1, {stop, 0.0});
-    }
-    Normalize(points);
-  }
+  const SimulationResult r = RunToTheRangeEnds(*sim, options, g_index, std::move(points));
   p.status = r.status;
   p.message = r.message;
   p.model_g.assign(n, kNaN);
