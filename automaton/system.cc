@@ -509,6 +509,16 @@ class ProductBuilder {
   const int max_modes_;
   Automaton& out_;
   std::vector<std::set<std::string>> alphabet_;  // per component
+
+ public:
+  // The component modes of each product mode (by ModeId).
+  std::vector<std::vector<int>> Tuples() const {
+    std::vector<std::vector<int>> out(index_.size());
+    for (const auto& [tuple, id] : index_) out[static_cast<size_t>(id.value())] = tuple;
+    return out;
+  }
+
+ private:
   std::map<Tuple, ModeId> index_;
   std::deque<Tuple> queue_;  // product modes added but not explored yet
   int transition_count_ = 0;
@@ -749,13 +759,14 @@ System System::Restricted(std::span<const int> which) const {
   return out;
 }
 
-Automaton System::Product(int max_modes) const {
+Automaton System::Product(int max_modes, std::vector<std::vector<int>>* tuples) const {
   if (components_.empty()) Fail("system '" + name_ + "' has no components");
   Automaton out(name_);
   DeclareSymbols(symbols_, components_, out);
   ProductBuilder builder(symbols_, components_, max_modes, out);
   builder.AddInitialStates();
   builder.Explore();
+  if (tuples) *tuples = builder.Tuples();
   AddProductProperties(properties_, out);
   if (scenario_) out.SetScenario(*scenario_);
   return out;

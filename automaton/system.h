@@ -104,8 +104,9 @@ class System {
   /// from the initial tuples through the transition graph (guards are not evaluated), named by
   /// joining the component mode names with "__"; flows are the union of the components' flows,
   /// invariants their conjunction; transitions follow the synchronisation rule above. Throws
-  /// std::invalid_argument ("System::Product: ...") past `max_modes` modes.
-  Automaton Product(int max_modes = 100000) const;
+  /// std::invalid_argument ("System::Product: ...") past `max_modes` modes. With `tuples`, also
+  /// gives the component modes (ModeId values, in component order) of each product mode.
+  Automaton Product(int max_modes = 100000, std::vector<std::vector<int>>* tuples = nullptr) const;
 
   /// The system of components `which` (indices into components()) alone, with their names,
   /// shared names and binds, and no properties or scenario; its slots are numbered afresh in the

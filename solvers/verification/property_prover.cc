@@ -1025,7 +1025,9 @@ void AddGoal(int c, const Property& q, int i, const Property& p,
 // them; the product is made on first use.
 struct ProductJob {
   std::optional<Automaton> automaton;
-  std::string failure;  // why the product could not be made
+  std::vector<int> components;           // the System's components, in product order
+  std::vector<std::vector<int>> tuples;  // product mode -> component modes
+  std::string failure;                   // why the product could not be made
   Job job;
 };
 // Keyed by the components (ascending indices); a map, so that job.automaton stays valid.
@@ -1079,8 +1081,9 @@ std::vector<int> GroupsOf(const std::vector<int>& group, const std::set<int>& co
 void MakeProduct(const System& system, const std::vector<int>& which, int max_product_modes,
                  ProductJob& pj) {
   const System restricted = system.Restricted(which);
+  pj.components = which;
   try {
-    pj.automaton = restricted.Product(max_product_modes);
+    pj.automaton = restricted.Product(max_product_modes, &pj.tuples);
   } catch (const std::invalid_argument& e) {
     pj.failure = std::string(
                      "the property reads several components and their product is too "
@@ -1109,12 +1112,52 @@ Property OverJobSlots(const Property& p, const std::vector<int>& to_system, int 
   return q;
 }
 
-// Adds property number i (`p`, which reads `in MODE` atoms if `reads_modes`) to the job of the
-// product of components `which`, making the product on first use; or leaves it `unknown` when
-// the product is too large or the property reads modes.
-void AddProductGoal(const System& system, const Property& p, int i, bool reads_modes,
-                    const std::vector<int>& which, int max_product_modes,
-                    std::vector<CheckResult>& results, ProductJobs& products) {
+// The disjunction of `atoms[lo, hi)`, as a balanced tree (depth log2 of their number); false for
+// none.
+Predicate AnyOf(const std::vector<Predicate>& atoms, std::size_t lo, std::size_t hi) {
+  if (lo >= hi) return Predicate::False();
+  if (hi - lo == 1) return atoms[lo];
+  const std::size_t mid = lo + (hi - lo) / 2;
+  return Predicate::Or(AnyOf(atoms, lo, mid), AnyOf(atoms, mid, hi));
+}
+
+// `p` with every `in A.m` atom (a mode of one component) replaced by the disjunction of the
+// product modes of `pj` whose A part is m.
+Predicate OverProductModes(const System& system, const ProductJob& pj, const Predicate& p) {
+  switch (p.kind()) {
+    case Predicate::Kind::kInMode: {
+      const auto found = system.FindMode(p.mode());
+      const auto at = found ? std::find(pj.components.begin(), pj.components.end(), found->first)
+                            : pj.components.end();
+      if (at == pj.components.end()) return Predicate::False();
+      const std::size_t i = static_cast<std::size_t>(at - pj.components.begin());
+      std::vector<Predicate> atoms;
+      for (std::size_t m = 0; m < pj.tuples.size(); ++m) {
+        if (pj.tuples[m][i] == found->second.value()) {
+          atoms.push_back(Predicate::InMode(pj.automaton->modes()[m].name));
+        }
+      }
+      return AnyOf(atoms, 0, atoms.size());
+    }
+    case Predicate::Kind::kNot:
+      return Predicate::Not(OverProductModes(system, pj, p.operands()[0]));
+    case Predicate::Kind::kAnd:
+      return Predicate::And(OverProductModes(system, pj, p.operands()[0]),
+                            OverProductModes(system, pj, p.operands()[1]));
+    case Predicate::Kind::kOr:
+      return Predicate::Or(OverProductModes(system, pj, p.operands()[0]),
+                           OverProductModes(system, pj, p.operands()[1]));
+    default:
+      return p;
+  }
+}
+
+// Adds property number i (`p`) to the job of the product of components `which`, making the
+// product on first use (its `in A.m` atoms become disjunctions of product modes); or leaves it
+// `unknown` when the product is too large.
+void AddProductGoal(const System& system, const Property& p, int i, const std::vector<int>& which,
+                    int max_product_modes, std::vector<CheckResult>& results,
+                    ProductJobs& products) {
   ProductJob& pj = products[which];
   if (!pj.automaton && pj.failure.empty()) MakeProduct(system, which, max_product_modes, pj);
   if (!pj.automaton) {
@@ -1122,12 +1165,9 @@ void AddProductGoal(const System& system, const Property& p, int i, bool reads_m
     results[i].reason = pj.failure;
     return;
   }
-  if (reads_modes) {
-    results[i].verdict = Verdict::kUnknown;
-    results[i].reason = "`in MODE` atoms over several components are not supported";
-    return;
-  }
-  pj.job.goals.push_back({OverJobSlots(p, pj.job.to_system, system.symbols().size()), i, p, {}});
+  Property q = OverJobSlots(p, pj.job.to_system, system.symbols().size());
+  q.predicate = OverProductModes(system, pj, q.predicate);
+  pj.job.goals.push_back({std::move(q), i, p, {}});
 }
 
 // Sorts `properties` into jobs: one per component for a property that reads only that
@@ -1153,8 +1193,8 @@ void PlanJobs(const System& system, std::span<const Property> properties, int ma
       AddGoal(c, Localise(system, c, p), static_cast<int>(i), p, asked, jobs);
       continue;
     }
-    AddProductGoal(system, p, static_cast<int>(i), !modes.empty(), GroupsOf(group, comps),
-                   max_product_modes, results, products);
+    AddProductGoal(system, p, static_cast<int>(i), GroupsOf(group, comps), max_product_modes,
+                   results, products);
   }
 }
 

@@ -266,6 +266,65 @@ TEST(PropertyProver, SecondInstanceSharesTheProof) {
   EXPECT_GT(AtTarget(system, a_copy, "A.x"), 3.0);
 }
 
+// Two processes and a shared lock: a process enters its critical section only when the lock is
+// free and takes it with its id.
+constexpr std::string_view kMutexModel = R"(
+automaton proc {
+  param id = 1;
+  var x in [0, 10];
+  var lock in [0, 2];
+  mode idle { x' = 1; inv x <= 3; }
+  mode cs { x' = 1; inv x <= 2; }
+  transition enter: idle -> cs { guard x >= 1 and lock == 0; reset x := 0, lock := id; }
+  transition leave: cs -> idle { guard x >= 1; reset x := 0, lock := 0; }
+  transition wait: idle -> idle { guard x >= 3; reset x := 0; }
+  init idle { x = 0; lock = 0; }
+}
+system mutex {
+  share lock;
+  instance A = proc;
+  instance B = proc;
+  property exclusive: never in A.cs and in B.cs;
+  property a_holds: always not in A.cs or lock == 1;
+  property b_holds: always not in B.cs or lock == 2;
+  property a_enters: reach in A.cs;
+}
+)";
+
+// Properties that combine the modes of two components are checked on their product, each
+// `in A.cs` the product modes whose A part is cs: mutual exclusion is proved with the lock's
+// invariants, and a process entering is reachable.
+TEST(PropertyProver, ModesOfSeveralComponentsAreCheckedOnTheirProduct) {
+  System system = Parse(kMutexModel);
+  system.SetParameter("B.id", 2);
+  const std::vector<CheckResult> results =
+      PropertyProver(Small()).Check(system, system.properties());
+  ASSERT_EQ(results.size(), 4u);
+  for (int i : {0, 1, 2}) EXPECT_EQ(results[i].verdict, Verdict::kProved) << results[i].reason;
+  EXPECT_EQ(results[3].verdict, Verdict::kReachable) << results[3].reason;
+}
+
+// With both ids 1, B in its critical section holds the lock as 1: b_holds is violated (a path
+// of 7 steps: A enters and leaves, then B enters), with a trace the simulator replays into a
+// state where B is in cs and the lock is not 2; without the lock test in the guard, exclusion
+// itself is violated.
+TEST(PropertyProver, ModesOfSeveralComponentsComeBackViolatedWithReplayedTraces) {
+  const System same = Parse(kMutexModel);
+  PropertyProver::Options options = Small();
+  options.max_depth = 8;
+  const std::vector<CheckResult> results = PropertyProver(options).Check(same, same.properties());
+  EXPECT_NE(results[0].verdict, Verdict::kViolated) << results[0].reason;
+  ASSERT_EQ(results[2].verdict, Verdict::kViolated) << results[2].reason;
+  const Trace trace = Replayed(same, Named(same, "b_holds"), results[2]);
+  EXPECT_NE(AtTarget(same, trace, "lock"), 2.0);
+  const System unlocked =
+      Parse(testing::ReplaceOnce(std::string(kMutexModel), "x >= 1 and lock == 0", "x >= 1"));
+  const std::vector<CheckResult> broken =
+      PropertyProver(options).Check(unlocked, unlocked.properties());
+  ASSERT_EQ(broken[0].verdict, Verdict::kViolated) << broken[0].reason;
+  Replayed(unlocked, Named(unlocked, "exclusive"), broken[0]);
+}
+
 TEST(PropertyProver, PropertyReadingAnInputThrows) {
   const System system = Parse(kLimitedModel);
   // The parser rejects such properties; a hand-built one is misuse.
