@@ -148,41 +148,50 @@ void Automaton::SetParameter(std::string_view name, double value) {
     Fail("'" + std::string(name) + "' is not a parameter of automaton '" + name_ + "'");
   }
   if (!std::isfinite(value)) Fail("value of '" + std::string(name) + "' is not finite");
+  const std::pair<int, double> set = {*slot, value};
+  ParameterEnvironment({&set, 1}, "setting '" + std::string(name) + "' to " + FormatNumber(value));
   auto it = std::find_if(parameters_.begin(), parameters_.end(),
                          [&](const auto& p) { return p.first == *slot; });
-  const Expression old = it->second;
   it->second = Expression::Constant(value);
-  auto fail = [&](const std::string& message) {
-    it->second = old;
-    Fail(message);
+}
+
+std::vector<double> Automaton::ParameterEnvironment(std::span<const std::pair<int, double>> values,
+                                                    const std::string& setting) const {
+  auto set = [&](int s) -> const std::pair<int, double>* {
+    for (const auto& v : values) {
+      if (v.first == s) return &v;
+    }
+    return nullptr;
   };
-  const std::string setting = "setting '" + std::string(name) + "' to " + FormatNumber(value);
+  std::vector<double> env(symbols_.size(), 0.0);
+  for (const auto& [s, definition] : parameters_) {
+    const auto* v = set(s);
+    env[s] = v ? v->second : definition.Evaluate(env);
+  }
   // Every parameter and range bound is evaluated in the new environment; ranges read only
-  // earlier parameters, so the range of `name` itself is unchanged.
-  const std::vector<double> env = ParameterEnvironment();
+  // earlier parameters.
   for (size_t i = 0; i < parameters_.size(); ++i) {
     const int s = parameters_[i].first;
     const std::string& p = symbols_[s].name;
-    if (!std::isfinite(env[s])) {
-      fail("setting '" + std::string(name) + "' makes parameter '" + p + "' non-finite");
-    }
+    if (!std::isfinite(env[s])) Fail(setting + " makes parameter '" + p + "' non-finite");
     const std::optional<Range>& range = parameter_ranges_[i];
     if (!range) continue;
     const double lo = range->lo.Evaluate(env);
     const double hi = range->hi.Evaluate(env);
     if (!std::isfinite(lo) || !std::isfinite(hi)) {
-      fail(setting + " makes the range of parameter '" + p + "' non-finite");
+      Fail(setting + " makes the range of parameter '" + p + "' non-finite");
     }
-    if (lo > hi) fail(setting + " makes the range of parameter '" + p + "' empty");
+    if (lo > hi) Fail(setting + " makes the range of parameter '" + p + "' empty");
     if (env[s] < lo || env[s] > hi) {
-      if (s == *slot) {
-        fail("value " + FormatNumber(value) + " of parameter '" + p + "' is outside its range " +
+      if (set(s)) {
+        Fail("value " + FormatNumber(env[s]) + " of parameter '" + p + "' is outside its range " +
              RangeText(lo, hi));
       }
-      fail(setting + " puts parameter '" + p + "' (" + FormatNumber(env[s]) +
+      Fail(setting + " puts parameter '" + p + "' (" + FormatNumber(env[s]) +
            ") outside its range " + RangeText(lo, hi));
     }
   }
+  return env;
 }
 
 ModeId Automaton::AddMode(Mode mode) {

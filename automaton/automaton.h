@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "automaton/expression.h"
@@ -136,6 +137,13 @@ class Automaton {
   /// An environment (one entry per slot) with every parameter evaluated in declaration order and
   /// every other slot 0.
   std::vector<double> ParameterEnvironment() const;
+  /// ParameterEnvironment() with the parameters at the slots of `values` taking those values in
+  /// place of their definitions (parameters defined from them follow), checked as SetParameter
+  /// checks one value: throws std::invalid_argument, the message beginning with `setting`
+  /// ("setting 'k' to 2"), if a parameter or a range bound becomes non-finite, a range empty or a
+  /// parameter leaves its range. Preconditions: every slot of `values` is a parameter's.
+  std::vector<double> ParameterEnvironment(std::span<const std::pair<int, double>> values,
+                                           const std::string& setting) const;
   /// The value of a constant expression over parameters (throws std::invalid_argument, naming
   /// `context`, if it reads a non-parameter or is not finite).
   double EvaluateConstant(const Expression& e, std::string_view context) const;

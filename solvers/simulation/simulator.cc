@@ -324,35 +324,23 @@ void FixDefiningParameters(const System& system, std::vector<char>& fixed) {
 
 [[noreturn]] void BadParameter(const std::string& message) { throw std::invalid_argument(message); }
 
-// Component `comp`'s parameters evaluated with `value` (System slot -> a value set for the run)
-// in place of their definitions, into `env` (System slots), each checked as
-// Automaton::SetParameter checks: finite, and within its declared range.
+// Component `comp`'s parameters with `value` (System slot -> a value set for the run) in place
+// of their definitions, into `env` (System slots); checked as Automaton::SetParameter checks.
 void EvaluateParameters(const Component& comp, const std::vector<std::optional<double>>& value,
                         std::vector<double>& env) {
   const Automaton& a = comp.automaton;
-  std::vector<double> local(static_cast<size_t>(a.symbols().size()), 0.0);
-  bool changed = false;
+  std::vector<std::pair<int, double>> set;
+  std::string setting;
   for (const auto& [slot, definition] : a.parameters()) {
-    const std::optional<double>& set = value[comp.global_slot[slot]];
-    changed = changed || set.has_value();
-    local[slot] = set ? *set : definition.Evaluate(local);
-  }
-  if (!changed) return;
-  for (const auto& [slot, definition] : a.parameters()) {
-    const std::string& name = a.symbols()[slot].name;
-    if (!std::isfinite(local[slot])) {
-      BadParameter("the parameter values of the run make '" + name + "' non-finite");
+    if (const std::optional<double>& v = value[comp.global_slot[slot]]) {
+      set.emplace_back(slot, *v);
+      setting += (setting.empty() ? "setting '" : ", '") + a.symbols()[slot].name + "' to " +
+                 FormatNumber(*v);
     }
-    if (const std::optional<Range> range = a.ParameterRange(slot)) {
-      const double lo = range->lo.Evaluate(local), hi = range->hi.Evaluate(local);
-      if (!(local[slot] >= lo && local[slot] <= hi)) {
-        BadParameter("parameter '" + name + "' (" + FormatNumber(local[slot]) +
-                     ") outside its range [" + FormatNumber(lo) + ", " + FormatNumber(hi) +
-                     "] for this run");
-      }
-    }
-    env[comp.global_slot[slot]] = local[slot];
   }
+  if (set.empty()) return;
+  const std::vector<double> local = a.ParameterEnvironment(set, setting + " for the run");
+  for (const auto& [slot, definition] : a.parameters()) env[comp.global_slot[slot]] = local[slot];
 }
 
 }  // namespace

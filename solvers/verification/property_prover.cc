@@ -9,7 +9,6 @@
 #include <functional>
 #include <iostream>
 #include <map>
-#include <memory>
 #include <set>
 #include <stdexcept>
 #include <tuple>
@@ -980,13 +979,12 @@ bool WritesAlone(const System& system, const std::vector<std::vector<int>>& owne
   return alone;
 }
 
-// `p` (System slots and mode names) over component c's own slots and mode names.
-Property Localise(const System& system, int c, const Property& p) {
-  const Component& comp = system.components()[c];
-  std::vector<int> local(system.symbols().size(), -1);
-  for (std::size_t s = 0; s < comp.global_slot.size(); ++s) {
-    local[comp.global_slot[s]] = static_cast<int>(s);
-  }
+// `p` (System slots) over the slots of a job whose slot i is System slot to_system[i], its mode
+// names mapped by `mode`.
+Property OverJobSlots(const Property& p, const std::vector<int>& to_system, int system_slots,
+                      const std::function<std::string(const std::string&)>& mode) {
+  std::vector<int> local(static_cast<std::size_t>(system_slots), -1);
+  for (std::size_t s = 0; s < to_system.size(); ++s) local[to_system[s]] = static_cast<int>(s);
   Property q = p;
   q.predicate = Remap(
       p.predicate,
@@ -995,11 +993,17 @@ Property Localise(const System& system, int c, const Property& p) {
           return Expression::Symbol(name, local.at(slot));
         });
       },
-      [&](const std::string& m) {
-        auto found = system.FindMode(m);
-        return found ? comp.automaton.mode(found->second).name : m;
-      });
+      mode);
   return q;
+}
+
+// `p` (System slots and mode names) over component c's own slots and mode names.
+Property Localise(const System& system, int c, const Property& p) {
+  const Component& comp = system.components()[c];
+  return OverJobSlots(p, comp.global_slot, system.symbols().size(), [&](const std::string& m) {
+    auto found = system.FindMode(m);
+    return found ? comp.automaton.mode(found->second).name : m;
+  });
 }
 
 // Adds `q`, the local form of property number i (`p`), to component c's job; the same question
@@ -1096,22 +1100,6 @@ void MakeProduct(const System& system, const std::vector<int>& which, int max_pr
   }
 }
 
-// `p` (System slots) over the slots of a job whose slot i is System slot to_system[i].
-Property OverJobSlots(const Property& p, const std::vector<int>& to_system, int system_slots) {
-  std::vector<int> local(static_cast<std::size_t>(system_slots), -1);
-  for (std::size_t s = 0; s < to_system.size(); ++s) local[to_system[s]] = static_cast<int>(s);
-  Property q = p;
-  q.predicate = Remap(
-      p.predicate,
-      [&](const Expression& e) {
-        return e.Substitute([&](const std::string& name, int slot) -> std::optional<Expression> {
-          return Expression::Symbol(name, local.at(slot));
-        });
-      },
-      [](const std::string& m) { return m; });
-  return q;
-}
-
 // The disjunction of `atoms[lo, hi)`, as a balanced tree (depth log2 of their number); false for
 // none.
 Predicate AnyOf(const std::vector<Predicate>& atoms, std::size_t lo, std::size_t hi) {
@@ -1165,7 +1153,9 @@ void AddProductGoal(const System& system, const Property& p, int i, const std::v
     results[i].reason = pj.failure;
     return;
   }
-  Property q = OverJobSlots(p, pj.job.to_system, system.symbols().size());
+  // Modes are kept (OverProductModes maps them).
+  Property q = OverJobSlots(p, pj.job.to_system, system.symbols().size(),
+                            [](const std::string& m) { return m; });
   q.predicate = OverProductModes(system, pj, q.predicate);
   pj.job.goals.push_back({std::move(q), i, p, {}});
 }
@@ -1350,7 +1340,7 @@ std::optional<SharedProof> Corresponding(const System& system, const std::vector
                                          const std::vector<int>& b) {
   const auto components = system.components();
   if (a.size() != b.size() || a == b) return std::nullopt;
-  auto prefixes = std::make_shared<std::map<std::string, std::string>>();  // "A." -> "B."
+  std::map<std::string, std::string> prefixes;  // "A." -> "B."
   SharedProof how;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const Component& ca = components[a[i]];
@@ -1358,11 +1348,11 @@ std::optional<SharedProof> Corresponding(const System& system, const std::vector
     if (ca.instance.empty() || cb.instance.empty() || !(ca.source == cb.source)) {
       return std::nullopt;
     }
-    (*prefixes)[ca.instance + "."] = cb.instance + ".";
+    prefixes[ca.instance + "."] = cb.instance + ".";
     how.component[a[i]] = b[i];
   }
   how.rename = [prefixes](const std::string& name) {
-    for (const auto& [from, to] : *prefixes) {
+    for (const auto& [from, to] : prefixes) {
       if (name.rfind(from, 0) == 0) return to + name.substr(from.size());
     }
     return name;

@@ -2197,8 +2197,9 @@ TEST(SimulatorParameters, RefusedParametersNameTheParameter) {
   EXPECT_EQ(message({{"x", 1}}), "'x' is not a parameter of the model");
   EXPECT_EQ(message({{"nope", 1}}), "'nope' is not a parameter of the model");
   EXPECT_EQ(message({{"b", kNaN}}), "value of parameter 'b' is not finite");
-  EXPECT_EQ(message({{"r", 3}}), "parameter 'r' (3) outside its range [0, 2] for this run");
-  EXPECT_EQ(message({{"b", 1e308}}), "the parameter values of the run make 'c' non-finite");
+  EXPECT_EQ(message({{"r", 3}}), "value 3 of parameter 'r' is outside its range [0, 2]");
+  EXPECT_EQ(message({{"b", 1e308}, {"r", 1}}),
+            "setting 'b' to 1e+308, 'r' to 1 for the run makes parameter 'c' non-finite");
   for (const std::string fixed : {"k", "x0"}) {
     EXPECT_EQ(message({{fixed, 1}}),
               "parameter '" + fixed +
