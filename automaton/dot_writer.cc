@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "automaton/printer.h"
+
 namespace hybrid {
 namespace {
 
@@ -31,7 +33,7 @@ std::string ModeLabel(const Automaton& a, const Mode& m) {
   }
   text += "\n";
   for (const auto& [slot, rhs] : m.flows) {
-    text += a.symbols()[slot].name + "' = " + rhs.ToString() + "\n";
+    text += a.symbols()[slot].name + "'" + FlowText(rhs) + "\n";
   }
   if (!m.invariant.empty()) text += "inv " + m.invariant.ToString() + "\n";
   return text;

@@ -16,6 +16,7 @@
 #include <tao/pegtl/contrib/parse_tree.hpp>
 #include <vector>
 
+#include "automaton/rectangular_rate.h"
 #include "automaton/stack_thread.h"
 
 namespace hybrid {
@@ -187,7 +188,8 @@ struct input_decl
 struct discrete_value : seq<ident_tok, must<equals>, must<signed_number_tok>> {};
 struct discrete_values
     : seq<lparen, must<discrete_value>, star<comma, must<discrete_value>>, must<rparen>> {};
-struct flow : seq<ident_tok, prime, must<equals>, must<expression>, must<semi>> {};
+struct flow_rhs : sor<seq<equals, must<expression>>, seq<kw_in, must<range>>> {};
+struct flow : seq<ident_tok, prime, must<flow_rhs>, must<semi>> {};
 struct invariant : seq<kw_inv, must<conjunction>, must<no_or>, must<semi>> {};
 struct mode_item : sor<flow, invariant> {};
 struct mode_body_end : rbrace {};
@@ -335,8 +337,12 @@ inline constexpr auto kMessage<discrete_value> = "expected 'name = integer'";
 template <>
 inline constexpr auto kMessage<signed_number_tok> = "expected a number";
 template <>
+inline constexpr auto kMessage<flow_rhs> =
+    "expected '= expression' (a flow) or 'in [lo, hi]' (a rectangular rate) after x'";
+template <>
 inline constexpr auto kMessage<mode_body_end> =
-    "expected a flow (x' = expression;), an invariant (inv ...;) or '}' closing the mode";
+    "expected a flow (x' = expression; or x' in [lo, hi];), an invariant (inv ...;) or '}' closing "
+    "the mode";
 template <>
 inline constexpr auto kMessage<transition_body_end> =
     "expected 'guard', 'reset', 'label', 'urgent', 'lazy' or '}' closing the transition";
@@ -689,6 +695,35 @@ class Builder {
     return {Expr(*n.children.at(0), scope), Expr(*n.children.at(1), scope)};
   }
 
+  // The right-hand side of flow `item` (whose variable is declared in `a`): its expression, or
+  // for `x' in [lo, hi]` the RectangularFlow over x's rate input (declared with x).
+  Expression FlowOf(const Node& item, const Automaton& a, const Scope& scope) {
+    const Node& rhs = *item.children.at(1);
+    if (!rhs.is_type<grammar::range>()) return Expr(rhs, scope);
+    const Range rate = RangeOf(rhs, scope);
+    const double lo = At(*rhs.children.at(0), [&] { return a.EvaluateConstant(rate.lo, "rate"); });
+    const double hi = At(*rhs.children.at(1), [&] { return a.EvaluateConstant(rate.hi, "rate"); });
+    if (lo > hi) {
+      Fail(rhs, "empty rate range: " + FormatNumber(lo) + " > " + FormatNumber(hi));
+    }
+    const std::string w = RateInputName(Text(*item.children.at(0)));
+    return RectangularFlow(rate, Expression::Symbol(w, *a.symbols().Find(w)));
+  }
+
+  // Names of the variables some mode of automaton declaration `n` gives a rectangular rate.
+  static std::set<std::string> RatedVariables(const Node& n) {
+    std::set<std::string> rated;
+    for (const auto& item : n.children) {
+      if (!item->is_type<grammar::mode_decl>()) continue;
+      for (const auto& flow : item->children) {
+        if (flow->is_type<grammar::flow>() && flow->children.at(1)->is_type<grammar::range>()) {
+          rated.insert(Text(*flow->children.at(0)));
+        }
+      }
+    }
+    return rated;
+  }
+
   int Slot(const Node& n, const Automaton& a, SymbolKind kind, std::string_view what) const {
     const std::string id = Text(n);
     const auto slot = a.symbols().Find(id);
@@ -805,6 +840,7 @@ class Builder {
     const Scope scope = ConstantScope(a.symbols());
     bool has_scenario = false;
     std::vector<const Node*> inits;  // the mode name of each init declaration, in order
+    const std::set<std::string> rated = RatedVariables(n);
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
       if (item.is_type<var_decl>()) {
@@ -813,6 +849,7 @@ class Builder {
           std::optional<Range> domain;
           if (const Node* r = Child(*v, range{})) domain = RangeOf(*r, scope);
           At(id, [&] { return a.AddVariable(Text(id), Unit(*v), domain); });
+          if (rated.count(Text(id))) DeclareRateInput(a, Text(id));
         }
       } else if (item.is_type<discrete_decl>()) {
         for (const auto& id : item.children) {
@@ -886,7 +923,7 @@ class Builder {
         const Node& id = *item.children.at(0);
         const int slot = Slot(id, *a, SymbolKind::kVariable, "continuous variable");
         if (m.FlowOf(slot)) Fail(id, "second flow for '" + Text(id) + "' in mode '" + m.name + "'");
-        m.flows.emplace_back(slot, Expr(*item.children.at(1), scope));
+        m.flows.emplace_back(slot, FlowOf(item, *a, scope));
       } else if (item.is_type<invariant>()) {
         for (Comparison& c : Conjunction(*item.children.at(0), scope).comparisons) {
           m.invariant.comparisons.push_back(std::move(c));

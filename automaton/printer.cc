@@ -4,6 +4,8 @@
 #include <set>
 #include <sstream>
 
+#include "automaton/rectangular_rate.h"
+
 namespace hybrid {
 namespace {
 
@@ -34,6 +36,15 @@ void PrintScenario(const Scenario& scenario, const SymbolTable& symbols, const s
   out << indent << "}\n";
 }
 
+}  // namespace
+
+std::string FlowText(const Expression& flow) {
+  if (const std::optional<Range> rate = AsRectangularFlow(flow)) return " in " + RangeText(*rate);
+  return " = " + flow.ToString();
+}
+
+namespace {
+
 void PrintProperty(const Property& p, const std::string& indent, std::ostream& out) {
   out << indent << "property " << p.name << ": " << KindKeyword(p.kind) << " "
       << p.predicate.ToString();
@@ -62,6 +73,10 @@ std::string PrintAutomaton(const Automaton& a) {
         out << "  discrete " << sym.name << ";\n";
         break;
       case SymbolKind::kInput:
+        if (IsRateInputName(sym.name)) {  // declared by its variable's rectangular flows
+          ++input;
+          break;
+        }
         out << "  input " << sym.name << UnitSuffix(sym) << " in "
             << RangeText(a.inputs()[input++].bounds) << ";\n";
         break;
@@ -88,7 +103,7 @@ std::string PrintAutomaton(const Automaton& a) {
     }
     out << " {\n";
     for (const auto& [slot, rhs] : m.flows) {
-      out << "    " << symbols[slot].name << "' = " << rhs.ToString() << ";\n";
+      out << "    " << symbols[slot].name << "'" << FlowText(rhs) << ";\n";
     }
     if (!m.invariant.empty()) out << "    inv " << m.invariant.ToString() << ";\n";
     out << "  }\n";

@@ -14,6 +14,10 @@ namespace hybrid {
 /// System::Product results or renamed components, whose names contain '.').
 std::string PrintAutomaton(const Automaton& automaton);
 
+/// The right-hand side of a flow as written after `x'`: " in [lo, hi]" for a rectangular rate
+/// (AsRectangularFlow), " = EXPRESSION" otherwise.
+std::string FlowText(const Expression& flow);
+
 /// Writes `system`: each distinct automaton it instantiates (as declared, before renaming), then
 /// the `system` block. For a system made by System::Of, writes the automaton alone. Parsing the
 /// result (ParseModel) gives an equal System.

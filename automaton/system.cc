@@ -380,6 +380,101 @@ std::vector<std::vector<Participant>> Combinations(
   return combos;
 }
 
+// The labels each component's transitions use (for synchronisation).
+std::vector<std::set<std::string>> Alphabets(std::span<const Component> components) {
+  std::vector<std::set<std::string>> alphabet;
+  for (const Component& c : components) {
+    std::set<std::string>& labels = alphabet.emplace_back();
+    for (const Transition& t : c.automaton.transitions()) {
+      if (!t.label.empty()) labels.insert(t.label);
+    }
+  }
+  return alphabet;
+}
+
+// The transitions that can take part in a step of transition `t` of component `i` from
+// `tuple`: `t` for `i`, and for every other component whose alphabet has t's label its
+// transitions from its mode with that label (empty for components not taking part). Nullopt
+// if one of those has none (the step is blocked) or if a lower component takes part (a
+// synchronised step is generated once, from its first participant).
+std::optional<std::vector<std::vector<const Transition*>>> Choices(
+    std::span<const Component> components, std::span<const std::set<std::string>> alphabet,
+    std::span<const int> tuple, int i, const Transition& t) {
+  const int n = static_cast<int>(components.size());
+  std::vector<std::vector<const Transition*>> choices(n);
+  bool blocked = false;
+  bool leader = true;
+  for (int j = 0; j < n && !blocked; ++j) {
+    if (j == i || t.label.empty() || !alphabet[j].count(t.label)) continue;
+    if (j < i) leader = false;
+    for (const Transition& u : components[j].automaton.transitions()) {
+      if (u.source.value() == tuple[j] && u.label == t.label) choices[j].push_back(&u);
+    }
+    blocked = choices[j].empty();
+  }
+  if (blocked || !leader) return std::nullopt;
+  choices[i] = {&t};
+  return choices;
+}
+
+// The step that takes the participants of `combo` together from `tuple`, labelled `label`:
+// guards conjoined, resets joined (throws if two reset one variable), urgent if one of them
+// is, named by the participants' qualified names joined with "__" ('.' becoming '_').
+System::Step JointStep(std::span<const Component> components, const SymbolTable& symbols,
+                       std::span<const int> tuple, const std::string& label,
+                       const std::vector<Participant>& combo) {
+  System::Step step;
+  step.target.assign(tuple.begin(), tuple.end());
+  Transition& joint = step.transition;
+  joint.label = label;
+  joint.urgency = Urgency::kLazy;
+  for (const auto& [j, u] : combo) {
+    const Component& c = components[j];
+    step.target[j] = u->target.value();
+    step.participants.emplace_back(
+        j, TransitionId(static_cast<int>(u - c.automaton.transitions().data())));
+    joint.name += (joint.name.empty() ? "" : "__") +
+                  (c.instance.empty() ? u->name : c.instance + "." + u->name);
+    for (const Comparison& x : u->guard.comparisons) {
+      joint.guard.comparisons.push_back(Remap(x, c.global_slot, symbols));
+    }
+    for (const Reset& r : u->resets) {
+      const int g = c.global_slot[r.slot];
+      if (std::any_of(joint.resets.begin(), joint.resets.end(),
+                      [g](const Reset& x) { return x.slot == g; })) {
+        Fail("synchronised transitions reset '" + symbols[g].name + "' twice");
+      }
+      joint.resets.push_back({g, Global(c, r.value, symbols)});
+    }
+    if (u->urgency == Urgency::kUrgent) joint.urgency = Urgency::kUrgent;
+  }
+  std::sort(joint.resets.begin(), joint.resets.end(),
+            [](const Reset& a, const Reset& b) { return a.slot < b.slot; });
+  for (char& ch : joint.name) {
+    if (ch == '.') ch = '_';
+  }
+  return step;
+}
+
+// Every step of the composed system from `tuple` (System::StepsFrom).
+std::vector<System::Step> StepsFrom(std::span<const Component> components,
+                                    const SymbolTable& symbols,
+                                    std::span<const std::set<std::string>> alphabet,
+                                    std::span<const int> tuple) {
+  std::vector<System::Step> steps;
+  for (int i = 0; i < static_cast<int>(components.size()); ++i) {
+    for (const Transition& t : components[i].automaton.transitions()) {
+      if (t.source.value() != tuple[i]) continue;
+      const auto choices = Choices(components, alphabet, tuple, i, t);
+      if (!choices) continue;
+      for (const auto& combo : Combinations(*choices)) {
+        steps.push_back(JointStep(components, symbols, tuple, t.label, combo));
+      }
+    }
+  }
+  return steps;
+}
+
 // Builds the reachable part of the product of `components` into `out` (whose symbols are the
 // System's, declared in slot order): product modes are created when first reached and explored
 // breadth first; transitions are numbered in the order they are added.
@@ -387,15 +482,11 @@ class ProductBuilder {
  public:
   ProductBuilder(const SymbolTable& symbols, std::span<const Component> components, int max_modes,
                  Automaton& out)
-      : symbols_(symbols), components_(components), max_modes_(max_modes), out_(out) {
-    // Labels used by each component (for synchronisation).
-    for (const Component& c : components_) {
-      std::set<std::string>& labels = alphabet_.emplace_back();
-      for (const Transition& t : c.automaton.transitions()) {
-        if (!t.label.empty()) labels.insert(t.label);
-      }
-    }
-  }
+      : symbols_(symbols),
+        components_(components),
+        max_modes_(max_modes),
+        out_(out),
+        alphabet_(Alphabets(components)) {}
 
   // Adds the initial states (InitialTuples, values sorted by slot) and their product modes.
   void AddInitialStates() {
@@ -407,27 +498,23 @@ class ProductBuilder {
   }
 
   // Adds the transitions of every product mode reached, and the modes they reach, until no new
-  // mode is reached.
+  // mode is reached; transition names are StepsFrom's prefixed by "t<number>_".
   void Explore() {
     while (!queue_.empty()) {
       const Tuple tuple = queue_.front();
       queue_.pop_front();
       const ModeId source = index_.at(tuple);
-      for (int i = 0; i < n(); ++i) {
-        for (const Transition& t : components_[i].automaton.transitions()) {
-          if (t.source.value() != tuple[i]) continue;
-          const std::optional<std::vector<std::vector<const Transition*>>> choices =
-              Choices(tuple, i, t);
-          if (!choices) continue;
-          for (const auto& combo : Combinations(*choices)) AddJoint(tuple, source, t.label, combo);
-        }
+      for (System::Step& step : StepsFrom(components_, symbols_, alphabet_, tuple)) {
+        Transition joint = std::move(step.transition);
+        joint.name = "t" + std::to_string(transition_count_++) + "_" + joint.name;
+        joint.source = source;
+        joint.target = ModeOf(step.target);
+        out_.AddTransition(std::move(joint));
       }
     }
   }
 
  private:
-  int n() const { return static_cast<int>(components_.size()); }
-
   // The product mode of `tuple`, added (and queued for exploration) if new; throws past
   // `max_modes_` modes.
   ModeId ModeOf(const Tuple& tuple) {
@@ -439,69 +526,6 @@ class ProductBuilder {
     index_.emplace(tuple, id);
     queue_.push_back(tuple);
     return id;
-  }
-
-  // The transitions that can take part in a step of transition `t` of component `i` from
-  // `tuple`: `t` for `i`, and for every other component whose alphabet has t's label its
-  // transitions from its mode with that label (empty for components not taking part). Nullopt
-  // if one of those has none (the step is blocked) or if a lower component takes part (a
-  // synchronised step is generated once, from its first participant).
-  std::optional<std::vector<std::vector<const Transition*>>> Choices(const Tuple& tuple, int i,
-                                                                     const Transition& t) const {
-    std::vector<std::vector<const Transition*>> choices(n());
-    bool blocked = false;
-    bool leader = true;
-    for (int j = 0; j < n() && !blocked; ++j) {
-      if (j == i || t.label.empty() || !alphabet_[j].count(t.label)) continue;
-      if (j < i) leader = false;
-      for (const Transition& u : components_[j].automaton.transitions()) {
-        if (u.source.value() == tuple[j] && u.label == t.label) choices[j].push_back(&u);
-      }
-      blocked = choices[j].empty();
-    }
-    if (blocked || !leader) return std::nullopt;
-    choices[i] = {&t};
-    return choices;
-  }
-
-  // Adds the transition, labelled `label`, that takes the participants of `combo` together from
-  // product mode `source` (tuple `tuple`): guards conjoined, resets joined (throws if two reset
-  // one variable), urgent if one of them is, named "t<number>_" + the participants' qualified
-  // names joined with "__" ('.' becoming '_').
-  void AddJoint(const Tuple& tuple, ModeId source, const std::string& label,
-                const std::vector<Participant>& combo) {
-    Tuple target = tuple;
-    Transition joint;
-    joint.source = source;
-    joint.label = label;
-    joint.urgency = Urgency::kLazy;
-    std::string name;
-    for (const auto& [j, u] : combo) {
-      const Component& c = components_[j];
-      target[j] = u->target.value();
-      name +=
-          (name.empty() ? "" : "__") + (c.instance.empty() ? u->name : c.instance + "." + u->name);
-      for (const Comparison& x : u->guard.comparisons) {
-        joint.guard.comparisons.push_back(Remap(x, c.global_slot, symbols_));
-      }
-      for (const Reset& r : u->resets) {
-        const int g = c.global_slot[r.slot];
-        if (std::any_of(joint.resets.begin(), joint.resets.end(),
-                        [g](const Reset& x) { return x.slot == g; })) {
-          Fail("synchronised transitions reset '" + symbols_[g].name + "' twice");
-        }
-        joint.resets.push_back({g, Global(c, r.value, symbols_)});
-      }
-      if (u->urgency == Urgency::kUrgent) joint.urgency = Urgency::kUrgent;
-    }
-    std::sort(joint.resets.begin(), joint.resets.end(),
-              [](const Reset& a, const Reset& b) { return a.slot < b.slot; });
-    joint.name = "t" + std::to_string(transition_count_++) + "_" + name;
-    for (char& ch : joint.name) {
-      if (ch == '.') ch = '_';
-    }
-    joint.target = ModeOf(target);
-    out_.AddTransition(std::move(joint));
   }
 
   const SymbolTable& symbols_;
@@ -594,6 +618,16 @@ void System::AddComponent(std::string instance, const Automaton& automaton,
   }
   CheckSharedFlows(c, components_);
   components_.push_back(std::move(c));
+}
+
+std::vector<System::Step> System::StepsFrom(std::span<const int> tuple) const {
+  if (tuple.size() != components_.size()) Fail("a mode tuple needs one mode per component");
+  return hybrid::StepsFrom(components_, symbols_, Alphabets(components_), tuple);
+}
+
+Mode System::ProductModeOf(std::span<const int> tuple) const {
+  if (tuple.size() != components_.size()) Fail("a mode tuple needs one mode per component");
+  return ProductMode(Tuple(tuple.begin(), tuple.end()), components_, symbols_);
 }
 
 std::optional<std::pair<int, ModeId>> System::FindMode(std::string_view qualified) const {

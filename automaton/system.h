@@ -108,6 +108,25 @@ class System {
   /// gives the component modes (ModeId values, in component order) of each product mode.
   Automaton Product(int max_modes = 100000, std::vector<std::vector<int>>* tuples = nullptr) const;
 
+  /// One step of the composed system (see the class comment) from a tuple of component modes.
+  struct Step {
+    /// The joint transition over System slots: guards conjoined, resets joined, urgent if one
+    /// participant is, labelled; named by the participants' qualified names joined with "__"
+    /// ('.' becoming '_'); source and target are left 0 (the tuples say where).
+    Transition transition;
+    /// The component modes after the step (ModeId values, in component order).
+    std::vector<int> target;
+    /// The component transitions taken together, in component order.
+    std::vector<std::pair<int, TransitionId>> participants;
+  };
+  /// Every step from `tuple` (ModeId values, one per component), in the order Product adds
+  /// them, without building the product: what on-the-fly exploration needs. Throws
+  /// std::invalid_argument if `tuple` does not have one mode per component, or if synchronised
+  /// transitions reset one variable twice.
+  std::vector<Step> StepsFrom(std::span<const int> tuple) const;
+  /// The product mode of `tuple` as Product makes it (flows and invariants over System slots).
+  Mode ProductModeOf(std::span<const int> tuple) const;
+
   /// The system of components `which` (indices into components()) alone, with their names,
   /// shared names and binds, and no properties or scenario; its slots are numbered afresh in the
   /// order the components first use them (look a name up in symbols() to map them back). Throws

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "automaton/parser.h"
+#include "solvers/reachability/polyhedral_reachability.h"
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
 #include "solvers/verification/property_sampler.h"
@@ -119,8 +120,10 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
 // Throws std::invalid_argument for an option value out of its range (in the order of the
 // checks: method, depth, induction, runs, budget).
 void CheckOptions(const CheckArgs& args) {
-  if (args.method != "prove" && args.method != "sample") {
-    throw std::invalid_argument("--method must be 'prove' or 'sample', not '" + args.method + "'");
+  if (args.method != "auto" && args.method != "reach" && args.method != "prove" &&
+      args.method != "sample") {
+    throw std::invalid_argument("--method must be 'auto', 'reach', 'prove' or 'sample', not '" +
+                                args.method + "'");
   }
   if (args.depth < 0 || args.depth > 1000)
     throw std::invalid_argument("--depth must be in [0, 1000]");
@@ -162,13 +165,55 @@ struct Findings {
   double seconds = 0.0;
 };
 
+// The bounds of polyhedral reachability: its deterministic state bound, and --budget as the
+// seconds of its CPU-time safety net.
+PolyhedralReachability::Options ReachOptions(const CheckArgs& args) {
+  PolyhedralReachability::Options options;
+  options.cpu_seconds = args.budget;
+  return options;
+}
+
+// --method auto: polyhedral reachability when the model is a linear hybrid automaton, then SMT
+// k-induction (with `budget`) on what it leaves unknown; k-induction alone otherwise. Each
+// result names the method that gave it.
+std::vector<CheckResult> CheckAuto(const PolyhedralReachability::Options& reach,
+                                   const PropertyProver::Options& prove, const System& system,
+                                   const std::vector<Property>& chosen, SolverBudget& budget) {
+  std::string why;
+  if (!PolyhedralReachability::Handles(system, chosen, &why)) {
+    return PropertyProver(prove).Check(system, chosen, budget);
+  }
+  std::vector<CheckResult> results = PolyhedralReachability(reach).Check(system, chosen);
+  std::vector<Property> left;
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    if (results[i].verdict == Verdict::kUnknown) left.push_back(chosen[i]);
+  }
+  if (left.empty()) return results;
+  const std::vector<CheckResult> proved = PropertyProver(prove).Check(system, left, budget);
+  std::size_t next = 0;
+  for (CheckResult& r : results) {
+    if (r.verdict != Verdict::kUnknown) continue;
+    const CheckResult& p = proved[next++];
+    if (p.verdict != Verdict::kUnknown) {
+      r = p;
+    } else {
+      r.reason += "; prove: " + p.reason;
+      r.seconds += p.seconds;
+    }
+  }
+  return results;
+}
+
 // Checks `chosen` on `system` by --method (prove: with `budget`; sample: --runs runs from
 // --seed), one result per property in order.
 std::vector<CheckResult> CheckProperties(const CheckArgs& args,
                                          const PropertyProver::Options& prove, const System& system,
                                          const std::vector<Property>& chosen,
                                          SolverBudget& budget) {
+  if (args.method == "reach")
+    return PolyhedralReachability(ReachOptions(args)).Check(system, chosen);
   if (args.method == "prove") return PropertyProver(prove).Check(system, chosen, budget);
+  if (args.method == "auto") return CheckAuto(ReachOptions(args), prove, system, chosen, budget);
   std::vector<CheckResult> results;
   PropertySampler::Options options;
   options.runs = args.runs;

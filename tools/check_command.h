@@ -10,7 +10,7 @@ namespace hybrid::cli {
 struct CheckArgs {
   std::string model;
   std::vector<std::string> properties;  ///< names to check; empty: every declared property
-  std::string method = "prove";         ///< prove or sample
+  std::string method = "auto";          ///< auto, reach, prove or sample
   bool json = false;
   bool modes = false;      ///< also report which modes (discrete states) are reachable
   int depth = 10;          ///< prove: longest counterexample searched, in steps

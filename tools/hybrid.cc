@@ -172,7 +172,12 @@ void AddCheck(CLI::App& app, Commands& c) {
   check->add_option("--property", a.properties,
                     "Check only this property (repeatable; default: every declared property, "
                     "components' ones named INSTANCE.NAME)");
-  check->add_option("--method", a.method, "prove or sample")->capture_default_str();
+  check
+      ->add_option("--method", a.method,
+                   "auto (reach for linear hybrid automata, then prove on what is left; prove "
+                   "otherwise), reach (exact polyhedral reachability), prove (SMT k-induction) "
+                   "or sample")
+      ->capture_default_str();
   check->add_flag("--json", a.json, "Machine-readable output");
   check->add_flag("--modes", a.modes, "Also report which modes (discrete states) some run reaches");
   AddNumberOption(check, "--depth", &a.depth,

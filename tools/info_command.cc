@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "automaton/mode_graph.h"
+#include "automaton/printer.h"
+#include "automaton/rectangular_rate.h"
 
 namespace hybrid::cli {
 namespace {
@@ -82,7 +84,10 @@ json ModesJson(const Automaton& a) {
   json modes = json::array();
   for (const auto& m : a.modes()) {
     json flows = json::object();
-    for (const auto& [slot, rhs] : m.flows) flows[sym[slot].name] = rhs.ToString();
+    for (const auto& [slot, rhs] : m.flows) {
+      const std::optional<Range> rate = AsRectangularFlow(rhs);
+      flows[sym[slot].name] = rate ? FlowText(rhs).substr(1) : rhs.ToString();
+    }
     json values = json::object();
     for (const auto& [slot, v] : m.discrete_values) values[sym[slot].name] = v;
     modes.push_back({{"name", m.name},

@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev
   librapidcheck-dev      # property tests; sampling in `hybrid check`
   libz3-dev              # Z3: SMT proofs in `hybrid check --method prove`
+  libppl-dev             # PPL: exact polyhedra in `hybrid check --method reach`
   libceres-dev           # Ceres: robust refinement of fitted effects in `hybrid diagnose`
   libbenchmark-dev       # Google Benchmark
   tao-pegtl-dev          # the model-language grammar

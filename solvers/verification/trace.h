@@ -41,6 +41,10 @@ struct Trace {
   /// Horizon and input signals (System input slots). Checkers produce step signals: the input
   /// is piecewise constant.
   Scenario inputs;
+  /// The jumps of the run in order, when the checker knows them: (time, joint transition named
+  /// as System::StepsFrom names it). Replay takes lazy jumps at these times
+  /// (SimulationOptions::lazy_schedule); empty: lazy jumps as the simulator chooses.
+  std::vector<std::pair<double, std::string>> schedule;
   /// The simulator's run of this trace.
   SimulationResult run;
   /// Index into run.samples of the first state at which the property fails (`always`, `never`)

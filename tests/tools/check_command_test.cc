@@ -129,7 +129,8 @@ std::string SmallModel(const std::string& properties) {
 TEST(CheckCommand, ProvesEveryInvariantOfTheFingerAndReachesFullClosure) {
   const json report = RunHybridJson("check " + Quote(kFinger), 0);
   EXPECT_EQ(report.value("model", ""), kFinger);
-  EXPECT_EQ(report.value("method", ""), "prove");
+  EXPECT_EQ(report.value("method", ""), "auto");  // the finger is not linear: k-induction
+  for (const json& p : Field(report, "properties")) EXPECT_EQ(p.value("method", ""), "prove");
   EXPECT_TRUE(report.contains("seconds") && Field(report, "seconds").is_number());
   EXPECT_FALSE(report.contains("modes"));
   ASSERT_TRUE(report.contains("properties"));
@@ -171,7 +172,7 @@ TEST(CheckCommand, TextOutputNamesTheModelAndTheVerdicts) {
   const Result r =
       RunHybrid("check " + Quote(kFinger) + " --property theta1_range --property can_close_fully");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(r.out.starts_with(kFinger + ": 2 properties, method prove, ")) << r.out;
+  EXPECT_TRUE(r.out.starts_with(kFinger + ": 2 properties, method auto, ")) << r.out;
   EXPECT_NE(r.out.find("\n  proved  theta1_range (always, "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\n  reachable  can_close_fully (reach, "), std::string::npos) << r.out;
   // The witness: its input and its final state.
@@ -413,7 +414,7 @@ TEST(CheckCommand, BudgetFiveBoundsAThreeHundredModeChainToTenSeconds) {
   TempDir dir;
   const std::string model = dir.Write("chain300.ha", Chain(300)).string();
   const auto start = std::chrono::steady_clock::now();
-  const json report = RunHybridJson("check " + Quote(model) + " --budget 5", 7);
+  const json report = RunHybridJson("check " + Quote(model) + " --method prove --budget 5", 7);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 10.0);
@@ -422,10 +423,22 @@ TEST(CheckCommand, BudgetFiveBoundsAThreeHundredModeChainToTenSeconds) {
       << report.dump(2);
 }
 
+// The chain is a linear hybrid automaton: the default method settles both properties by
+// polyhedral reachability, the witness of `far` (2n - 1 steps) replayed by the simulator.
+TEST(CheckCommand, AutoSettlesTheChainByPolyhedralReachability) {
+  TempDir dir;
+  const std::string model = dir.Write("chain300.ha", Chain(300)).string();
+  const json report = RunHybridJson("check " + Quote(model), 0);
+  EXPECT_EQ(Property(report, "bounded").value("verdict", ""), "proved") << report.dump(2);
+  EXPECT_EQ(Property(report, "bounded").value("method", ""), "reach");
+  EXPECT_EQ(Property(report, "far").value("verdict", ""), "reachable") << report.dump(2);
+  EXPECT_EQ(Property(report, "far").value("method", ""), "reach");
+}
+
 TEST(CheckCommand, TenThousandModesEndWithVerdictsUnderTwoGigabytes) {
   TempDir dir;
   const std::string model = dir.Write("chain10000.ha", Chain(10000)).string();
-  const Result r = RunHybrid("check " + Quote(model) + " --budget 5 --json");
+  const Result r = RunHybrid("check " + Quote(model) + " --method prove --budget 5 --json");
   EXPECT_EQ(r.exit_code, 7) << r.err;
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
   const json report = json::parse(r.out, nullptr, false);
@@ -447,8 +460,8 @@ TEST(CheckCommand, SameCommandSameVerdicts) {
   const std::string model = dir.Write("chain60.ha", Chain(60)).string();
   for (const std::string budget : {"0.2", "1.5"}) {
     auto verdicts = [&] {
-      const json report =
-          RunHybridJson("check " + Quote(model) + " --modes --depth 4 --budget " + budget, 7);
+      const json report = RunHybridJson(
+          "check " + Quote(model) + " --method prove --modes --depth 4 --budget " + budget, 7);
       std::vector<std::string> out;
       for (const json& p : Field(report, "properties")) {
         out.push_back(p.value("verdict", "") + ": " + p.value("reason", ""));

@@ -1,0 +1,89 @@
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace hybrid {
+
+/// A linear constraint sum_i a[i] x_i + b REL 0 over dimensions x_0 .. x_{n-1}, REL one of <, <=
+/// or ==. Coefficients are doubles read as the shortest decimal that gives them back (0.1 is
+/// 1/10, as the model wrote it), then handled exactly as rationals.
+struct LinearConstraint {
+  enum class Kind { kLess, kLessEqual, kEqual };
+  std::vector<double> a;
+  double b = 0.0;
+  Kind kind = Kind::kLessEqual;
+};
+
+/// An affine map of the dimensions: sum_i a[i] x_i + b.
+struct AffineMap {
+  std::vector<double> a;
+  double b = 0.0;
+};
+
+/// A convex polyhedron of R^n with exact rational arithmetic, closed or not (strict
+/// inequalities are kept strict): the Parma Polyhedra Library's NNC_Polyhedron behind a value
+/// type (its handles never leave convex_polyhedron.cc). Operations are the exact set operations
+/// named; none approximates except Widen.
+class ConvexPolyhedron {
+ public:
+  /// R^dims (dims >= 0).
+  static ConvexPolyhedron Universe(int dims);
+  /// The empty set of R^dims.
+  static ConvexPolyhedron Empty(int dims);
+
+  ConvexPolyhedron(const ConvexPolyhedron& other);
+  ConvexPolyhedron& operator=(const ConvexPolyhedron& other);
+  ConvexPolyhedron(ConvexPolyhedron&&) noexcept;
+  ConvexPolyhedron& operator=(ConvexPolyhedron&&) noexcept;
+  ~ConvexPolyhedron();
+
+  int dims() const;
+  /// Intersects with {x : c(x)}; c.a has dims() entries (throws std::invalid_argument otherwise,
+  /// or for a non-finite coefficient).
+  void AddConstraint(const LinearConstraint& c);
+  void Intersect(const ConvexPolyhedron& other);
+  bool IsEmpty() const;
+  /// Whether other is a subset of this.
+  bool Contains(const ConvexPolyhedron& other) const;
+  /// Whether the two share a point.
+  bool Intersects(const ConvexPolyhedron& other) const;
+  /// {x + t r : x in this, r in rates, t >= 0}: the states reached by letting time elapse at any
+  /// constant rate of `rates` (a polyhedron of derivatives, same dims).
+  void TimeElapse(const ConvexPolyhedron& rates);
+  /// Assigns x_d := f_d(x) for every (d, f_d) of `maps` at once (each f_d reads the state before).
+  void Assign(std::span<const std::pair<int, AffineMap>> maps);
+  /// Forgets everything about dimension d (projects it out and back).
+  void Unconstrain(int d);
+  /// Adds `count` unconstrained dimensions after the existing ones.
+  void AddDimensions(int count);
+  /// Keeps the first `dims` dimensions (projection).
+  void KeepDimensions(int dims);
+  /// The convex hull of this and other.
+  void Hull(const ConvexPolyhedron& other);
+  /// The H79 widening of this (which must contain `previous`) with respect to `previous`.
+  void Widen(const ConvexPolyhedron& previous);
+  /// Its minimised constraints, for messages and tests.
+  std::vector<LinearConstraint> Constraints() const;
+  /// Number of minimised constraints (a size measure).
+  int NumConstraints() const;
+
+ private:
+  struct Impl;
+  explicit ConvexPolyhedron(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Linear programming with exact rationals (PPL's MIP_Problem): maximises sum_i objective[i] x_i
+/// over {x in R^dims : every constraint holds, strict ones read as non-strict}. Returns an
+/// optimal point (a feasible one if the objective is unbounded), rounded to doubles, or nullopt
+/// if there is none.
+std::optional<std::vector<double>> MaximizeLinear(int dims,
+                                                  std::span<const LinearConstraint> constraints,
+                                                  std::span<const double> objective);
+
+}  // namespace hybrid
