@@ -108,6 +108,8 @@ std::string CauseName(EventRecord::Cause cause) {
       return "invariant";
     case EventRecord::Cause::kEnabled:
       return "enabled";
+    case EventRecord::Cause::kScheduled:
+      return "scheduled";
   }
   return "?";
 }

@@ -721,6 +721,13 @@ void ValidateSimulationOptions(const SimulationOptions& o, double until) {
   if (o.max_events < 0) fail("the event limit must be >= 0");
   if (o.max_samples < 0) fail("the sample limit must be >= 0");
   if (o.max_steps < 1) fail("the step limit must be at least 1");
+  for (size_t i = 0; i < o.lazy_schedule.size(); ++i) {
+    const double t = o.lazy_schedule[i].time;
+    if (!(t >= 0.0) || !(t <= until) || (i > 0 && t < o.lazy_schedule[i - 1].time)) {
+      fail("scheduled jump " + std::to_string(i + 1) + " at t = " + FormatNumber(t) +
+           ": jump times must be non-decreasing and within [0, " + FormatNumber(until) + "]");
+    }
+  }
   // Samples at sample times: refused before the run rather than grown without bound.
   const double uniform = o.sample_step > 0.0 ? std::floor(until / o.sample_step) : 0.0;
   const double planned = uniform + static_cast<double>(o.sample_times.size());
@@ -800,14 +807,18 @@ void ValidateInputs(const System& system, const std::vector<InputSignal>& inputs
   }
 }
 
-// The breakpoints of the inputs: the times in (0, until) of their points, sorted and distinct.
-// Integration restarts there.
-std::vector<double> Breakpoints(const std::vector<InputSignal>& inputs, double until) {
+// The breakpoints of the inputs and the times of scheduled jumps: the times in (0, until) of
+// their points, sorted and distinct. Integration restarts there.
+std::vector<double> Breakpoints(const std::vector<InputSignal>& inputs, double until,
+                                const std::vector<ScheduledJump>& schedule) {
   std::vector<double> breakpoints;
   for (const InputSignal& s : inputs) {
     for (const auto& [t, v] : s.points) {
       if (t > 0.0 && t < until) breakpoints.push_back(t);
     }
+  }
+  for (const ScheduledJump& j : schedule) {
+    if (j.time > 0.0 && j.time < until) breakpoints.push_back(j.time);
   }
   std::sort(breakpoints.begin(), breakpoints.end());
   breakpoints.erase(std::unique(breakpoints.begin(), breakpoints.end()), breakpoints.end());
@@ -946,6 +957,9 @@ class EventLoop {
   // Records the samples due at t_, then applies an input breakpoint reached (InputJump, *restart
   // set). Returns false when the run must stop.
   bool ReachStopTimes(bool* restart);
+  // Takes the entries of options_.lazy_schedule due at t_ whose transitions are enabled
+  // (JumpAndIterate). Returns false when the run must stop.
+  bool FireScheduled();
   // Ends a pass: root functions at the new state, restart and anchor decisions, and the stall
   // guard (kSolverFailure after kMaxStalledPasses passes without progress: returns false).
   bool EndPass(const Pass& p, bool restart);
@@ -1040,6 +1054,7 @@ class EventLoop {
   Eigen::VectorXd anchor_x_, anchor_rate_;
   std::vector<double> anchor_g_;
   size_t next_break_ = 0;
+  size_t next_scheduled_ = 0;  // the first entry of options_.lazy_schedule not yet due
   double next_uniform_;
   size_t next_listed_ = 0;  // in options.sample_times
   double next_sample_ = 0.0;
@@ -1086,6 +1101,7 @@ SimulationResult EventLoop::Simulate() {
   result_.samples.reserve(options_.sample_times.size() + 16);
   Record(StateSample::Kind::kStart);
   bool running = JumpAndIterate(Candidates(), EventRecord::Cause::kEnabled);
+  if (running) running = FireScheduled();
   if (running && ZenoCheck()) running = false;
   // Listed times already reached (0, or before the first step): recorded now, after the start.
   RecordListed();
@@ -1405,11 +1421,33 @@ bool EventLoop::ReachStopTimes(bool* restart) {
     run_.SetStepInputs(t_);
     run_.Load(t_, x_.data());
     settled_time_ = std::numeric_limits<double>::quiet_NaN();  // the inputs changed
-    const bool running = InputJump();
+    bool running = InputJump();
+    if (running) running = FireScheduled();
     *restart = true;
     return running;
   }
   return true;
+}
+
+bool EventLoop::FireScheduled() {
+  const std::vector<ScheduledJump>& schedule = options_.lazy_schedule;
+  bool running = true;
+  while (running && next_scheduled_ < schedule.size() && schedule[next_scheduled_].time <= t_) {
+    const ScheduledJump& entry = schedule[next_scheduled_++];
+    Jump jump;
+    bool enabled = !entry.transitions.empty();
+    for (const auto& [c, ti] : entry.transitions) {
+      enabled = enabled && c >= 0 && c < static_cast<int>(components_.size()) && ti >= 0 &&
+                ti < static_cast<int>(components_[c].transitions.size()) &&
+                components_[c].transitions[ti].source == run_.modes()[c] &&
+                run_.GuardHolds(c, ti, true);
+      jump.emplace_back(c, ti);
+    }
+    if (!enabled) continue;
+    running = JumpAndIterate({jump}, EventRecord::Cause::kScheduled);
+    settled_time_ = std::numeric_limits<double>::quiet_NaN();
+  }
+  return running;
 }
 
 bool EventLoop::EndPass(const Pass& p, bool restart) {
@@ -1731,7 +1769,7 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   ValidateSampleTimes(options, until);
   const std::vector<InputSignal> inputs = MergedInputs(system, signals);
   ValidateInputs(system, inputs);
-  std::vector<double> breakpoints = Breakpoints(inputs, until);
+  std::vector<double> breakpoints = Breakpoints(inputs, until, options.lazy_schedule);
 
   // Initial state.
   const int n = static_cast<int>(c_->variable_slots.size());

@@ -13,6 +13,15 @@
 
 namespace hybrid {
 
+/// A jump taken at a given time: one transition per participating component, (component index
+/// in the System, transition index in its automaton), and a name for messages.
+struct ScheduledJump {
+  double time = 0.0;
+  std::string name;
+  std::vector<std::pair<int, int>> transitions;
+  friend bool operator==(const ScheduledJump&, const ScheduledJump&) = default;
+};
+
 /// Settings of one simulation run. Defaults suit models whose time scale is between 1e-3 and
 /// 1e4 (seconds, or any unit). Run throws std::invalid_argument for a setting out of its range.
 ///
@@ -83,6 +92,13 @@ struct SimulationOptions {
   /// holds as a constant: one that an initial value reads, or that scales a continuous variable
   /// in a guard or invariant (set those in the model).
   std::vector<std::pair<std::string, double>> parameters;
+  /// Lazy jumps to take at given times (a replayed trace's schedule), in time order: at each
+  /// entry's time (a hard stop of the integration, like an input breakpoint) its transitions are
+  /// taken together if every one leaves its component's current mode and its guard holds (in
+  /// its closure, within event_tolerance); otherwise the entry is skipped. Urgent transitions and
+  /// lazy ones at invariant boundaries fire as usual. Times must be finite, non-decreasing and
+  /// in [0, until].
+  std::vector<ScheduledJump> lazy_schedule;
 };
 
 /// Throws std::invalid_argument, with a message for the user, if the horizon `until` (the one the
@@ -136,6 +152,7 @@ struct EventRecord {
     kCrossing,   ///< a guard comparison crossed zero (an urgent transition)
     kInvariant,  ///< an invariant was about to be violated (a lazy transition)
     kEnabled,    ///< the guard already held on entering the mode or when an input jumped
+    kScheduled,  ///< a lazy jump at a time SimulationOptions::lazy_schedule gives
   };
   double time = 0.0;
   Cause cause = Cause::kCrossing;

@@ -33,6 +33,7 @@ void ConfirmTrace(const System& system, const Property& property, CheckResult& r
     fresh.initial_states = result.trace->initial_states;
     fresh.initial_values = result.trace->initial_values;
     fresh.inputs = result.trace->inputs;
+    fresh.schedule = result.trace->schedule;
     try {
       if (ReplayTrace(system, property, fresh)) {
         result.trace = std::move(fresh);

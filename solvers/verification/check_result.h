@@ -40,10 +40,11 @@ struct CheckResult {
 };
 
 /// The gate every verdict that rests on a trace passes before it is reported. For `violated`
-/// and `reachable`: replays a fresh copy of result.trace for `property` (ReplayTrace, default
-/// options); if there is no trace, or it does not reach a counterexample (witness) state, or the
-/// replay throws, the verdict becomes `unknown`, the trace is dropped and the reason says why;
-/// otherwise the trace is replaced by the fresh replay. Other verdicts are left as they are.
+/// and `reachable`: replays a fresh copy of result.trace (its start, inputs and jump schedule) for
+/// `property` (ReplayTrace, default options); if there is no trace, or it does not reach a
+/// counterexample (witness) state, or the replay throws, the verdict becomes `unknown`, the trace
+/// is dropped and the reason says why; otherwise the trace is replaced by the fresh replay. Other
+/// verdicts are left as they are.
 void ConfirmTrace(const System& system, const Property& property, CheckResult& result);
 
 }  // namespace hybrid

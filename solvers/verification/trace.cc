@@ -197,6 +197,7 @@ bool ReplayTrace(const System& system, const Property& property, Trace& trace,
   SimulationOptions sim;
   sim.until = trace.inputs.until;
   sim.sample_step = options.sample_fraction > 0 ? trace.inputs.until * options.sample_fraction : 0;
+  sim.lazy_schedule = trace.schedule;
   trace.run = simulator.Run(sim, trace.inputs.inputs);
   trace.state_index = -1;
   const double horizon = property.horizon.value_or(INFINITY);

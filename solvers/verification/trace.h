@@ -41,10 +41,10 @@ struct Trace {
   /// Horizon and input signals (System input slots). Checkers produce step signals: the input
   /// is piecewise constant.
   Scenario inputs;
-  /// The jumps of the run in order, when the checker knows them: (time, joint transition named
-  /// as System::StepsFrom names it). Replay takes lazy jumps at these times
-  /// (SimulationOptions::lazy_schedule); empty: lazy jumps as the simulator chooses.
-  std::vector<std::pair<double, std::string>> schedule;
+  /// The lazy jumps of the run in time order, when the checker chose them (polyhedral
+  /// reachability does): replay takes them at these times (SimulationOptions::lazy_schedule);
+  /// empty: lazy jumps as the simulator chooses (at invariant boundaries).
+  std::vector<ScheduledJump> schedule;
   /// The simulator's run of this trace.
   SimulationResult run;
   /// Index into run.samples of the first state at which the property fails (`always`, `never`)

@@ -2216,3 +2216,61 @@ TEST(SimulatorParameters, RefusedParametersNameTheParameter) {
 
 }  // namespace
 }  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+// A lazy transition the simulator would take only at the invariant boundary (x = 10); a
+// schedule takes it earlier. Analytic: x = t until the jump, then x keeps its value (rate 0).
+constexpr std::string_view kLazyClock = R"(
+automaton clock {
+  var x;
+  mode run { x' = 1; inv x <= 10; }
+  mode stop { }
+  transition halt: run -> stop { guard x >= 2; lazy; }
+  init run { x = 0; }
+}
+)";
+
+TEST(SimulatorScheduleTest, TakesALazyJumpAtTheScheduledTime) {
+  const System system = ParseModel(kLazyClock, "clock.ha");
+  const Simulator sim(system);
+  SimulationOptions options;
+  options.until = 12;
+  const SimulationResult unscheduled = sim.Run(options);
+  ASSERT_EQ(unscheduled.events.size(), 1u);
+  EXPECT_NEAR(unscheduled.events[0].time, 10.0, 1e-9);  // at the invariant boundary
+  options.lazy_schedule = {{3.25, "halt", {{0, 0}}}};
+  const SimulationResult scheduled = sim.Run(options);
+  ASSERT_EQ(scheduled.status, SimulationStatus::kCompleted);
+  ASSERT_EQ(scheduled.events.size(), 1u);
+  EXPECT_EQ(scheduled.events[0].time, 3.25);
+  EXPECT_EQ(scheduled.events[0].cause, EventRecord::Cause::kScheduled);
+  EXPECT_NEAR(scheduled.samples.back().x[0], 3.25, 1e-12);
+}
+
+TEST(SimulatorScheduleTest, SkipsAJumpWhoseGuardDoesNotHold) {
+  const System system = ParseModel(kLazyClock, "clock.ha");
+  const Simulator sim(system);
+  SimulationOptions options;
+  options.until = 12;
+  options.lazy_schedule = {{1.0, "halt", {{0, 0}}}};  // x = 1 < 2: not enabled
+  const SimulationResult r = sim.Run(options);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_NEAR(r.events[0].time, 10.0, 1e-9);
+  EXPECT_EQ(r.events[0].cause, EventRecord::Cause::kInvariant);
+}
+
+TEST(SimulatorScheduleTest, RefusesTimesOutOfOrderOrBeyondTheHorizon) {
+  const System system = ParseModel(kLazyClock, "clock.ha");
+  const Simulator sim(system);
+  SimulationOptions options;
+  options.until = 12;
+  options.lazy_schedule = {{3.0, "halt", {{0, 0}}}, {2.0, "halt", {{0, 0}}}};
+  EXPECT_THROW(sim.Run(options), std::invalid_argument);
+  options.lazy_schedule = {{13.0, "halt", {{0, 0}}}};
+  EXPECT_THROW(sim.Run(options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hybrid
