@@ -2,6 +2,7 @@
 
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <ppl.hh>
@@ -26,6 +27,9 @@ namespace ppl = Parma_Polyhedra_Library;
 // The rational written by the shortest decimal that reads back as `value` (finite).
 mpq_class ToRational(double value) {
   if (!std::isfinite(value)) throw std::invalid_argument("a coefficient is not finite");
+  if (value == std::trunc(value) && std::fabs(value) < 1e15) {
+    return mpq_class(static_cast<long>(value));  // an integer (the common case), exactly
+  }
   char buffer[64];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
   if (ec != std::errc()) throw std::invalid_argument("a coefficient cannot be written");
@@ -50,8 +54,8 @@ mpq_class ToRational(double value) {
 }
 
 // sum a[i] x_i + b with integer coefficients: the rational one times the positive lcm of its
-// denominators (so the sign, hence the relation, is kept).
-ppl::Linear_Expression IntegerForm(std::span<const double> a, double b) {
+// denominators (so the sign, hence the relation, is kept), and that lcm.
+std::pair<ppl::Linear_Expression, mpz_class> ScaledForm(std::span<const double> a, double b) {
   std::vector<mpq_class> q;
   q.reserve(a.size() + 1);
   mpz_class lcm = 1;
@@ -66,8 +70,55 @@ ppl::Linear_Expression IntegerForm(std::span<const double> a, double b) {
   }
   const mpz_class c = q.back().get_num() * (lcm / q.back().get_den());
   e += ppl::Coefficient(c.get_mpz_t());
-  return e;
+  return {std::move(e), std::move(lcm)};
 }
+
+ppl::Linear_Expression IntegerForm(std::span<const double> a, double b) {
+  return ScaledForm(a, b).first;
+}
+
+mpz_class ToInteger(const ppl::Coefficient& c) {
+  mpz_class z;
+  ppl::assign_r(z, c, ppl::ROUND_NOT_NEEDED);
+  return z;
+}
+
+// The coordinates of point (or closure point) g.
+std::vector<mpq_class> Coordinates(const ppl::Generator& g) {
+  const mpz_class divisor = ToInteger(g.divisor());
+  std::vector<mpq_class> x(g.space_dimension());
+  for (ppl::dimension_type i = 0; i < g.space_dimension(); ++i) {
+    x[i] = mpq_class(ToInteger(g.coefficient(ppl::Variable(i))), divisor);
+    x[i].canonicalize();
+  }
+  return x;
+}
+
+// The point generator of x.
+ppl::Generator PointOf(const std::vector<mpq_class>& x) {
+  mpz_class lcm = 1;
+  for (const mpq_class& v : x) mpz_lcm(lcm.get_mpz_t(), lcm.get_mpz_t(), v.get_den_mpz_t());
+  ppl::Linear_Expression e;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const mpz_class c = x[i].get_num() * (lcm / x[i].get_den());
+    if (c != 0) {
+      e += ppl::Coefficient(c.get_mpz_t()) * ppl::Variable(static_cast<ppl::dimension_type>(i));
+    }
+  }
+  e.set_space_dimension(x.size());  // trailing zero coordinates count too
+  return ppl::point(e, ppl::Coefficient(lcm.get_mpz_t()));
+}
+
+// A permutation of the dimensions for NNC_Polyhedron::map_space_dimensions.
+struct Permutation {
+  std::vector<ppl::dimension_type> to;
+  bool has_empty_codomain() const { return to.empty(); }
+  ppl::dimension_type max_in_codomain() const { return to.size() - 1; }
+  bool maps(ppl::dimension_type i, ppl::dimension_type& j) const {
+    j = to[i];
+    return true;
+  }
+};
 
 ppl::Constraint ToPpl(const LinearConstraint& c, bool closed) {
   const ppl::Linear_Expression e = IntegerForm(c.a, c.b);
@@ -84,10 +135,7 @@ ppl::Constraint ToPpl(const LinearConstraint& c, bool closed) {
 }
 
 double ToDouble(const ppl::Coefficient& numerator, const ppl::Coefficient& denominator) {
-  mpz_class n, d;
-  ppl::assign_r(n, numerator, ppl::ROUND_NOT_NEEDED);
-  ppl::assign_r(d, denominator, ppl::ROUND_NOT_NEEDED);
-  return mpq_class(n, d).get_d();
+  return mpq_class(ToInteger(numerator), ToInteger(denominator)).get_d();
 }
 
 }  // namespace
@@ -108,6 +156,14 @@ ConvexPolyhedron ConvexPolyhedron::Empty(int dims) {
   if (dims < 0) throw std::invalid_argument("negative dimension");
   return ConvexPolyhedron(std::make_unique<Impl>(
       Impl{ppl::NNC_Polyhedron(static_cast<ppl::dimension_type>(dims), ppl::EMPTY)}));
+}
+
+ConvexPolyhedron ConvexPolyhedron::Point(std::span<const double> x) {
+  std::vector<mpq_class> q;
+  q.reserve(x.size());
+  for (const double v : x) q.push_back(ToRational(v));
+  return ConvexPolyhedron(
+      std::make_unique<Impl>(Impl{ppl::NNC_Polyhedron(ppl::Generator_System(PointOf(q)))}));
 }
 
 ConvexPolyhedron::ConvexPolyhedron(const ConvexPolyhedron& other)
@@ -148,18 +204,21 @@ void ConvexPolyhedron::TimeElapse(const ConvexPolyhedron& rates) {
   impl_->p.time_elapse_assign(rates.impl_->p);
 }
 
+void ConvexPolyhedron::TimeElapseBackward(const ConvexPolyhedron& rates) {
+  ppl::NNC_Polyhedron negated = rates.impl_->p;
+  for (ppl::dimension_type i = 0; i < negated.space_dimension(); ++i) {
+    negated.affine_image(ppl::Variable(i), -ppl::Variable(i));
+  }
+  impl_->p.time_elapse_assign(negated);
+}
+
 void ConvexPolyhedron::Assign(std::span<const std::pair<int, AffineMap>> maps) {
   if (maps.empty()) return;
   if (maps.size() == 1) {
+    // x_d := (integer form) / lcm: PPL takes the denominator separately.
     const auto& [d, f] = maps.front();
-    // x_d := (integer form) / lcm: PPL takes the denominator separately; IntegerForm scales by
-    // a positive lcm, recovered from the rational coefficients.
-    std::vector<mpq_class> q;
-    mpz_class lcm = 1;
-    for (const double v : f.a) q.push_back(ToRational(v));
-    q.push_back(ToRational(f.b));
-    for (const mpq_class& x : q) mpz_lcm(lcm.get_mpz_t(), lcm.get_mpz_t(), x.get_den_mpz_t());
-    impl_->p.affine_image(ppl::Variable(static_cast<ppl::dimension_type>(d)), IntegerForm(f.a, f.b),
+    const auto [e, lcm] = ScaledForm(f.a, f.b);
+    impl_->p.affine_image(ppl::Variable(static_cast<ppl::dimension_type>(d)), e,
                           ppl::Coefficient(lcm.get_mpz_t()));
     return;
   }
@@ -177,6 +236,39 @@ void ConvexPolyhedron::Assign(std::span<const std::pair<int, AffineMap>> maps) {
     const ppl::Variable x(static_cast<ppl::dimension_type>(maps[j].first));
     impl_->p.unconstrain(x);
     impl_->p.add_constraint(x == ppl::Variable(static_cast<ppl::dimension_type>(n + j)));
+  }
+  impl_->p.remove_higher_space_dimensions(static_cast<ppl::dimension_type>(n));
+}
+
+void ConvexPolyhedron::AssignPreimage(std::span<const std::pair<int, AffineMap>> maps) {
+  if (maps.empty()) return;
+  if (maps.size() == 1) {
+    const auto& [d, f] = maps.front();
+    const auto [e, lcm] = ScaledForm(f.a, f.b);
+    impl_->p.affine_preimage(ppl::Variable(static_cast<ppl::dimension_type>(d)), e,
+                             ppl::Coefficient(lcm.get_mpz_t()));
+    return;
+  }
+  // Simultaneous: fresh dimensions z_j take the place of x_{d_j} in this set (swapped in, the
+  // x_{d_j} becoming free), then z_j = f_j(x) is imposed and the z_j projected away.
+  const int n = dims();
+  const int k = static_cast<int>(maps.size());
+  Permutation swap;
+  for (int i = 0; i < n + k; ++i) swap.to.push_back(static_cast<ppl::dimension_type>(i));
+  for (int j = 0; j < k; ++j) {
+    const int d = maps[j].first;
+    if (d < 0 || d >= n || swap.to[static_cast<size_t>(d)] != static_cast<size_t>(d)) {
+      throw std::invalid_argument("a simultaneous assignment writes a dimension twice");
+    }
+    std::swap(swap.to[static_cast<size_t>(d)], swap.to[static_cast<size_t>(n + j)]);
+  }
+  impl_->p.add_space_dimensions_and_embed(static_cast<ppl::dimension_type>(k));
+  impl_->p.map_space_dimensions(swap);
+  for (int j = 0; j < k; ++j) {
+    std::vector<double> a = maps[j].second.a;
+    a.resize(static_cast<size_t>(n + k), 0.0);
+    a[static_cast<size_t>(n + j)] = -1.0;
+    impl_->p.add_constraint(ToPpl({a, maps[j].second.b, LinearConstraint::Kind::kEqual}, false));
   }
   impl_->p.remove_higher_space_dimensions(static_cast<ppl::dimension_type>(n));
 }
@@ -199,6 +291,108 @@ void ConvexPolyhedron::Hull(const ConvexPolyhedron& other) {
 
 void ConvexPolyhedron::Widen(const ConvexPolyhedron& previous) {
   impl_->p.H79_widening_assign(previous.impl_->p);
+}
+
+std::optional<double> ConvexPolyhedron::Supremum(std::span<const double> objective,
+                                                 bool* attained) const {
+  if (static_cast<int>(objective.size()) != dims()) {
+    throw std::invalid_argument("an objective of the wrong dimension");
+  }
+  const auto [e, lcm] = ScaledForm(objective, 0.0);
+  ppl::Coefficient n, d;
+  bool maximum = false;
+  if (!impl_->p.maximize(e, n, d, maximum)) return std::nullopt;
+  if (attained) *attained = maximum;
+  return mpq_class(ToInteger(n), ToInteger(d) * lcm).get_d();
+}
+
+bool ConvexPolyhedron::RestrictToMaximum(std::span<const double> objective) {
+  if (static_cast<int>(objective.size()) != dims()) {
+    throw std::invalid_argument("an objective of the wrong dimension");
+  }
+  const ppl::Linear_Expression e = IntegerForm(objective, 0.0);
+  ppl::Coefficient n, d;
+  bool maximum = false;
+  if (!impl_->p.maximize(e, n, d, maximum) || !maximum) return false;
+  impl_->p.add_constraint(d * e == n);
+  return true;
+}
+
+ConvexPolyhedron ConvexPolyhedron::CentralPoint() const {
+  if (IsEmpty()) throw std::logic_error("a point of an empty polyhedron");
+  std::vector<mpq_class> centre(static_cast<size_t>(dims()));
+  std::vector<mpq_class> rays(centre.size());
+  long count = 0;
+  for (const ppl::Generator& g : impl_->p.minimized_generators()) {
+    if (g.is_point() || g.is_closure_point()) {
+      const std::vector<mpq_class> x = Coordinates(g);
+      for (size_t i = 0; i < x.size(); ++i) centre[i] += x[i];
+      ++count;
+    } else if (g.is_ray()) {
+      mpz_class largest = 0;
+      for (size_t i = 0; i < rays.size(); ++i) {
+        const mpz_class c = abs(ToInteger(g.coefficient(ppl::Variable(i))));
+        if (c > largest) largest = c;
+      }
+      for (size_t i = 0; i < rays.size(); ++i) {
+        rays[i] += mpq_class(ToInteger(g.coefficient(ppl::Variable(i))), largest);
+      }
+    }
+  }
+  std::vector<double> rounded;
+  for (size_t i = 0; i < centre.size(); ++i) {
+    centre[i] = centre[i] / count + rays[i];
+    centre[i].canonicalize();
+    rounded.push_back(centre[i].get_d());
+  }
+  if (std::all_of(rounded.begin(), rounded.end(), [](double v) { return std::isfinite(v); })) {
+    ConvexPolyhedron simple = Point(rounded);
+    if (Contains(simple)) return simple;
+  }
+  return ConvexPolyhedron(
+      std::make_unique<Impl>(Impl{ppl::NNC_Polyhedron(ppl::Generator_System(PointOf(centre)))}));
+}
+
+std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
+  const size_t n = static_cast<size_t>(dims());
+  std::vector<std::pair<double, double>> out(n, {INFINITY, -INFINITY});
+  if (IsEmpty()) return out;
+  std::vector<std::optional<mpq_class>> lo(n), hi(n);
+  std::vector<bool> below(n, false), above(n, false);  // unbounded that way
+  for (const ppl::Generator& g : impl_->p.minimized_generators()) {
+    if (g.is_point() || g.is_closure_point()) {
+      const std::vector<mpq_class> x = Coordinates(g);
+      for (size_t i = 0; i < n; ++i) {
+        if (!lo[i] || x[i] < *lo[i]) lo[i] = x[i];
+        if (!hi[i] || x[i] > *hi[i]) hi[i] = x[i];
+      }
+      continue;
+    }
+    for (size_t i = 0; i < n; ++i) {  // a ray or a line
+      const int sign = sgn(ToInteger(g.coefficient(ppl::Variable(i))));
+      below[i] = below[i] || sign < 0 || (sign != 0 && g.is_line());
+      above[i] = above[i] || sign > 0 || (sign != 0 && g.is_line());
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    out[i].first = below[i] ? -INFINITY : lo[i]->get_d();
+    out[i].second = above[i] ? INFINITY : hi[i]->get_d();
+  }
+  return out;
+}
+
+bool ConvexPolyhedron::IsPoint() const {
+  return !impl_->p.is_empty() && impl_->p.affine_dimension() == 0;
+}
+
+std::vector<double> ConvexPolyhedron::PointCoordinates() const {
+  for (const ppl::Generator& g : impl_->p.minimized_generators()) {
+    if (!g.is_point()) continue;
+    std::vector<double> x;
+    for (const mpq_class& v : Coordinates(g)) x.push_back(v.get_d());
+    return x;
+  }
+  throw std::logic_error("the coordinates of a point of an empty polyhedron");
 }
 
 std::vector<LinearConstraint> ConvexPolyhedron::Constraints() const {

@@ -35,6 +35,9 @@ class ConvexPolyhedron {
   static ConvexPolyhedron Universe(int dims);
   /// The empty set of R^dims.
   static ConvexPolyhedron Empty(int dims);
+  /// The one point {x} of R^x.size(), its coordinates read as LinearConstraint reads
+  /// coefficients (throws std::invalid_argument for a non-finite one).
+  static ConvexPolyhedron Point(std::span<const double> x);
 
   ConvexPolyhedron(const ConvexPolyhedron& other);
   ConvexPolyhedron& operator=(const ConvexPolyhedron& other);
@@ -55,8 +58,15 @@ class ConvexPolyhedron {
   /// {x + t r : x in this, r in rates, t >= 0}: the states reached by letting time elapse at any
   /// constant rate of `rates` (a polyhedron of derivatives, same dims).
   void TimeElapse(const ConvexPolyhedron& rates);
+  /// {x - t r : x in this, r in rates, t >= 0}: the states from which letting time elapse at a
+  /// constant rate of `rates` (same dims) reaches this set (TimeElapse with the rates negated).
+  void TimeElapseBackward(const ConvexPolyhedron& rates);
   /// Assigns x_d := f_d(x) for every (d, f_d) of `maps` at once (each f_d reads the state before).
   void Assign(std::span<const std::pair<int, AffineMap>> maps);
+  /// {x : Assign(maps) takes x into this}: the pre-image of this set under the simultaneous
+  /// assignment, exactly (the old value of an overwritten dimension matters only where some
+  /// f_d reads it). Throws std::invalid_argument if `maps` writes a dimension twice.
+  void AssignPreimage(std::span<const std::pair<int, AffineMap>> maps);
   /// Forgets everything about dimension d (projects it out and back).
   void Unconstrain(int d);
   /// Adds `count` unconstrained dimensions after the existing ones.
@@ -67,6 +77,30 @@ class ConvexPolyhedron {
   void Hull(const ConvexPolyhedron& other);
   /// The H79 widening of this (which must contain `previous`) with respect to `previous`.
   void Widen(const ConvexPolyhedron& previous);
+  /// The supremum of sum_i objective[i] x_i over this (objective has dims() entries), rounded to
+  /// a double, or nullopt if this is empty or the objective is unbounded above. With `attained`,
+  /// also whether some point of this reaches it (it may not, past a strict inequality).
+  std::optional<double> Supremum(std::span<const double> objective, bool* attained = nullptr) const;
+  /// Keeps only the points where the objective reaches its supremum over this, exactly, and
+  /// returns true; returns false, leaving this unchanged, if this is empty, the objective is
+  /// unbounded above, or no point reaches the supremum.
+  bool RestrictToMaximum(std::span<const double> objective);
+  /// One point of this (non-empty, else throws std::logic_error), exactly, as a one-point
+  /// polyhedron: the barycentre of the points and closure points of its minimised generators
+  /// plus the sum of its rays, each scaled to a largest coordinate of magnitude 1 (lines are
+  /// ignored), which lies in the relative interior of this; replaced by that point rounded to
+  /// doubles (read as Point reads them) when the rounded point lies in this too, so that
+  /// coordinates stay short along a chain of choices.
+  ConvexPolyhedron CentralPoint() const;
+  /// Whether this is exactly one point.
+  bool IsPoint() const;
+  /// The coordinates of one point of this (of its only point when IsPoint()), rounded to
+  /// doubles; throws std::logic_error if this is empty.
+  std::vector<double> PointCoordinates() const;
+  /// Per dimension, the infimum and supremum of x_i over this, each rounded to a double within
+  /// one unit in the last place (-inf or +inf where it is unbounded), as (inf, sup) pairs; for an
+  /// empty polyhedron, (+inf, -inf). A cheap necessary condition for Contains.
+  std::vector<std::pair<double, double>> Bounds() const;
   /// Its minimised constraints, for messages and tests.
   std::vector<LinearConstraint> Constraints() const;
   /// Number of minimised constraints (a size measure).

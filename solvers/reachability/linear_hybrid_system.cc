@@ -314,8 +314,19 @@ LinearLocation LinearHybridSystem::Build(const std::vector<int>& tuple) const {
     const std::string what = "transition " + step.transition.name;
     const auto guard = f.Conjunction(step.transition.guard.comparisons, mode.discrete_values, what);
     if (!guard) continue;  // never enabled
-    LinearEdge edge{step.target,      *guard, {}, step.transition.name, step.transition.urgency,
-                    step.participants};
+    // Guards in their closure: the simulator takes a jump where its guard holds in its closure
+    // (a strict guard crossed at its boundary), so runs may jump there.
+    std::vector<LinearConstraint> closed = *guard;
+    for (LinearConstraint& c : closed) {
+      if (c.kind == Kind::kLess) c.kind = Kind::kLessEqual;
+    }
+    LinearEdge edge{std::move(step.target),
+                    closed,
+                    Polyhedron(closed),
+                    {},
+                    std::move(step.transition.name),
+                    step.transition.urgency,
+                    std::move(step.participants)};
     for (const Reset& r : step.transition.resets) {
       const std::optional<AffineMap> value = f.Affine(r.value, mode.discrete_values);
       if (!value)
@@ -330,6 +341,8 @@ LinearLocation LinearHybridSystem::Build(const std::vector<int>& tuple) const {
     }
     loc.edges.push_back(std::move(edge));
   }
+  loc.invariant_set = Polyhedron(loc.invariant);
+  loc.elapse_set = Polyhedron(loc.elapse_invariant);
   return loc;
 }
 

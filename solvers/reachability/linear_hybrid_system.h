@@ -18,6 +18,8 @@ struct LinearEdge {
   std::vector<int> target;
   /// The joint guard (conjunction) over the dimensions.
   std::vector<LinearConstraint> guard;
+  /// The guard as a polyhedron (made once, intersected many times).
+  ConvexPolyhedron guard_set = ConvexPolyhedron::Universe(0);
   /// x_d := f_d(x), simultaneous.
   std::vector<std::pair<int, AffineMap>> resets;
   /// The joint transition's name (System::Step) and urgency.
@@ -36,6 +38,9 @@ struct LinearLocation {
   /// inequality g(x) REL 0, the closure of its complement (time cannot pass a point where an
   /// urgent guard holds, so it stops on the boundary). Sound: every real run satisfies it.
   std::vector<LinearConstraint> elapse_invariant;
+  /// `invariant` and `elapse_invariant` as polyhedra.
+  ConvexPolyhedron invariant_set = ConvexPolyhedron::Universe(0);
+  ConvexPolyhedron elapse_set = ConvexPolyhedron::Universe(0);
   /// The derivatives flows allow (over all dimensions; parameters and untouched variables 0).
   ConvexPolyhedron rates = ConvexPolyhedron::Universe(0);
   /// Whether `rates` is exact: false when a rate reading an uncertain parameter was replaced by

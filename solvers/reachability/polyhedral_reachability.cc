@@ -24,12 +24,40 @@ double ThreadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// The bounding box of a symbolic state, each bound (ConvexPolyhedron::Bounds, within one ulp of
+// the true one) widened by one ulp either way: the true infimum of dimension i lies in
+// [lo_down[i], lo_up[i]], the true supremum in [hi_down[i], hi_up[i]].
+struct Box {
+  std::vector<double> lo_down, lo_up, hi_down, hi_up;
+};
+
+Box BoxOf(const ConvexPolyhedron& set) {
+  Box box;
+  for (const auto& [lo, hi] : set.Bounds()) {
+    box.lo_down.push_back(std::nextafter(lo, -INFINITY));
+    box.lo_up.push_back(std::nextafter(lo, INFINITY));
+    box.hi_down.push_back(std::nextafter(hi, -INFINITY));
+    box.hi_up.push_back(std::nextafter(hi, INFINITY));
+  }
+  return box;
+}
+
+// Whether `outer` may contain `inner` as far as their boxes tell: false only when it certainly
+// does not (a bound of `inner` beyond the same bound of `outer`).
+bool MayContain(const Box& outer, const Box& inner) {
+  for (size_t i = 0; i < outer.lo_down.size(); ++i) {
+    if (outer.lo_down[i] > inner.lo_up[i] || outer.hi_up[i] < inner.hi_down[i]) return false;
+  }
+  return true;
+}
+
 // A symbolic state: a location, a convex set of states there, and how it was reached.
 struct Node {
   std::vector<int> tuple;
   ConvexPolyhedron set;
   int parent = -1;  // -1 for an initial state
   int edge = -1;    // index into the parent location's edges, or of the initial set
+  Box box = {};     // BoxOf(set), once pushed
 };
 
 // What is known about one property during the exploration.
@@ -41,63 +69,50 @@ struct Goal {
   std::string why_no_trace;
 };
 
-// The time-elapse successor of `set` in `loc`, kept inside its elapse invariant (and `extra`).
-ConvexPolyhedron Flow(const LinearHybridSystem& lhs, const LinearLocation& loc,
-                      ConvexPolyhedron set, const Conjunction& extra) {
-  for (const LinearConstraint& c : loc.elapse_invariant) set.AddConstraint(c);
-  for (const LinearConstraint& c : extra) set.AddConstraint(c);
+// The time-elapse successor of `set` in `loc`, kept inside its elapse invariant and `extra`.
+// `set` (entry states, inside the invariant) is reachable at once; time elapses only from its
+// states inside the elapse invariant (an urgent guard that holds on entry fires at once). The
+// result is the convex hull of both parts (exact when the entry states all lie inside the
+// elapse invariant, as usual; an over-approximation otherwise).
+ConvexPolyhedron Flow(const LinearLocation& loc, ConvexPolyhedron set,
+                      const ConvexPolyhedron& extra) {
+  set.Intersect(extra);
   if (set.IsEmpty()) return set;
-  set.TimeElapse(loc.rates);
-  for (const LinearConstraint& c : loc.elapse_invariant) set.AddConstraint(c);
-  for (const LinearConstraint& c : extra) set.AddConstraint(c);
-  (void)lhs;
-  return set;
+  ConvexPolyhedron flowing = set;
+  flowing.Intersect(loc.elapse_set);
+  if (flowing.IsEmpty()) return set;
+  flowing.TimeElapse(loc.rates);
+  flowing.Intersect(loc.elapse_set);
+  flowing.Intersect(extra);
+  if (!flowing.Contains(set)) flowing.Hull(set);
+  return flowing;
 }
 
-// Builds the linear program of one path (PathProgram::Solve): per flow k the state at its
-// start x_k and end y_k, its dwell time and its inputs times the dwell time.
-class PathProgram {
- public:
-  PathProgram(const LinearHybridSystem& lhs, int flows)
-      : d_(lhs.dims()), ni_(static_cast<int>(lhs.inputs().size())), flows_(flows) {}
+// `p` with `count` unconstrained dimensions added after its own.
+ConvexPolyhedron Lifted(ConvexPolyhedron p, int count) {
+  p.AddDimensions(count);
+  return p;
+}
 
-  int width() const { return flows_ * Stride() + 1; }
-  int x(int k) const { return k * Stride(); }
-  int y(int k) const { return k * Stride() + d_; }
-  int dwell(int k) const { return k * Stride() + 2 * d_; }
-  int v(int k) const { return k * Stride() + 2 * d_ + 1; }
-  int epsilon() const { return width() - 1; }
+// The unit vector e_i of R^n.
+std::vector<double> Unit(int n, int i) {
+  std::vector<double> e(static_cast<size_t>(n), 0.0);
+  e[static_cast<size_t>(i)] = 1.0;
+  return e;
+}
 
-  // c applied to the block of dimensions starting at `at`; with `margin`, c + epsilon REL 0.
-  void On(const LinearConstraint& c, int at, bool margin = false) {
-    LinearConstraint row{Zero(), c.b, c.kind};
-    for (int i = 0; i < d_; ++i) row.a[static_cast<size_t>(at + i)] = c.a[static_cast<size_t>(i)];
-    if (margin && c.kind != Kind::kEqual) {
-      row.a[static_cast<size_t>(epsilon())] = 1.0;
-      row.kind = Kind::kLessEqual;
-    }
-    rows_.push_back(std::move(row));
-  }
-  void Add(std::vector<std::pair<int, double>> terms, double b, Kind kind) {
-    LinearConstraint row{Zero(), b, kind};
-    for (const auto& [i, a] : terms) row.a[static_cast<size_t>(i)] += a;
-    rows_.push_back(std::move(row));
-  }
-  std::vector<double> Zero() const {
-    return std::vector<double>(static_cast<size_t>(width()), 0.0);
-  }
-  // Maximises the margin epsilon (at most 1).
-  std::optional<std::vector<double>> Solve() {
-    Add({{epsilon(), 1.0}}, -1.0, Kind::kLessEqual);
-    std::vector<double> objective = Zero();
-    objective[static_cast<size_t>(epsilon())] = 1.0;
-    return MaximizeLinear(width(), rows_, objective);
-  }
+// A concrete run along a path, as Explorer::Concretize picks it: the values of the dimensions at
+// the start, and per flow its dwell time and the value of each input.
+struct PathRun {
+  std::vector<double> start;
+  std::vector<double> dwell;
+  std::vector<std::vector<double>> inputs;
+};
 
- private:
-  int Stride() const { return 2 * d_ + 1 + ni_; }
-  int d_, ni_, flows_;
-  std::vector<LinearConstraint> rows_;
+// A part (conjunction) of a goal's bad states at one location, and its polyhedron.
+struct BadPart {
+  Conjunction constraints;
+  ConvexPolyhedron set;
 };
 
 class Explorer {
@@ -108,11 +123,11 @@ class Explorer {
         lhs_(system, horizon.has_value()),
         goals_(std::move(goals)),
         options_(options),
-        initial_(lhs_.InitialSets()) {
+        initial_(lhs_.InitialSets()),
+        horizon_set_(ConvexPolyhedron::Universe(lhs_.dims())) {
     if (horizon) {
-      std::vector<double> a(static_cast<size_t>(lhs_.dims()), 0.0);
-      a[static_cast<size_t>(lhs_.clock())] = 1.0;
-      horizon_.push_back({a, -*horizon, Kind::kLessEqual});
+      horizon_.push_back({Unit(lhs_.dims(), lhs_.clock()), -*horizon, Kind::kLessEqual});
+      horizon_set_ = lhs_.Polyhedron(horizon_);
     }
   }
 
@@ -123,8 +138,8 @@ class Explorer {
     for (int i = 0; i < static_cast<int>(initial_.size()); ++i) {
       const LinearLocation& loc = lhs_.At(initial_[i].tuple);
       ConvexPolyhedron set = initial_[i].set;
-      for (const LinearConstraint& c : loc.invariant) set.AddConstraint(c);
-      Push({initial_[i].tuple, Flow(lhs_, loc, std::move(set), horizon_), -1, i});
+      set.Intersect(loc.invariant_set);
+      Push({initial_[i].tuple, Flow(loc, std::move(set), horizon_set_), -1, i});
     }
     std::string stopped;
     while (!queue_.empty() && !AllDecided()) {
@@ -149,54 +164,63 @@ class Explorer {
     return std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
   }
 
+  // Pushes the successors of node n through each edge of its location (locations live in a
+  // std::map, so references to them stay valid while others are added; nodes_ does not).
   void Expand(int n) {
-    const std::vector<int> tuple = nodes_[n].tuple;
-    const std::vector<LinearEdge> edges = lhs_.At(tuple).edges;
-    for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
+    const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
+    for (int e = 0; e < static_cast<int>(loc.edges.size()); ++e) {
+      const LinearEdge& edge = loc.edges[static_cast<size_t>(e)];
       ConvexPolyhedron set = nodes_[n].set;
-      for (const LinearConstraint& c : edges[e].guard) set.AddConstraint(c);
+      set.Intersect(edge.guard_set);
       if (set.IsEmpty()) continue;
-      set.Assign(edges[e].resets);
-      const LinearLocation& target = lhs_.At(edges[e].target);
-      for (const LinearConstraint& c : target.invariant) set.AddConstraint(c);
+      set.Assign(edge.resets);
+      const LinearLocation& target = lhs_.At(edge.target);
+      set.Intersect(target.invariant_set);
       if (set.IsEmpty()) continue;
-      Push({edges[e].target, Flow(lhs_, target, std::move(set), horizon_), n, e});
+      Push({edge.target, Flow(target, std::move(set), horizon_set_), n, e});
     }
   }
 
-  // Adds `node` unless it is empty or contained in a state found before at its location; checks
-  // the goals on it.
+  // Adds `node` unless it is empty or contained in a state found before at its location (their
+  // bounding boxes rule most out cheaply); checks the goals on it.
   void Push(Node node) {
     if (node.set.IsEmpty()) return;
+    node.box = BoxOf(node.set);
     std::vector<int>& here = passed_[node.tuple];
     for (const int i : here) {
-      if (nodes_[i].set.Contains(node.set)) return;
+      if (MayContain(nodes_[i].box, node.box) && nodes_[i].set.Contains(node.set)) return;
     }
     const int index = static_cast<int>(nodes_.size());
     nodes_.push_back(std::move(node));
     here.push_back(index);
     queue_.push_back(index);
-    for (Goal& g : goals_) {
-      if (!g.decided) CheckGoal(g, index);
+    for (int g = 0; g < static_cast<int>(goals_.size()); ++g) {
+      if (!goals_[g].decided) CheckGoal(g, index);
     }
   }
 
-  // The bad (target) states of `g` at a location: where an `always` predicate fails, where a
-  // `never` or `reach` predicate holds.
-  std::vector<Conjunction> Bad(const Goal& g, const LinearLocation& loc) const {
-    const bool negated = g.property->kind == Property::Kind::kAlways;
-    std::vector<Conjunction> bad = lhs_.States(g.property->predicate, negated, loc);
-    for (Conjunction& c : bad) c.insert(c.end(), horizon_.begin(), horizon_.end());
-    return bad;
+  // The bad (target) states of goal g at `loc`: where an `always` predicate fails, where a
+  // `never` or `reach` predicate holds; within the horizon. Computed once per goal and location.
+  const std::vector<BadPart>& Bad(int g, const LinearLocation& loc) {
+    auto [it, added] = bad_.try_emplace({g, &loc});
+    if (!added) return it->second;
+    const Property& property = *goals_[g].property;
+    const bool negated = property.kind == Property::Kind::kAlways;
+    for (Conjunction& c : lhs_.States(property.predicate, negated, loc)) {
+      c.insert(c.end(), horizon_.begin(), horizon_.end());
+      ConvexPolyhedron set = lhs_.Polyhedron(c);
+      if (!set.IsEmpty()) it->second.push_back({std::move(c), std::move(set)});
+    }
+    return it->second;
   }
 
-  void CheckGoal(Goal& g, int n) {
+  void CheckGoal(int index, int n) {
+    Goal& g = goals_[index];
     const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
-    for (const Conjunction& bad : Bad(g, loc)) {
-      ConvexPolyhedron meet = lhs_.Polyhedron(bad);
-      if (!meet.Intersects(nodes_[n].set)) continue;
+    for (const BadPart& bad : Bad(index, loc)) {
+      if (!bad.set.Intersects(nodes_[n].set)) continue;
       g.met = true;
-      std::optional<Trace> trace = Concretize(n, bad, &g.why_no_trace);
+      std::optional<Trace> trace = Concretize(n, bad.constraints, &g.why_no_trace);
       if (!trace) continue;
       CheckResult& r = *g.result;
       r.verdict =
@@ -221,9 +245,19 @@ class Explorer {
     return path;
   }
 
+  const LinearLocation& LocationOf(int node) { return lhs_.At(nodes_[node].tuple); }
+  // The edge by which node path[k + 1] was reached from path[k].
+  const LinearEdge& EdgeAfter(const std::vector<int>& path, int k) {
+    return LocationOf(path[k]).edges[static_cast<size_t>(nodes_[path[k + 1]].edge)];
+  }
+
   std::optional<Trace> Concretize(int n, const Conjunction& bad, std::string* why);
-  void JumpRows(PathProgram& lp, const LinearEdge& edge, int k) const;
-  Trace TraceOf(const std::vector<double>& z, const PathProgram& lp, const std::vector<int>& path,
+  ConvexPolyhedron Backward(const std::vector<int>& path, const Conjunction& bad,
+                            std::vector<ConvexPolyhedron>& ends);
+  ConvexPolyhedron LiftedRates(const LinearLocation& loc) const;
+  PathRun Forward(const std::vector<int>& path, const ConvexPolyhedron& start,
+                  const std::vector<ConvexPolyhedron>& ends);
+  Trace TraceOf(const PathRun& run, const std::vector<int>& path,
                 const LinearHybridSystem::Initial& init);
   void Finish(const std::string& stopped);
 
@@ -233,91 +267,160 @@ class Explorer {
   PolyhedralReachability::Options options_;
   std::vector<LinearHybridSystem::Initial> initial_;
   Conjunction horizon_;
+  ConvexPolyhedron horizon_set_;
   std::vector<Node> nodes_;
   std::map<std::vector<int>, std::vector<int>> passed_;
   std::deque<int> queue_;
+  std::map<std::pair<int, const LinearLocation*>, std::vector<BadPart>> bad_;
 };
 
-// The linear program of the path to node n ending in `bad`, solved for the largest margin into
-// `bad`; its solution as a Trace (parameters, initial state and values, step inputs).
+// A run along the path to node n that ends in `bad` with the largest margin (at most 1) into its
+// inequalities, as a Trace (parameters, initial state and values, step inputs, jump schedule);
+// nullopt with the reason in `why` if there is none with a positive margin (or rates along the
+// path are over-approximated). Exact: the states from which the rest of the path reaches `bad`
+// are propagated backward (Backward), the margin dimension maximised over the start, and the run
+// picked forward flow by flow inside those sets (Forward).
 std::optional<Trace> Explorer::Concretize(int n, const Conjunction& bad, std::string* why) {
   const std::vector<int> path = PathOf(n);
-  const int m = static_cast<int>(path.size());
-  const int d = lhs_.dims();
-  const int ni = static_cast<int>(lhs_.inputs().size());
-  PathProgram lp(lhs_, m);
-  const LinearHybridSystem::Initial& init = initial_[nodes_[path[0]].edge];
-  for (const LinearConstraint& c : init.set.Constraints()) lp.On(c, lp.x(0));
-  for (int k = 0; k < m; ++k) {
-    const LinearLocation& loc = lhs_.At(nodes_[path[k]].tuple);
+  for (const int k : path) {
+    const LinearLocation& loc = LocationOf(k);
     if (!loc.exact_rates) {
       *why = "rates of " + loc.name + " read uncertain parameters (over-approximated)";
       return std::nullopt;
     }
-    for (const LinearConstraint& c : loc.elapse_invariant) {
-      lp.On(c, lp.x(k));
-      lp.On(c, lp.y(k));
-    }
-    lp.Add({{lp.dwell(k), -1.0}}, 0.0, Kind::kLessEqual);
-    for (int i = 0; i < d; ++i) {  // y - x = rate * dwell
-      std::vector<std::pair<int, double>> terms = {{lp.y(k) + i, 1.0}, {lp.x(k) + i, -1.0}};
-      if (i < lhs_.num_variables()) {
-        const AffineMap& rate = loc.input_rates[static_cast<size_t>(i)];
-        terms.emplace_back(lp.dwell(k), -rate.b);
-        for (int j = 0; j < ni; ++j)
-          terms.emplace_back(lp.v(k) + j, -rate.a[static_cast<size_t>(j)]);
-      } else if (i == lhs_.clock()) {
-        terms.emplace_back(lp.dwell(k), -1.0);
-      }
-      lp.Add(terms, 0.0, Kind::kEqual);
-    }
-    for (int j = 0; j < ni; ++j) {  // lo * dwell <= v <= hi * dwell
-      const auto [lo, hi] = lhs_.input_bounds()[static_cast<size_t>(j)];
-      lp.Add({{lp.v(k) + j, 1.0}, {lp.dwell(k), -hi}}, 0.0, Kind::kLessEqual);
-      lp.Add({{lp.v(k) + j, -1.0}, {lp.dwell(k), lo}}, 0.0, Kind::kLessEqual);
-    }
-    if (k + 1 < m) JumpRows(lp, loc.edges[static_cast<size_t>(nodes_[path[k + 1]].edge)], k);
   }
-  for (const LinearConstraint& c : bad) lp.On(c, lp.y(m - 1), true);
-  const std::optional<std::vector<double>> z = lp.Solve();
-  if (!z || (*z)[static_cast<size_t>(lp.epsilon())] < 1e-9) {
+  std::vector<ConvexPolyhedron> ends;
+  ConvexPolyhedron start = Backward(path, bad, ends);
+  const std::vector<double> margin = Unit(lhs_.dims() + 1, lhs_.dims());
+  const std::optional<double> best = start.Supremum(margin);
+  if (!best || *best < 1e-9) {
     *why = "the states met lie on the boundary of the property (no run violates it with margin)";
     return std::nullopt;
   }
-  return TraceOf(*z, lp, path, init);
-}
-
-// Rows of the jump of `edge` after flow k: guard at y_k, x_{k+1} = reset(y_k).
-void Explorer::JumpRows(PathProgram& lp, const LinearEdge& edge, int k) const {
-  for (const LinearConstraint& c : edge.guard) lp.On(c, lp.y(k));
-  for (int i = 0; i < lhs_.dims(); ++i) {
-    std::vector<std::pair<int, double>> terms = {{lp.x(k + 1) + i, 1.0}};
-    double b = 0.0;
-    const auto reset = std::find_if(edge.resets.begin(), edge.resets.end(),
-                                    [i](const auto& r) { return r.first == i; });
-    if (reset == edge.resets.end()) {
-      terms.emplace_back(lp.y(k) + i, -1.0);
-    } else {
-      for (int j = 0; j < lhs_.dims(); ++j) {
-        terms.emplace_back(lp.y(k) + j, -reset->second.a[static_cast<size_t>(j)]);
-      }
-      b = -reset->second.b;
-    }
-    lp.Add(terms, b, Kind::kEqual);
+  // The margin is the largest, or half the supremum where a strict inequality keeps it from
+  // being reached (smaller margins are possible too: they only weaken `bad`).
+  if (!start.RestrictToMaximum(margin)) {
+    start.AddConstraint({margin, -*best / 2, Kind::kEqual});
   }
+  const PathRun run = Forward(path, start, ends);
+  return TraceOf(run, path, initial_[static_cast<size_t>(nodes_[path[0]].edge)]);
 }
 
-Trace Explorer::TraceOf(const std::vector<double>& z, const PathProgram& lp,
-                        const std::vector<int>& path, const LinearHybridSystem::Initial& init) {
+// Backward along `path` from `bad`, over the dimensions and a margin e (the last dimension,
+// 0 <= e <= 1, constant): ends[k] becomes the states at the end of flow k from which the rest of
+// the path reaches `bad` with every inequality of it held with margin e; returns those at the
+// start of the first flow within the initial set.
+ConvexPolyhedron Explorer::Backward(const std::vector<int>& path, const Conjunction& bad,
+                                    std::vector<ConvexPolyhedron>& ends) {
+  const int d = lhs_.dims();
+  const int m = static_cast<int>(path.size());
+  ConvexPolyhedron set = ConvexPolyhedron::Universe(d + 1);
+  for (const LinearConstraint& c : bad) {
+    LinearConstraint lifted = c;
+    lifted.a.push_back(c.kind == Kind::kEqual ? 0.0 : 1.0);  // c + e <= 0
+    if (c.kind != Kind::kEqual) lifted.kind = Kind::kLessEqual;
+    set.AddConstraint(lifted);
+  }
+  set.AddConstraint({Unit(d + 1, d), -1.0, Kind::kLessEqual});
+  std::vector<double> below = Unit(d + 1, d);
+  below[static_cast<size_t>(d)] = -1.0;
+  set.AddConstraint({below, 0.0, Kind::kLessEqual});
+  ends.assign(static_cast<size_t>(m), ConvexPolyhedron::Empty(d + 1));
+  for (int k = m - 1; k >= 0; --k) {
+    const LinearLocation& loc = LocationOf(path[k]);
+    const ConvexPolyhedron inside = Lifted(loc.elapse_set, 1);
+    set.Intersect(inside);
+    ends[static_cast<size_t>(k)] = set;
+    ConvexPolyhedron rates = Lifted(loc.rates, 1);
+    rates.AddConstraint({Unit(d + 1, d), 0.0, Kind::kEqual});
+    set.TimeElapseBackward(rates);
+    set.Intersect(inside);
+    if (k == 0) break;
+    const LinearEdge& edge = EdgeAfter(path, k - 1);
+    set.AssignPreimage(edge.resets);
+    set.Intersect(Lifted(edge.guard_set, 1));
+  }
+  set.Intersect(Lifted(initial_[static_cast<size_t>(nodes_[path[0]].edge)].set, 1));
+  return set;
+}
+
+// The rates of `loc` over (dimensions, margin e, dwell t, v): e' = 0, t' = 1, and per input k
+// v_k' = u_k within its bounds, each variable's rate c + B u (LinearLocation::input_rates), so
+// that after a flow t is its duration and v_k / t the constant value of input k.
+ConvexPolyhedron Explorer::LiftedRates(const LinearLocation& loc) const {
+  const int d = lhs_.dims();
+  const int ni = static_cast<int>(lhs_.inputs().size());
+  const int width = d + 2 + ni;
+  ConvexPolyhedron r = ConvexPolyhedron::Universe(width);
+  for (int i = 0; i < d; ++i) {
+    LinearConstraint row{Unit(width, i), 0.0, Kind::kEqual};
+    if (i < lhs_.num_variables()) {
+      const AffineMap& rate = loc.input_rates[static_cast<size_t>(i)];
+      row.b = -rate.b;
+      for (int k = 0; k < ni; ++k) row.a[static_cast<size_t>(d + 2 + k)] = -rate.a[k];
+    } else if (i == lhs_.clock()) {
+      row.b = -1.0;
+    }
+    r.AddConstraint(row);
+  }
+  r.AddConstraint({Unit(width, d), 0.0, Kind::kEqual});
+  r.AddConstraint({Unit(width, d + 1), -1.0, Kind::kEqual});
+  for (int k = 0; k < ni; ++k) {
+    const auto [lo, hi] = lhs_.input_bounds()[static_cast<size_t>(k)];
+    std::vector<double> below = Unit(width, d + 2 + k);
+    below[static_cast<size_t>(d + 2 + k)] = -1.0;
+    r.AddConstraint({Unit(width, d + 2 + k), -hi, Kind::kLessEqual});
+    r.AddConstraint({below, lo, Kind::kLessEqual});
+  }
+  return r;
+}
+
+// Picks the run forward from a point of `start` (Backward's, with the margin fixed): for each
+// flow the end point is a central point of the states that flow reaches from the current one
+// (one constant input value) within ends[k], then the jump's resets give the next start. Every
+// point is exact (a one-point polyhedron), so each choice is possible by construction.
+PathRun Explorer::Forward(const std::vector<int>& path, const ConvexPolyhedron& start,
+                          const std::vector<ConvexPolyhedron>& ends) {
+  const int d = lhs_.dims();
+  const int ni = static_cast<int>(lhs_.inputs().size());
+  const int m = static_cast<int>(path.size());
+  PathRun run;
+  ConvexPolyhedron point = start.CentralPoint();
+  run.start = point.PointCoordinates();
+  run.start.resize(static_cast<size_t>(d));
+  for (int k = 0; k < m; ++k) {
+    ConvexPolyhedron flow = Lifted(point, 1 + ni);
+    for (int i = d + 1; i < d + 2 + ni; ++i)
+      flow.AddConstraint({Unit(d + 2 + ni, i), 0.0, Kind::kEqual});
+    flow.TimeElapse(LiftedRates(LocationOf(path[k])));
+    flow.Intersect(Lifted(ends[static_cast<size_t>(k)], 1 + ni));
+    point = flow.CentralPoint();
+    const std::vector<double> x = point.PointCoordinates();
+    const double dwell = x[static_cast<size_t>(d + 1)];
+    run.dwell.push_back(dwell);
+    std::vector<double> inputs;
+    for (int j = 0; j < ni; ++j) {
+      const auto [lo, hi] = lhs_.input_bounds()[static_cast<size_t>(j)];
+      const double v = x[static_cast<size_t>(d + 2 + j)];
+      inputs.push_back(dwell > 0 ? std::clamp(v / dwell, lo, hi) : std::clamp(0.0, lo, hi));
+    }
+    run.inputs.push_back(std::move(inputs));
+    point.KeepDimensions(d + 1);
+    if (k + 1 < m) point.Assign(EdgeAfter(path, k).resets);
+  }
+  return run;
+}
+
+Trace Explorer::TraceOf(const PathRun& run, const std::vector<int>& path,
+                        const LinearHybridSystem::Initial& init) {
   Trace trace;
   const int m = static_cast<int>(path.size());
-  const SymbolTable& symbols = system_.symbols();
   for (int c = 0; c < static_cast<int>(init.init_index.size()); ++c) {
     trace.initial_states.emplace_back(c, init.init_index[static_cast<size_t>(c)]);
   }
   for (int i = 0; i < lhs_.dims(); ++i) {
     if (i == lhs_.clock()) continue;
-    const double value = z[static_cast<size_t>(lp.x(0) + i)];
+    const double value = run.start[static_cast<size_t>(i)];
     const std::string& name = lhs_.names()[static_cast<size_t>(i)];
     if (i < lhs_.num_variables()) {
       trace.initial_values.emplace_back(name, value);
@@ -332,11 +435,8 @@ Trace Explorer::TraceOf(const std::vector<double>& z, const PathProgram& lp,
     signals[j].shape = InputSignal::Shape::kStep;
   }
   for (int k = 0; k < m; ++k) {
-    const double dwell = z[static_cast<size_t>(lp.dwell(k))];
     for (size_t j = 0; j < signals.size(); ++j) {
-      const auto [lo, hi] = lhs_.input_bounds()[j];
-      const double u = dwell > 0 ? std::clamp(z[static_cast<size_t>(lp.v(k)) + j] / dwell, lo, hi)
-                                 : std::clamp(0.0, lo, hi);
+      const double u = run.inputs[static_cast<size_t>(k)][j];
       auto& points = signals[j].points;
       if (!points.empty() && points.back().first == t) {
         points.back().second = u;  // an instantaneous flow: the next one's value counts
@@ -344,16 +444,16 @@ Trace Explorer::TraceOf(const std::vector<double>& z, const PathProgram& lp,
         points.emplace_back(t, u);
       }
     }
-    t += dwell;
+    t += run.dwell[static_cast<size_t>(k)];
     if (k + 1 < m) {
-      const LinearLocation& loc = lhs_.At(nodes_[path[k]].tuple);
-      const LinearEdge& edge = loc.edges[static_cast<size_t>(nodes_[path[k + 1]].edge)];
-      trace.schedule.push_back({t, edge.name});
+      const LinearEdge& edge = EdgeAfter(path, k);
+      ScheduledJump jump{t, edge.name, {}};
+      for (const auto& [c, id] : edge.participants) jump.transitions.emplace_back(c, id.value());
+      trace.schedule.push_back(std::move(jump));
     }
   }
   trace.inputs.until = t > 0 ? t : 1e-9;
   trace.inputs.inputs = std::move(signals);
-  (void)symbols;
   return trace;
 }
 

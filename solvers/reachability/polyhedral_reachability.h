@@ -19,11 +19,15 @@ namespace hybrid {
 /// invariant). A new state contained in one already found at its location is dropped; when none
 /// is left the reachable set is complete (a fixpoint) and every property it does not meet is
 /// `proved` (`unreachable` for `reach`). A state that meets a property's bad (target) states is
-/// turned into a concrete run by linear programming along its path (dwell times, one input and
-/// rate value per flow, a robust end point), replayed by the simulator with its jump schedule
-/// (ConfirmTrace): `violated` (`reachable`) if it replays, `unknown` otherwise. The exploration is
-/// exact (no widening, no hull) and bounded by `max_states` symbolic states (deterministic), with
-/// a CPU-time safety net; hitting either leaves undecided properties `unknown`.
+/// turned into a concrete run along its path, exactly: the states from which the rest of the path
+/// reaches the bad states with a margin are propagated backward (inverse time elapse, guard,
+/// reset pre-image), the margin (at most 1) is maximised over the initial set, and the run is
+/// picked forward flow by flow inside those sets (a central point each: dwell time and one input
+/// value per flow), so its cost grows linearly with the path's length. The run is replayed by the
+/// simulator with its jump schedule (ConfirmTrace): `violated` (`reachable`) if it replays,
+/// `unknown` otherwise. The exploration is exact (no widening, no hull) and bounded by
+/// `max_states` symbolic states (deterministic), with a CPU-time safety net; hitting either leaves
+/// undecided properties `unknown`.
 class PolyhedralReachability {
  public:
   struct Options {

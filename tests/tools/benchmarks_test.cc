@@ -1,0 +1,101 @@
+// tools/benchmarks.py (docs/benchmarks_lha.md): its quick subset of spec/benchmarks/ is decided
+// and as expected, and its exit status follows the verdicts (skipped without python3).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include "tests/test_utilities/command_line.h"
+
+namespace hybrid::testing {
+namespace {
+
+const std::string kSource = HYBRID_SOURCE_DIR;
+
+struct ScriptRun {
+  int status = -1;  // as pclose returns it
+  std::string output;
+};
+
+/// Runs `python3 tools/benchmarks.py --hybrid HYBRID_BINARY ARGS` (standard error merged).
+ScriptRun RunScript(const std::string& args) {
+  const std::string command = "python3 " + Quote(kSource + "/tools/benchmarks.py") + " --hybrid " +
+                              Quote(HYBRID_BINARY) + " " + args + " 2>&1 </dev/null";
+  ScriptRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  run.status = pclose(pipe);
+  return run;
+}
+
+int ExitCode(const ScriptRun& run) { return WIFEXITED(run.status) ? WEXITSTATUS(run.status) : -1; }
+
+#define SKIP_WITHOUT_PYTHON(run) \
+  if (ExitCode(run) == 127) GTEST_SKIP() << "no python3: " << (run).output
+
+// Every model of the quick subset is decided today and every verdict is the expected one.
+TEST(BenchmarksTest, QuickSubsetIsDecidedAsExpected) {
+  const ScriptRun run = RunScript("--quick --require-all");
+  SKIP_WITHOUT_PYTHON(run);
+  EXPECT_EQ(ExitCode(run), 0) << run.output;
+  EXPECT_EQ(run.output.find("MISMATCH "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" 0 MISMATCH, 0 UNKNOWN"), std::string::npos) << run.output;
+}
+
+// A decided verdict other than the expected one is a failure, with or without --require-all.
+TEST(BenchmarksTest, ContradictionFails) {
+  TempDir dir;
+  const auto table = dir.Write("expected.tsv",
+                               "file\tproperty\texpected\n"
+                               "water_tank.ha\tlevel_in_range\tviolated\n");
+  const ScriptRun run = RunScript("--expected " + Quote(table.string()) + " water_tank");
+  SKIP_WITHOUT_PYTHON(run);
+  EXPECT_EQ(ExitCode(run), 1) << run.output;
+  EXPECT_NE(run.output.find("violated     proved       reach"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("MISMATCH"), std::string::npos) << run.output;
+}
+
+// A benchmark that does not exist and a missing binary are usage errors (exit status 2).
+TEST(BenchmarksTest, UsageErrors) {
+  const ScriptRun run = RunScript("no_such_benchmark");
+  SKIP_WITHOUT_PYTHON(run);
+  EXPECT_EQ(ExitCode(run), 2) << run.output;
+  const ScriptRun no_binary = RunScript("--hybrid /nonexistent/hybrid water_tank");
+  EXPECT_EQ(ExitCode(no_binary), 2) << no_binary.output;
+}
+
+// An unknown verdict (sampling never proves) is reported; it fails only with --require-all.
+TEST(BenchmarksTest, UnknownFailsOnlyWithRequireAll) {
+  TempDir dir;
+  const auto table = dir.Write("expected.tsv",
+                               "file\tproperty\texpected\n"
+                               "water_tank.ha\tlevel_in_range\tproved\n");
+  const std::string args = "--method sample --expected " + Quote(table.string()) + " water_tank";
+  const ScriptRun run = RunScript(args);
+  SKIP_WITHOUT_PYTHON(run);
+  EXPECT_EQ(ExitCode(run), 0) << run.output;
+  EXPECT_NE(run.output.find("UNKNOWN"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("sampling never proves"), std::string::npos) << run.output;
+  EXPECT_EQ(ExitCode(RunScript(args + " --require-all")), 1);
+}
+
+// --json is one JSON document; --peer-command times a peer for each model.
+TEST(BenchmarksTest, JsonAndPeerCommand) {
+  const ScriptRun run = RunScript("--json --peer-command 'test -f {model}' water_tank nav2");
+  SKIP_WITHOUT_PYTHON(run);
+  ASSERT_EQ(ExitCode(run), 0) << run.output;
+  const nlohmann::json report = nlohmann::json::parse(run.output);
+  EXPECT_EQ(Field(report, "counts", "OK"), 7);
+  EXPECT_EQ(Field(report, "models").size(), 2u);
+  EXPECT_EQ(Field(report, "models", 0, "peer_exit_code"), 0);  // the model's path was substituted
+  EXPECT_TRUE(Field(report, "models", 1, "ratio").is_number());
+}
+
+}  // namespace
+}  // namespace hybrid::testing

@@ -1,0 +1,296 @@
+#!/usr/bin/env python3
+"""Runs the linear-hybrid-automata benchmarks of spec/benchmarks/ through `hybrid check --json`
+and compares every verdict with spec/benchmarks/expected.tsv (docs/benchmarks_lha.md).
+
+usage: tools/benchmarks.py [options] [BENCHMARK ...]
+
+BENCHMARK is a file of spec/benchmarks/ (`nav2.ha`, or `nav2`) or a path to a model; default:
+every file listed in expected.tsv, in its order. The models run one after the other (timings
+are wall times on a machine that may be doing other things: compare them on an idle one).
+
+Output: one row per property: file, property, expected, got, method, seconds (the tool's own
+time for the property, as `hybrid check --json` reports it: the properties one reachability
+run decides share its time), status:
+  OK        the verdict is the expected one
+  MISMATCH  a decided verdict (proved, violated, reachable, unreachable) other than the
+            expected one
+  UNKNOWN   no decided verdict: `unknown` (the tool's reason is listed below the table), or the
+            run timed out (`timeout`), failed (`error`) or did not report the property (`missing`)
+  -         a decided verdict for a property expected.tsv does not list (expected `-`)
+Then the unknowns with their reasons and the total time.
+
+Exit status: 0; 1 if some status is MISMATCH (with --require-all: also if some is UNKNOWN);
+2 on a usage error (an unknown benchmark, no `hybrid` binary).
+
+--peer-command TEMPLATE runs a peer tool once per model for comparison, e.g.
+  --peer-command 'peer_checker --model {model}'   ({model}: the model's path, shell-quoted)
+through the shell, with the same --timeout, and prints its wall time and the ratio of our wall
+time (the whole `hybrid check` process) to the peer's. The peer's verdicts are not read.
+"""
+import argparse
+import json
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BENCHMARKS = os.path.join(REPO, "spec", "benchmarks")
+EXPECTED = os.path.join(BENCHMARKS, "expected.tsv")
+
+# The quick subset (--quick): models whose every verdict is decided and as expected today
+# (docs/benchmarks_lha.md), about 20 s together on this 2-core machine under load (fiscs04.ha
+# takes most of it). The ctest BenchmarksTest.QuickSubsetIsDecidedAsExpected runs
+# `--quick --require-all`, so only fully decided models belong here. Left out: the models with
+# an unknown verdict (nav4, fischer_5, fischer_6, fiscs05) and the decided but slow ones (tte_5,
+# tte_7, disc_3: 30 to 100 s each).
+QUICK = [
+    "water_tank.ha",
+    "nav2.ha",
+    "nav3.ha",
+    "fischer_2.ha",
+    "fischer_2_unsafe.ha",
+    "fischer_3.ha",
+    "fischer_3_unsafe.ha",
+    "fischer_4.ha",
+    "fischer_4_unsafe.ha",
+    "fiscs04.ha",
+    "fiscu04.ha",
+    "disc_2.ha",
+]
+
+DECIDED = {"proved", "violated", "reachable", "unreachable"}
+
+
+def read_expected(path):
+    """{file: [(property, verdict), ...]} in the file's order (dicts keep insertion order)."""
+    expected = {}
+    with open(path) as f:
+        for number, line in enumerate(f, 1):
+            line = line.rstrip("\n")
+            if not line.strip() or line.startswith("#"):
+                continue
+            fields = line.split("\t")
+            if fields[0] == "file":
+                continue  # the header
+            if len(fields) != 3:
+                sys.exit("%s:%d: expected 3 tab-separated columns" % (path, number))
+            expected.setdefault(fields[0], []).append((fields[1], fields[2]))
+    return expected
+
+
+def resolve(name, expected):
+    """(path, key in expected.tsv) of a benchmark named on the command line."""
+    for candidate in (name, name + ".ha"):
+        if candidate in expected or os.path.isfile(os.path.join(BENCHMARKS, candidate)):
+            return os.path.join(BENCHMARKS, candidate), candidate
+    if os.path.isfile(name):
+        return name, os.path.basename(name)
+    raise ValueError("no benchmark %r (neither in %s nor a file)" % (name, BENCHMARKS))
+
+
+def kill_group(process):
+    """Kills the process and everything it started (it leads its own session)."""
+    try:
+        os.killpg(process.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def terminated(signum, frame):
+    """SIGTERM (e.g. ctest's timeout) unwinds like Ctrl-C, so run() kills its process group."""
+    raise KeyboardInterrupt("signal %d" % signum)
+
+
+def run(command, timeout, shell=False):
+    """(exit code or None on timeout, stdout, stderr, wall seconds); the whole process group is
+    killed after `timeout` seconds."""
+    start = time.monotonic()
+    process = subprocess.Popen(command, shell=shell, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                               start_new_session=True)
+    try:
+        out, err = process.communicate(timeout=timeout)
+        code = process.returncode
+    except subprocess.TimeoutExpired:
+        kill_group(process)
+        out, err = process.communicate()
+        code = None
+    except BaseException:  # interrupted (Ctrl-C, SIGTERM): leave no process behind
+        kill_group(process)
+        process.wait()
+        raise
+    return code, out.decode(errors="replace"), err.decode(errors="replace"), \
+        time.monotonic() - start
+
+
+def check_model(hybrid, path, key, properties, args):
+    """The rows of one model (dicts) and our wall time."""
+    command = [hybrid, "check", path, "--json"]
+    if args.budget is not None:
+        command += ["--budget", str(args.budget)]
+    if args.method:
+        command += ["--method", args.method]
+    code, out, err, wall = run(command, args.timeout)
+    reported = {}
+    failure = None
+    if code is None:
+        failure = ("timeout", "killed after the --timeout of %g s" % args.timeout)
+    else:
+        try:
+            reported = {p["name"]: p for p in json.loads(out)["properties"]}
+        except (ValueError, KeyError, TypeError):
+            message = err.strip().splitlines()[-1] if err.strip() else "no JSON output"
+            failure = ("error", "exit code %d: %s" % (code, message[:300]))
+    rows = []
+    names = [name for name, _ in properties]
+    names += [name for name in reported if name not in dict(properties)]
+    if not names and failure is not None:
+        names = ["-"]  # a model without expected properties that failed: still one row
+    for name in names:
+        want = dict(properties).get(name, "-")
+        p = reported.get(name)
+        if p is not None:
+            got, method = p.get("verdict", "?"), p.get("method", "-")
+            seconds, reason = p.get("seconds"), p.get("reason", "")
+        elif failure is not None:
+            (got, reason), method, seconds = failure, "-", None
+        else:
+            got, method, seconds, reason = "missing", "-", None, "not in the tool's output"
+        if got not in DECIDED:
+            status = "UNKNOWN"
+        elif want == "-":
+            status = "-"
+        elif got == want:
+            status = "OK"
+        else:
+            status = "MISMATCH"
+        rows.append({"file": key, "property": name, "expected": want, "got": got,
+                     "method": method, "seconds": seconds, "status": status, "reason": reason})
+    return rows, wall
+
+
+def format_row(row, widths):
+    seconds = "-" if row["seconds"] is None else "%.3f" % row["seconds"]
+    cells = [row["file"], row["property"], row["expected"], row["got"], row["method"], seconds,
+             row["status"]]
+    return "  ".join(c.ljust(w) if i != 5 else c.rjust(w)
+                     for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+
+def main():
+    parser = argparse.ArgumentParser(
+        description="Runs `hybrid check --json` on the benchmarks of spec/benchmarks/ and "
+                    "compares the verdicts with spec/benchmarks/expected.tsv.",
+        epilog="Exit status: 0; 1 if a decided verdict contradicts the expected one (with "
+               "--require-all: also if a verdict is unknown, timed out or failed); 2 on a "
+               "usage error. Quick subset: " + " ".join(QUICK) + ".")
+    parser.add_argument("benchmarks", nargs="*", metavar="BENCHMARK",
+                        help="file of spec/benchmarks/ (nav2.ha or nav2) or path to a model "
+                             "(default: every file of expected.tsv)")
+    parser.add_argument("--quick", action="store_true",
+                        help="the quick subset (fully decided models, under 60 s in all)")
+    parser.add_argument("--hybrid", default=os.path.join(REPO, "build", "tools", "hybrid"),
+                        help="the hybrid binary (default: build/tools/hybrid of the repository)")
+    parser.add_argument("--budget", type=float,
+                        help="passed to `hybrid check --budget` (default: the tool's)")
+    parser.add_argument("--method", choices=["auto", "reach", "prove", "sample"],
+                        help="passed to `hybrid check --method` (default: the tool's, auto)")
+    parser.add_argument("--timeout", type=float, default=600,
+                        help="seconds per model before its process is killed (default 600)")
+    parser.add_argument("--json", action="store_true", help="machine-readable output")
+    parser.add_argument("--require-all", action="store_true",
+                        help="an undecided verdict (unknown, timeout, error) is a failure too")
+    parser.add_argument("--peer-command", metavar="TEMPLATE",
+                        help="shell command of a peer tool, {model} replaced by the model's "
+                             "path; its wall time and the ratio ours/peer are printed")
+    parser.add_argument("--expected", default=EXPECTED,
+                        help="the table of expected verdicts (default: spec/benchmarks/"
+                             "expected.tsv)")
+    args = parser.parse_args()
+    signal.signal(signal.SIGTERM, terminated)
+
+    expected = read_expected(args.expected)
+    names = list(args.benchmarks)
+    if args.quick:
+        names += [q for q in QUICK if q not in names]
+    if not names:
+        names = list(expected)
+    try:
+        models = [resolve(name, expected) for name in names]
+    except ValueError as error:
+        parser.error(str(error))
+    if not (os.path.isfile(args.hybrid) and os.access(args.hybrid, os.X_OK)):
+        parser.error("no executable %s (build it: cmake --build build --target hybrid)"
+                     % args.hybrid)
+
+    widths = [max([len("file")] + [len(k) for _, k in models]),
+              max([len("property")] + [len(p) for _, k in models
+                                       for p, _ in expected.get(k, [])]),
+              len("unreachable"), len("unreachable"), len("method"), 8, len("MISMATCH")]
+    header = ["file", "property", "expected", "got", "method", "seconds", "status"]
+    if not args.json:
+        print("  ".join(h.ljust(w) if i != 5 else h.rjust(w)
+                        for i, (h, w) in enumerate(zip(header, widths))).rstrip())
+        print("  ".join("-" * w for w in widths))
+        sys.stdout.flush()
+
+    start = time.monotonic()
+    rows, per_model = [], []
+    for path, key in models:
+        model_rows, ours = check_model(args.hybrid, path, key, expected.get(key, []), args)
+        rows += model_rows
+        entry = {"file": key, "seconds": ours}
+        if args.peer_command:
+            command = args.peer_command.replace("{model}", shlex.quote(path))
+            code, _, err, peer = run(command, args.timeout, shell=True)
+            entry.update({"peer_seconds": peer, "peer_exit_code": code,
+                          "ratio": ours / peer if peer > 0 else None})
+        per_model.append(entry)
+        if not args.json:
+            for row in model_rows:
+                widths[1] = max(widths[1], len(row["property"]))
+                print(format_row(row, widths))
+            if args.peer_command:
+                status = ("timeout" if entry["peer_exit_code"] is None
+                          else "exit %d" % entry["peer_exit_code"])
+                ratio = "-" if entry["ratio"] is None else "%.3g" % entry["ratio"]
+                print("  %s: ours %.3f s, peer %.3f s (%s), ours/peer %s"
+                      % (key, ours, entry["peer_seconds"], status, ratio))
+            sys.stdout.flush()
+    total = time.monotonic() - start
+
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("OK", "MISMATCH", "UNKNOWN")}
+    failed = counts["MISMATCH"] > 0 or (args.require_all and counts["UNKNOWN"] > 0)
+    if args.json:
+        json.dump({"hybrid": args.hybrid, "total_seconds": total, "counts": counts,
+                   "require_all": args.require_all, "ok": not failed, "models": per_model,
+                   "properties": rows}, sys.stdout, indent=2)
+        print()
+    else:
+        undecided = [r for r in rows if r["status"] in ("MISMATCH", "UNKNOWN")]
+        if undecided:
+            print("\nUnknown and contradicted verdicts, with the tool's reason:")
+            for r in undecided:
+                print("  %s %s: %s (expected %s): %s"
+                      % (r["file"], r["property"], r["got"], r["expected"], r["reason"]))
+        print("\nWall time per model (s): " + ", ".join(
+            "%s %.2f" % (m["file"], m["seconds"]) for m in per_model))
+        print("\n%d properties in %d models: %d OK, %d MISMATCH, %d UNKNOWN; total %.1f s"
+              % (len(rows), len(models), counts["OK"], counts["MISMATCH"], counts["UNKNOWN"],
+                 total))
+        if args.peer_command:
+            ours = sum(m["seconds"] for m in per_model)
+            peer = sum(m["peer_seconds"] for m in per_model)
+            print("wall time: ours %.1f s, peer %.1f s, ours/peer %s"
+                  % (ours, peer, "%.3g" % (ours / peer) if peer > 0 else "-"))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:
+        sys.exit(130)
