@@ -12,7 +12,12 @@ namespace {
 std::string UnitSuffix(const Symbol& s) { return s.unit.empty() ? "" : " [" + s.unit + "]"; }
 
 std::string RangeText(const Range& r) {
-  return "[" + r.lo.ToString() + ", " + r.hi.ToString() + "]";
+  std::string text = "[";  // appended piece by piece: GCC 12 warns (-Wrestrict) on the + chain
+  text += r.lo.ToString();
+  text += ", ";
+  text += r.hi.ToString();
+  text += "]";
+  return text;
 }
 
 void PrintScenario(const Scenario& scenario, const SymbolTable& symbols, const std::string& indent,
@@ -39,8 +44,14 @@ void PrintScenario(const Scenario& scenario, const SymbolTable& symbols, const s
 }  // namespace
 
 std::string FlowText(const Expression& flow) {
-  if (const std::optional<Range> rate = AsRectangularFlow(flow)) return " in " + RangeText(*rate);
-  return " = " + flow.ToString();
+  std::string text = " = ";
+  if (const std::optional<Range> rate = AsRectangularFlow(flow)) {
+    text = " in ";
+    text += RangeText(*rate);
+  } else {
+    text += flow.ToString();
+  }
+  return text;
 }
 
 namespace {
@@ -54,10 +65,12 @@ void PrintProperty(const Property& p, const std::string& indent, std::ostream& o
 
 }  // namespace
 
-std::string PrintAutomaton(const Automaton& a) {
-  std::ostringstream out;
+namespace {
+
+// The symbol declarations of `a` in slot order (rate inputs are declared by their variables'
+// rectangular flows, not here).
+void PrintDeclarations(const Automaton& a, std::ostream& out) {
   const SymbolTable& symbols = a.symbols();
-  out << "automaton " << a.name() << " {\n";
   size_t var = 0, input = 0, param = 0;
   for (int s = 0; s < symbols.size(); ++s) {
     const Symbol& sym = symbols[s];
@@ -91,6 +104,15 @@ std::string PrintAutomaton(const Automaton& a) {
       }
     }
   }
+}
+
+}  // namespace
+
+std::string PrintAutomaton(const Automaton& a) {
+  std::ostringstream out;
+  const SymbolTable& symbols = a.symbols();
+  out << "automaton " << a.name() << " {\n";
+  PrintDeclarations(a, out);
   for (const Mode& m : a.modes()) {
     out << "\n  mode " << m.name;
     if (!m.discrete_values.empty()) {
