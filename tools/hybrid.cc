@@ -165,9 +165,10 @@ void AddCheck(CLI::App& app, Commands& c) {
   hybrid::cli::CheckArgs& a = c.check_args;
   CLI::App* check = c.check = app.add_subcommand(
       "check",
-      "Prove a model's properties for every input (--method prove: SMT bounded model checking "
-      "and k-induction) or search for counterexamples (--method sample); every trace found is "
-      "replayed by the simulator");
+      "Prove a model's properties for every input (--method reach: exact polyhedral "
+      "reachability for linear hybrid automata; --method prove: SMT bounded model checking and "
+      "k-induction; --method auto, the default, picks by the model's class) or search for "
+      "counterexamples (--method sample); every trace found is replayed by the simulator");
   check->add_option("MODEL", a.model, "Model file (.ha)")->required();
   check->add_option("--property", a.properties,
                     "Check only this property (repeatable; default: every declared property, "
