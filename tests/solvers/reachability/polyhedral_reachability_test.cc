@@ -22,12 +22,15 @@
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/trace.h"
 #include "tests/test_utilities/properties.h"
+#include "tests/test_utilities/trace_states.h"
 
 namespace hybrid {
 namespace {
 
 using Kind = LinearConstraint::Kind;
+using testing::AtTarget;
 using testing::Named;
+using testing::Replayed;
 
 // The polyhedron of R^2 where every constraint a0 x + a1 y + b REL 0 holds.
 ConvexPolyhedron Plane(const std::vector<LinearConstraint>& constraints) {
@@ -210,28 +213,6 @@ std::vector<CheckResult> Check(const System& system, const std::vector<std::stri
   std::vector<Property> properties;
   for (const std::string& name : names) properties.push_back(Named(system, name));
   return PolyhedralReachability().Check(system, properties);
-}
-
-// Replays a copy of the result's trace: it must reach its target. Returns the replayed copy.
-Trace Replayed(const System& system, const Property& property, const CheckResult& result) {
-  EXPECT_TRUE(result.trace.has_value());
-  if (!result.trace) return {};
-  Trace copy = *result.trace;
-  copy.run = {};
-  copy.state_index = -1;
-  EXPECT_TRUE(ReplayTrace(system, property, copy));
-  EXPECT_GE(copy.state_index, 0);
-  return copy;
-}
-
-// The value of variable `name` at the replayed trace's target state.
-double AtTarget(const System& system, const Trace& trace, const std::string& name) {
-  const Simulator sim(system);
-  const auto& names = sim.variable_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  EXPECT_NE(it, names.end()) << name;
-  if (it == names.end() || trace.state_index < 0) return 0.0;
-  return trace.run.samples.at(trace.state_index).x[static_cast<int>(it - names.begin())];
 }
 
 // x' = u with u in [0, 1] from x = 0; an urgent transition stops x at 5.

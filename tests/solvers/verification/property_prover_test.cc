@@ -24,6 +24,7 @@
 #include "solvers/verification/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
+#include "tests/test_utilities/trace_states.h"
 
 namespace hybrid {
 namespace {
@@ -88,7 +89,9 @@ system pair {
 
 System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
 
+using testing::AtTarget;
 using testing::Named;
+using testing::Replayed;
 
 PropertyProver::Options Small() {
   PropertyProver::Options o;
@@ -105,29 +108,6 @@ CheckResult CheckOne(const System& system, const std::string& name,
   const std::vector<CheckResult> results = PropertyProver(options).Check(system, ps);
   EXPECT_EQ(results.size(), 1u);
   return results.at(0);
-}
-
-// The value of variable `name` at the trace's target state.
-double AtTarget(const System& system, const Trace& trace, const std::string& name) {
-  const Simulator sim(system);
-  const auto& names = sim.variable_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) throw std::invalid_argument("no variable " + name);
-  return trace.run.samples.at(trace.state_index).x[static_cast<int>(it - names.begin())];
-}
-
-// Replays a copy of the result's trace independently: it must hit, at a valid state. Returns the
-// replayed copy.
-Trace Replayed(const System& system, const Property& property, const CheckResult& result) {
-  EXPECT_TRUE(result.trace.has_value());
-  if (!result.trace) return {};
-  Trace copy = *result.trace;
-  copy.run = {};
-  copy.state_index = -1;
-  EXPECT_TRUE(ReplayTrace(system, property, copy));
-  EXPECT_GE(copy.state_index, 0);
-  EXPECT_LT(copy.state_index, static_cast<int>(copy.run.samples.size()));
-  return copy;
 }
 
 std::string ParameterNames(const Trace& t) {
