@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "automaton/parser.h"
+#include "automaton/spaceex/spaceex_import.h"
 #include "solvers/reachability/polyhedral_reachability.h"
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
@@ -319,7 +320,7 @@ std::string ReportText(const CheckArgs& args, const System& system, const Simula
 int RunCheck(const CheckArgs& args) {
   CheckOptions(args);
   const auto start = std::chrono::steady_clock::now();
-  const System system = ParseModelFile(args.model);
+  const System system = spaceex::ReadModelFile(args.model);
   Findings found;
   found.chosen = ChosenProperties(args, DeclaredProperties(system));
   // One solver budget for the whole command: the properties, then --modes, draw from it.

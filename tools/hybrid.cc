@@ -22,6 +22,7 @@
 
 #include "automaton/dot_writer.h"
 #include "automaton/parser.h"
+#include "automaton/spaceex/spaceex_import.h"
 #include "automaton/system.h"
 #include "gripper/measured_data.h"
 #include "tools/bundled_files.h"
@@ -95,19 +96,23 @@ int ExitFor(std::exception_ptr error, const std::string& prefix, int invalid_cod
   return kExitInternal;
 }
 
+constexpr const char* kModelHelp = "Model file (.ha, or a SpaceEx .xml read with its .cfg)";
+
 // The options of every command, filled by CLI11, and the subcommands that parse them.
 struct Commands {
   CLI::App* info = nullptr;
   CLI::App* dot = nullptr;
+  CLI::App* import = nullptr;
   CLI::App* simulate = nullptr;
   CLI::App* check = nullptr;
   CLI::App* finger = nullptr;
   CLI::App* hand = nullptr;
   CLI::App* diagnose = nullptr;
   CLI::App* synthesize = nullptr;
-  std::string model;  // info and dot
+  std::string model;  // info, dot and import
   bool as_json = false;
   std::string output;
+  std::string config;  // import
   bool product = false;
   hybrid::cli::SimulateArgs simulate_args;
   hybrid::cli::CheckArgs check_args;
@@ -122,17 +127,27 @@ void AddModelCommands(CLI::App& app, Commands& c) {
   c.info = app.add_subcommand("info",
                               "Summarise a model: variables, modes, transitions, "
                               "reachable modes, cycles, warnings");
-  c.info->add_option("MODEL", c.model, "Model file (.ha)")->required();
+  c.info->add_option("MODEL", c.model, kModelHelp)->required();
   c.info->add_flag("--json", c.as_json, "Machine-readable output");
 
   c.dot = app.add_subcommand("dot",
                              "Write the mode graph in Graphviz DOT (render with "
                              "`dot -Tsvg`)");
-  c.dot->add_option("MODEL", c.model, "Model file (.ha)")->required();
+  c.dot->add_option("MODEL", c.model, kModelHelp)->required();
   c.dot->add_option("-o,--output", c.output, "Output file (default: standard output)");
   c.dot->add_flag("--product", c.product,
                   "Draw a composed model as its product automaton instead of one cluster per "
                   "component");
+
+  c.import = app.add_subcommand(
+      "import",
+      "Translate a SpaceEx model (SX XML and its .cfg: initial states, forbidden set) into the "
+      "model language (docs/spaceex.md)");
+  c.import->add_option("MODEL", c.model, "SpaceEx model (.xml)")->required();
+  c.import->add_option("--config", c.config,
+                       "SpaceEx configuration (default: MODEL with the extension .cfg, if it "
+                       "exists)");
+  c.import->add_option("-o,--output", c.output, "Output file (default: standard output)");
 }
 
 // `hybrid simulate`.
@@ -140,7 +155,7 @@ void AddSimulate(CLI::App& app, Commands& c) {
   hybrid::cli::SimulateArgs& a = c.simulate_args;
   CLI::App* simulate = c.simulate = app.add_subcommand(
       "simulate", "Simulate a model with exact event location (CVODE); default: its scenario");
-  simulate->add_option("MODEL", a.model, "Model file (.ha)")->required();
+  simulate->add_option("MODEL", a.model, kModelHelp)->required();
   simulate->add_option("--input", a.inputs,
                        "NAME=SIGNAL, SIGNAL a number, step(t: v, ...) or linear(t: v, ...); "
                        "repeatable; overrides the scenario's signal for NAME");
@@ -169,7 +184,7 @@ void AddCheck(CLI::App& app, Commands& c) {
       "reachability for linear hybrid automata; --method prove: SMT bounded model checking and "
       "k-induction; --method auto, the default, picks by the model's class) or search for "
       "counterexamples (--method sample); every trace found is replayed by the simulator");
-  check->add_option("MODEL", a.model, "Model file (.ha)")->required();
+  check->add_option("MODEL", a.model, kModelHelp)->required();
   check->add_option("--property", a.properties,
                     "Check only this property (repeatable; default: every declared property, "
                     "components' ones named INSTANCE.NAME)");
@@ -312,13 +327,28 @@ void DefaultModels(Commands& c) {
   }
 }
 
+// `hybrid import`: the translation, checked by parsing it, then written; notes on stderr.
+int RunImport(const Commands& c) {
+  hybrid::cli::CheckDistinctFiles({{"MODEL", c.model}, {"--config", c.config}}, {{"-o", c.output}});
+  hybrid::cli::CheckOutputPlaces({{"-o", c.output}});
+  const hybrid::spaceex::Translation translation = hybrid::spaceex::ImportSpaceExFile(
+      c.model, c.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(c.config));
+  (void)translation.Parse(c.model);
+  for (const std::string& note : translation.notes) {
+    std::cerr << c.model << ": note: " << note << "\n";
+  }
+  WriteOutput(c.output, translation.text);
+  return 0;
+}
+
 // `hybrid info` and `hybrid dot` on the parsed model.
 int RunModelCommand(const Commands& c) {
+  if (c.import->parsed()) return RunImport(c);
   if (c.dot->parsed()) {
     hybrid::cli::CheckDistinctFiles({{"MODEL", c.model}}, {{"-o", c.output}});
     hybrid::cli::CheckOutputPlaces({{"-o", c.output}});
   }
-  const System system = hybrid::ParseModelFile(c.model);
+  const System system = hybrid::spaceex::ReadModelFile(c.model);
   if (c.info->parsed()) {
     const json report = hybrid::cli::InfoJson(system, c.model);
     for (const auto& w : report["warnings"]) {

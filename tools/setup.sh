@@ -12,6 +12,7 @@ packages=(
   librapidcheck-dev      # property tests; sampling in `hybrid check`
   libz3-dev              # Z3: SMT proofs in `hybrid check --method prove`
   libppl-dev             # PPL: exact polyhedra in `hybrid check --method reach`
+  libpugixml-dev         # pugixml: SpaceEx models (`hybrid import`, .xml models)
   libceres-dev           # Ceres: robust refinement of fitted effects in `hybrid diagnose`
   libbenchmark-dev       # Google Benchmark
   tao-pegtl-dev          # the model-language grammar

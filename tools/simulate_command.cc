@@ -10,6 +10,7 @@
 
 #include "automaton/number_syntax.h"
 #include "automaton/parser.h"
+#include "automaton/spaceex/spaceex_import.h"
 #include "solvers/simulation/simulator.h"
 #include "tools/options.h"
 #include "tools/output.h"
@@ -286,7 +287,7 @@ int RunSimulate(const SimulateArgs& args) {
     throw UsageError("--until: the horizon must be positive and finite");
   }
   CheckOutputPlaces({{"--out", args.out}, {"--events", args.events}});
-  System system = ParseModelFile(args.model);
+  System system = spaceex::ReadModelFile(args.model);
   SetParameters(args.parameters, system);
   const SymbolTable& symbols = system.symbols();
   std::vector<InputSignal> signals;

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "automaton/system.h"
+
+namespace hybrid::spaceex {
+
+/// Where a line of a translation comes from: a position in the SpaceEx model or configuration.
+struct Origin {
+  std::string file;
+  int line = 0;
+  int column = 0;
+};
+
+/// A SpaceEx model translated into the model language (docs/spaceex.md).
+struct Translation {
+  /// The model in the model language.
+  std::string text;
+  /// The origin of each line of `text` (index 0 is line 1).
+  std::vector<Origin> origins;
+  /// What the translation changed or left out, one sentence each, for the user.
+  std::vector<std::string> notes;
+
+  /// Parses `text` (ParseModel) as file `name`; a ParseError in it is reported at the origin of
+  /// its line, so that messages point into the SpaceEx files.
+  System Parse(const std::string& name) const;
+};
+
+/// Translates SpaceEx XML `xml` (named `xml_file` in messages) and, unless `cfg_file` is empty,
+/// the configuration text `cfg`: the component named by the option `system` (default: the last
+/// one) becomes an automaton (a base component) or a system of instances (a network: one
+/// automaton per base component, or per instance where instances differ in constants or initial
+/// states); `initially` gives initial states, `forbidden` the property `never` of that set.
+/// Throws ParseError naming the file, line and column of malformed XML or configuration, of a
+/// construct the translation does not support (nested networks, disjunctive initial sets, flows
+/// that leave a variable unconstrained, ...), or of a name that is not declared.
+Translation TranslateSpaceEx(std::string_view xml, const std::string& xml_file,
+                             std::string_view cfg, const std::string& cfg_file);
+
+/// Reads `xml` and its configuration (`cfg`, or else the file next to `xml` with the extension
+/// `.cfg` if there is one) and translates them. Throws ParseError (line 0) for a file that cannot
+/// be read, as TranslateSpaceEx otherwise.
+Translation ImportSpaceExFile(const std::filesystem::path& xml,
+                              const std::optional<std::filesystem::path>& cfg = std::nullopt);
+
+/// True if `path` names a SpaceEx model (its extension is `.xml`, in any case).
+bool IsSpaceExFile(const std::filesystem::path& path);
+
+/// Reads a model of either language: a SpaceEx model (IsSpaceExFile) through ImportSpaceExFile,
+/// anything else with ParseModelFile.
+System ReadModelFile(const std::filesystem::path& path);
+
+}  // namespace hybrid::spaceex
