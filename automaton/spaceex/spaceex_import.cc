@@ -400,6 +400,13 @@ void Translator::BuildInstances(const SxComponent& system) {
                                     [&p](const SxMap& m) { return m.key == p.name; });
       inst.targets[p.name] = MapParam(inst, p, map == b.maps.end() ? nullptr : &*map);
       const Target& target = inst.targets[p.name];
+      for (const auto& [other, other_target] : inst.targets) {
+        if (other == p.name || target.sx_name.empty() || other_target.sx_name != target.sx_name)
+          continue;
+        Fail(map == b.maps.end() ? inst.at : At(map->offset),
+             "'" + other + "' and '" + p.name + "' of '" + b.as + "' are both mapped to '" +
+                 target.sx_name + "'");
+      }
       if (p.local && p.type != SxParam::Type::kLabel)
         our_system_names_[target.sx_name] = target.our_name;
     }

@@ -146,8 +146,8 @@ class Reader {
       return compare;
     }
     pos_ = at;
-    if (Accept("!=")) Fail("'!=' is not supported: write two transitions (< and >)");
-    if (Accept("=")) Fail("'=' is not a comparison: write '=='");
+    if (text_.substr(at, 2) == "!=") Fail("'!=' is not supported: write two transitions (< and >)");
+    if (text_.substr(at, 1) == "=") Fail("'=' is not a comparison: write '=='");
     Fail("expected a comparison (==, <=, >=, <, >) or ':='");
   }
 

@@ -1,0 +1,239 @@
+#include "automaton/spaceex/spaceex_import.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "automaton/parser.h"
+#include "solvers/reachability/polyhedral_reachability.h"
+#include "tests/test_utilities/command_line.h"
+
+namespace hybrid::spaceex {
+namespace {
+
+using hybrid::testing::ReadAll;
+
+std::string SpecFile(const std::string& name) {
+  return ReadAll(std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/" + name);
+}
+
+Translation Translate(const std::string& xml, const std::string& cfg) {
+  return TranslateSpaceEx(xml, "m.xml", cfg, "m.cfg");
+}
+
+std::string Error(const std::string& xml, const std::string& cfg) {
+  try {
+    (void)Translate(xml, cfg).Parse("m.xml");
+  } catch (const ParseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// The verdict of exact reachability on the translation's property `forbidden`.
+Verdict ForbiddenVerdict(const std::string& xml, const std::string& cfg) {
+  const System system = Translate(xml, cfg).Parse("m.xml");
+  const std::vector<Property> properties(system.properties().begin(), system.properties().end());
+  const std::vector<CheckResult> results = PolyhedralReachability().Check(system, properties);
+  EXPECT_EQ(results.size(), 1u);
+  return results.at(0).verdict;
+}
+
+// A one-component model: parameters (name, dynamics), then locations and transitions as XML.
+std::string Base(const std::string& params, const std::string& body) {
+  return "<?xml version=\"1.0\"?>\n<sspaceex>\n<component id=\"c\">\n" + params + body +
+         "</component>\n</sspaceex>\n";
+}
+std::string Var(const std::string& name) {
+  return "<param name=\"" + name + "\" type=\"real\" local=\"false\" dynamics=\"any\"/>\n";
+}
+std::string Const(const std::string& name) {
+  return "<param name=\"" + name + "\" type=\"real\" local=\"false\" dynamics=\"const\"/>\n";
+}
+
+// Fischer's protocol guarantees mutual exclusion exactly when Delta > delta (the waiting time
+// exceeds the longest write delay): the published analysis, an oracle written apart from the
+// import. The SpaceEx model has delta = 1; Delta comes from the configuration.
+TEST(SpaceExImportTest, FischerIsSafeExactlyWhenDeltaExceedsDelta) {
+  const std::string xml = SpecFile("fischer_2.xml");
+  for (const double big_delta : {0.5, 1.0, 1.5, 3.0}) {
+    const std::string cfg =
+        "system = \"fischer\"\ninitially = \"loc(P1)==idle & loc(P2)==idle & "
+        "P1.x==0 & P2.x==0 & k==0 & delta==1 & Delta==" +
+        std::to_string(big_delta) + "\"\nforbidden = \"loc(P1)==cs & loc(P2)==cs\"\n";
+    EXPECT_EQ(ForbiddenVerdict(xml, cfg), big_delta > 1.0 ? Verdict::kProved : Verdict::kViolated)
+        << "Delta = " << big_delta;
+  }
+}
+
+// The water-level monitor's level stays in [1, 12] and reaches both ends (spec/benchmarks/
+// water_tank.ha, with the arithmetic in its header). A forbidden set the level only touches
+// (y >= 12) is `unknown`: no run meets it with a margin the simulator can confirm.
+TEST(SpaceExImportTest, WaterTankLevelsAreExactlyOneToTwelve) {
+  const std::string xml = SpecFile("water_tank.xml");
+  auto cfg = [](const std::string& forbidden) {
+    return "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"\n"
+           "forbidden = \"" +
+           forbidden + "\"\n";
+  };
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("y >= 12.01")), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("y >= 11.9")), Verdict::kViolated);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("y <= 0.99")), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("y <= 1.1 & loc(water_tank) == switching_on")),
+            Verdict::kViolated);
+  // The bundled configuration: the level never leaves [0.5, 12.5].
+  EXPECT_EQ(ForbiddenVerdict(xml, SpecFile("water_tank.cfg")), Verdict::kProved);
+}
+
+// Rate bounds become a rectangular rate: with x' in [1, 2] and a clock t, x <= 2 t exactly.
+TEST(SpaceExImportTest, RateBoundsBecomeRectangularRates) {
+  const std::string xml =
+      Base(Var("x") + Var("t"),
+           "<location id=\"1\" name=\"go\"><invariant>t &lt;= 5</invariant>"
+           "<flow>x' &gt;= 1 &amp; 2 &gt;= x' &amp; t' == 1</flow></location>\n");
+  const std::string init = "initially = \"x == 0 & t == 0\"\n";
+  EXPECT_NE(Translate(xml, init).text.find("x' in [1, 2];"), std::string::npos);
+  EXPECT_EQ(ForbiddenVerdict(xml, init + "forbidden = \"x >= 2*t + 0.001\""), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(xml, init + "forbidden = \"x <= t - 0.001\""), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(xml, init + "forbidden = \"x >= 1.9*t & t >= 1\""),
+            Verdict::kViolated);
+}
+
+TEST(SpaceExImportTest, InstancesWithDifferentConstantsGetAutomataOfTheirOwn) {
+  const Translation t = Translate(SpecFile("fischer_2.xml"), SpecFile("fischer_2.cfg"));
+  EXPECT_NE(t.text.find("automaton process_P1 {\n  param id = 1;"), std::string::npos);
+  EXPECT_NE(t.text.find("automaton process_P2 {\n  param id = 2;"), std::string::npos);
+  EXPECT_NE(t.text.find("instance P1 = process_P1 { k = k; delta = delta; Delta = Delta; }"),
+            std::string::npos);
+  // Both processes constrain k' == 0: the flow is given by P1 only, and the notes say so.
+  EXPECT_EQ(t.notes.size(), 2u);
+  const System system = t.Parse("m.xml");
+  EXPECT_EQ(system.components().size(), 2u);
+}
+
+TEST(SpaceExImportTest, KeywordsAreRenamedAndTheTranslationParses) {
+  const std::string xml =
+      Base(Var("input") + Const("mode"),
+           "<location id=\"1\" name=\"in\"><invariant>input &lt;= mode</invariant>"
+           "<flow>input' == 1</flow></location>\n");
+  const Translation t = Translate(xml,
+                                  "initially = \"input == 0 & mode == 3\"\n"
+                                  "forbidden = \"input >= mode & loc() == in\"\n");
+  EXPECT_NE(t.text.find("param mode_ = 3;"), std::string::npos);
+  EXPECT_NE(t.text.find("inv input_ <= mode_;"), std::string::npos);
+  EXPECT_NE(t.text.find("property forbidden: never input_ >= mode_ and in in_;"),
+            std::string::npos);
+  EXPECT_NO_THROW(t.Parse("m.xml"));
+}
+
+TEST(SpaceExImportTest, ConfigurationErrorsNameTheConfigurationFile) {
+  const std::string xml = SpecFile("water_tank.xml");
+  const std::string init = "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"";
+  EXPECT_EQ(Error(xml, "initially = \"y == 1 & z == 0\"\n"),
+            "m.cfg:1:23: undefined name 'z' in 'initially'");
+  EXPECT_EQ(Error(xml, init + "\nforbidden = \"level >= 3\""),
+            "m.cfg:2:14: undefined name 'level' in 'forbidden'");
+  EXPECT_EQ(Error(xml, "initially = \"loc()==full & y == 1\""),
+            "m.cfg:1:21: 'water_tank' has no location 'full'");
+  EXPECT_EQ(Error(xml, "initially = \"y == 1 | y == 2\""),
+            "m.cfg:1:14: '|' in 'initially' is not supported: give one initial set (a "
+            "conjunction)");
+  EXPECT_EQ(Error(xml, "initially = \"y + x <= 1\""),
+            "m.cfg:1:14: only bounds of single variables are supported in 'initially' (x == c, "
+            "x >= c, x <= c)");
+  EXPECT_EQ(Error(xml, "initially = \"y == 1 & x == 0 & delay == 2 & high == 10\""),
+            "m.xml:11:5: constant 'low' has no value: map it to a number in the bind, or give it "
+            "one in 'initially' (low == 2, or 1 <= low & low <= 2)");
+  EXPECT_EQ(Error(xml, "system = \"tank\""), "m.cfg:1:11: no component 'tank' in m.xml");
+  EXPECT_EQ(Error(xml, "initially = \"y == \n 1 &\""), "m.cfg:2:5: expected an expression");
+  EXPECT_EQ(Error(xml, "initially = \"y == \n 1 &"), "m.cfg:1:13: unterminated '\"'");
+}
+
+TEST(SpaceExImportTest, UnsupportedModelsAreReportedWhereTheyAre) {
+  const std::string cfg = "initially = \"x == 0\"\n";
+  // A location without the flow of a variable its component drives elsewhere.
+  EXPECT_EQ(Error(Base(Var("x"),
+                       "<location id=\"1\" name=\"a\"><flow>x' == 1</flow></location>\n"
+                       "<location id=\"2\" name=\"b\"/>\n"),
+                  cfg),
+            "m.xml:6:1: location 'b' gives no flow for 'x', which SpaceEx leaves free to change "
+            "there (add x' == 0 to keep it constant)");
+  EXPECT_EQ(Error(Base(Var("x"),
+                       "<location id=\"1\" name=\"a\"><invariant>x &lt;= 1</invariant>"
+                       "</location>\n"),
+                  cfg),
+            "m.xml:4:1: no component gives 'x' a flow: SpaceEx lets it change arbitrarily, which "
+            "the import does not support (add x' == 0 to the flows of one component to keep it "
+            "constant)");
+  EXPECT_EQ(
+      Error(Base(Var("x"), "<location id=\"1\" name=\"a\"><flow>x' == y</flow></location>\n"), cfg),
+      "m.xml:5:39: undefined name 'y' (not a parameter of component 'c')");
+  EXPECT_EQ(
+      Error(Base(Var("x"), "<location id=\"1\" name=\"a\"><flow>x' &gt;= 1</flow></location>\n"),
+            cfg),
+      "m.xml:5:33: rate of 'x' needs both bounds (x' >= a & x' <= b)");
+  EXPECT_EQ(Error(Base(Var("x"),
+                       "<location id=\"1\" name=\"a\"><flow>x' == 1</flow></location>\n"
+                       "<transition source=\"1\" target=\"1\"><guard>x &lt;= 0 | x &gt;= 2"
+                       "</guard></transition>\n"),
+                  cfg),
+            "m.xml:6:42: '|' is not supported in guards: split the transition");
+  EXPECT_EQ(Error(Base(Var("x"),
+                       "<location id=\"1\" name=\"a\"><flow>x' == 1</flow></location>\n"
+                       "<transition source=\"1\" target=\"7\"/>\n"),
+                  cfg),
+            "m.xml:6:1: no location with id '7' in 'c'");
+  EXPECT_EQ(Error(Base(Var("x-1"), ""), cfg),
+            "m.xml:4:1: parameter 'x-1' is not a name of the model language (letters, digits and "
+            "'_', not starting with a digit)");
+}
+
+TEST(SpaceExImportTest, NetworkErrorsPointAtTheBind) {
+  const std::string tank = "<component id=\"t\">" + Var("x") + Var("y") +
+                           "<location id=\"1\" name=\"a\"><flow>x' == 1 &amp; y' == 0</flow>"
+                           "</location></component>\n";
+  auto network = [&](const std::string& binds) {
+    return "<?xml version=\"1.0\"?>\n<sspaceex>\n" + tank + "<component id=\"n\">" + Var("k") +
+           Var("j") + "\n" + binds + "</component>\n</sspaceex>\n";
+  };
+  EXPECT_EQ(Error(network("<bind component=\"nope\" as=\"A\"/>"), ""),
+            "m.xml:9:1: bind 'A' of unknown component 'nope'");
+  EXPECT_EQ(Error(network("<bind component=\"n\" as=\"A\"/>"), ""),
+            "m.xml:9:1: component 'n' is a network: nested networks are not supported");
+  EXPECT_EQ(Error(network("<bind component=\"t\" as=\"A\"><map key=\"x\">k</map></bind>"), ""),
+            "m.xml:9:1: bind 'A' does not map 'y' of component 't'");
+  EXPECT_EQ(Error(network("<bind component=\"t\" as=\"A\"><map key=\"x\">k</map>"
+                          "<map key=\"y\">q</map></bind>"),
+                  ""),
+            "m.xml:9:61: undefined name 'q' (not a parameter of 'n')");
+  EXPECT_EQ(Error(network("<bind component=\"t\" as=\"A\"><map key=\"x\">k</map>"
+                          "<map key=\"y\">k</map></bind>"),
+                  ""),
+            "m.xml:9:48: 'x' and 'y' of 'A' are both mapped to 'k'");
+  // Two instances driving one variable.
+  EXPECT_EQ(Error(network("<bind component=\"t\" as=\"A\"><map key=\"x\">k</map>"
+                          "<map key=\"y\">j</map></bind>\n"
+                          "<bind component=\"t\" as=\"B\"><map key=\"x\">k</map>"
+                          "<map key=\"y\">j</map></bind>"),
+                  ""),
+            "m.xml:5:33: 'k' is given a flow by 'A' and by 'B': the import supports one component "
+            "per variable (or x' == 0 in all)");
+}
+
+TEST(SpaceExImportTest, ReadModelFileReadsBothLanguages) {
+  const System imported =
+      ReadModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/fischer_2.xml");
+  EXPECT_EQ(imported.properties().size(), 1u);
+  EXPECT_TRUE(IsSpaceExFile("a/b.XML"));
+  EXPECT_FALSE(IsSpaceExFile("a/b.ha"));
+  try {
+    (void)ReadModelFile("/nonexistent/m.xml");
+    ADD_FAILURE() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 0);
+  }
+}
+
+}  // namespace
+}  // namespace hybrid::spaceex
