@@ -329,10 +329,17 @@ void DefaultModels(Commands& c) {
 
 // `hybrid import`: the translation, checked by parsing it, then written; notes on stderr.
 int RunImport(const Commands& c) {
-  hybrid::cli::CheckDistinctFiles({{"MODEL", c.model}, {"--config", c.config}}, {{"-o", c.output}});
+  std::optional<std::filesystem::path> config;
+  if (!c.config.empty()) {
+    config = c.config;
+  } else {
+    config = hybrid::spaceex::DefaultConfigFile(c.model);
+  }
+  hybrid::cli::CheckDistinctFiles(
+      {{"MODEL", c.model}, {"--config", config ? config->string() : ""}}, {{"-o", c.output}});
   hybrid::cli::CheckOutputPlaces({{"-o", c.output}});
-  const hybrid::spaceex::Translation translation = hybrid::spaceex::ImportSpaceExFile(
-      c.model, c.config.empty() ? std::nullopt : std::optional<std::filesystem::path>(c.config));
+  const hybrid::spaceex::Translation translation =
+      hybrid::spaceex::ImportSpaceExFile(c.model, config);
   (void)translation.Parse(c.model);
   for (const std::string& note : translation.notes) {
     std::cerr << c.model << ": note: " << note << "\n";

@@ -897,20 +897,20 @@ Translation TranslateSpaceEx(std::string_view xml, const std::string& xml_file,
   return Translator(doc, config ? &*config : nullptr).Run();
 }
 
+std::optional<std::filesystem::path> DefaultConfigFile(const std::filesystem::path& xml) {
+  std::filesystem::path guess = xml;
+  guess.replace_extension(".cfg");
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(guess, ec)) return guess;
+  return std::nullopt;
+}
+
 Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg) {
-  std::filesystem::path cfg_path;
-  if (cfg) {
-    cfg_path = *cfg;
-  } else {
-    std::error_code ec;
-    std::filesystem::path guess = xml;
-    guess.replace_extension(".cfg");
-    if (std::filesystem::is_regular_file(guess, ec)) cfg_path = guess;
-  }
+  const std::optional<std::filesystem::path> cfg_path = cfg ? cfg : DefaultConfigFile(xml);
   const std::string xml_text = ReadFile(xml);
-  const std::string cfg_text = cfg_path.empty() ? std::string() : ReadFile(cfg_path);
-  return TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path.string());
+  const std::string cfg_text = cfg_path ? ReadFile(*cfg_path) : std::string();
+  return TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path ? cfg_path->string() : "");
 }
 
 bool IsSpaceExFile(const std::filesystem::path& path) {

@@ -48,6 +48,10 @@ Translation TranslateSpaceEx(std::string_view xml, const std::string& xml_file,
 Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg = std::nullopt);
 
+/// The configuration ImportSpaceExFile reads for `xml` when none is given: the file next to it
+/// with the extension `.cfg`, if it exists.
+std::optional<std::filesystem::path> DefaultConfigFile(const std::filesystem::path& xml);
+
 /// True if `path` names a SpaceEx model (its extension is `.xml`, in any case).
 bool IsSpaceExFile(const std::filesystem::path& path);
 

@@ -12,6 +12,7 @@ never from a committed generated corpus:
       spec/ and tests/;
   fuzz_object: tests/fuzz/seeds/fuzz_object/ and the "circle:..."/"segment:..." strings of tests/;
   fuzz_measured_data: tests/fuzz/seeds/fuzz_measured_data/ and the first rows of data/*.csv;
+  fuzz_spaceex: spec/spaceex/*.xml, each alone and followed by a NUL byte and its .cfg;
   any harness: tests/fuzz/seeds/HARNESS/ if it exists.
 Prints the number of seeds written.
 """
@@ -62,12 +63,21 @@ def measured_data_seeds(root):
             yield b"".join(line for _, line in zip(range(CSV_HEAD_LINES), f))
 
 
+def spaceex_seeds(root):
+    for path in sources(root, ["spec/spaceex/*.xml"]):
+        yield path.read_bytes()
+        cfg = path.with_suffix(".cfg")
+        if cfg.is_file():
+            yield path.read_bytes() + b"\0" + cfg.read_bytes()
+
+
 COLLECTORS = {
     "fuzz_model_parser": model_seeds,
     "fuzz_round_trip": model_seeds,
     "fuzz_signal": signal_seeds,
     "fuzz_object": object_seeds,
     "fuzz_measured_data": measured_data_seeds,
+    "fuzz_spaceex": spaceex_seeds,
 }
 
 

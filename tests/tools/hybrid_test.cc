@@ -416,5 +416,57 @@ TEST(HybridCli, FailedRunLeavesAnExistingOutputUntouched) {
   EXPECT_EQ(ReadAll(out), WriteDot(ParseModelFile(kFinger)));
 }
 
+// ---------------------------------------------------------------------------------------------
+// `hybrid import` and SpaceEx models read by every model command.
+
+namespace spaceex_cli {
+
+const fs::path kFischerXml = kSourceDir / "spec" / "spaceex" / "fischer_2.xml";
+
+TEST(HybridCli, ImportWritesAModelThatChecksLikeTheSpaceExFile) {
+  TempDir dir;
+  const fs::path out = dir.path() / "fischer.ha";
+  const Result import =
+      RunHybrid("import " + Quote(kFischerXml.string()) + " -o " + Quote(out.string()));
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  // The configuration next to the model was read; its time horizon is named as not imported.
+  EXPECT_NE(import.err.find("note: time-horizon = 100 is not imported"), std::string::npos);
+  EXPECT_NE(ReadAll(out).find("property forbidden: never in P1.cs and in P2.cs;"),
+            std::string::npos);
+  // Both the written model and the SpaceEx file itself are checked, with the same verdict:
+  // Fischer's protocol with Delta = 2 > delta = 1 is safe.
+  for (const fs::path& model : {out, kFischerXml}) {
+    const Result check = RunHybrid("check " + Quote(model.string()) + " --json");
+    ASSERT_EQ(check.exit_code, 0) << check.err;
+    const nlohmann::json j = nlohmann::json::parse(check.out);
+    EXPECT_EQ(Field(Field(Field(j, "properties"), 0), "verdict"), "proved") << model;
+  }
+}
+
+TEST(HybridCli, ImportRefusesToOverwriteItsInputsAndReportsBadFiles) {
+  TempDir dir;
+  const fs::path xml = dir.Write("m.xml", ReadAll(kFischerXml));
+  const fs::path cfg = dir.Write("m.cfg", "initially = \"k == 0 & zz == 1\"\n");
+  // The configuration found next to the model is an input too.
+  Result r = RunHybrid("import " + Quote(xml.string()) + " -o " + Quote(cfg.string()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("an output may not overwrite an input"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadAll(cfg), "initially = \"k == 0 & zz == 1\"\n");
+  r = RunHybrid("import " + Quote(xml.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, cfg.string() + ":1:23: undefined name 'zz' in 'initially'\n");
+  const fs::path broken =
+      dir.Write("broken.xml", "<sspaceex>\n  <component id=\"c\">\n</sspaceex>\n");
+  r = RunHybrid("check " + Quote(broken.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, broken.string() + ":3:3: malformed XML: Start-end tags mismatch\n");
+  r = RunHybrid("import " + Quote(xml.string()) + " --config " +
+                Quote((dir.path() / "none.cfg").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("none.cfg:0:0: cannot read file"), std::string::npos) << r.err;
+}
+
+}  // namespace spaceex_cli
+
 }  // namespace
 }  // namespace hybrid
