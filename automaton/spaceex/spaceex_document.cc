@@ -1,5 +1,6 @@
 #include "automaton/spaceex/spaceex_document.h"
 
+#include <algorithm>
 #include <cstring>
 #include <pugixml.hpp>
 #include <set>
@@ -210,8 +211,10 @@ SpaceExDocument::SpaceExDocument(std::string_view xml, std::string file)
   const pugi::xml_parse_result result =
       doc.load_buffer(raw_.data(), raw_.size(), pugi::parse_default, pugi::encoding_utf8);
   if (!result) {
-    Fail(static_cast<std::size_t>(std::max<std::ptrdiff_t>(result.offset, 0)),
-         std::string("malformed XML: ") + result.description());
+    // pugixml may report the offset just past the end of a truncated document.
+    const auto offset = std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(result.offset, 0)),
+                                 raw_.size());
+    Fail(offset, std::string("malformed XML: ") + result.description());
   }
   const Reader reader(*this, raw_);
   const pugi::xml_node root = doc.document_element();

@@ -39,6 +39,8 @@ std::string DecimalText(double x) {
   return std::string(buffer, result.ptr);
 }
 
+std::string RateInput(const std::string& variable) { return "zz_rate_" + variable; }
+
 std::string LazyChoiceInput(int transition) {
   return "zz_lazy_choice_" + std::to_string(transition);
 }
@@ -206,9 +208,15 @@ RandomComparison DrawInvariantAtom(Rng& rng, const Context& ctx) {
 }
 
 RandomMode DrawMode(Rng& rng, const Context& ctx, const std::string& name) {
-  RandomMode m{name, {}, {}};
+  RandomMode m{name, {}, {}, {}};
   const auto& vars = ctx.a->variables;
   for (int v = 0; v < static_cast<int>(vars.size()); ++v) {
+    if (RandomChance(rng, 12)) {  // a rectangular rate, sometimes a point
+      const double lo = Tenths(rng, -20, 20);
+      const double width = RandomChance(rng, 15) ? 0.0 : Tenths(rng, 1, 20);
+      m.rates.push_back({vars[v].name, lo, std::round((lo + width) * 10) / 10});
+      continue;
+    }
     if (auto f = DrawFlow(rng, ctx, v)) m.flows.emplace_back(vars[v].name, *f);
   }
   const int atoms = Weighted(rng, {35, 45, 20});
@@ -491,9 +499,24 @@ std::string RandomHybridAutomaton::Text(const PrintOptions& options) const {
   if (options.lazy_choices) {
     for (int i : lazy) out << "  input " << LazyChoiceInput(i) << " in [0, 1];\n";
   }
+  std::set<std::string> rated;
+  for (const RandomMode& m : modes) {
+    for (const RandomRate& r : m.rates) rated.insert(r.variable);
+  }
+  if (options.explicit_rates) {
+    for (const std::string& v : rated) out << "  input " << RateInput(v) << " in [0, 1];\n";
+  }
   for (const RandomMode& m : modes) {
     out << "  mode " << m.name << " {";
     for (const auto& [v, rhs] : m.flows) out << " " << v << "' = " << SumText(rhs) << ";";
+    for (const RandomRate& r : m.rates) {
+      out << " " << r.variable << "'"
+          << (options.explicit_rates ? " = " + DecimalText(r.lo) + " + " +
+                                           DecimalText(std::round((r.hi - r.lo) * 10) / 10) +
+                                           " * " + RateInput(r.variable)
+                                     : " in [" + DecimalText(r.lo) + ", " + DecimalText(r.hi) + "]")
+          << ";";
+    }
     if (!m.invariant.empty()) out << " inv " << ConjunctionText(m.invariant) << ";";
     out << " }\n";
   }

@@ -73,10 +73,18 @@ struct RandomParameter {
   std::optional<std::pair<double, double>> range;  ///< uncertain: `param p = v in [lo, hi];`
 };
 
+/// A rectangular rate `x' in [lo, hi];` of one variable in one mode.
+struct RandomRate {
+  std::string variable;
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
 struct RandomMode {
   std::string name;
   std::vector<std::pair<std::string, RandomSum>> flows;  ///< variable, right-hand side
   std::vector<RandomComparison> invariant;               ///< conjunction (empty: none)
+  std::vector<RandomRate> rates;  ///< variables with a rectangular rate (no flow)
 };
 
 struct RandomTransition {
@@ -122,6 +130,11 @@ struct PrintOptions {
   /// copy's strict comparisons are tightened to non-strict ones 0.001 inside (`x > 1` becomes
   /// `x >= 1.001`), because an urgent transition fires where its guard holds in its closure.
   bool lazy_choices = false;
+  /// Every rectangular rate `x' in [lo, hi]` is printed as the flow
+  /// `x' = lo + (hi - lo) * zz_rate_x` over an input `zz_rate_x in [0, 1]` (RateInput), declared
+  /// once per variable that has a rate somewhere: a step signal on it picks the rate segment by
+  /// segment, and every run of that text is a run of the automaton.
+  bool explicit_rates = false;
 };
 
 /// A random automaton in a form the test understands without the code under test.
@@ -146,11 +159,14 @@ struct RandomHybridAutomaton {
 
 /// Name of the choice input of lazy transition `transition` (PrintOptions::lazy_choices).
 std::string LazyChoiceInput(int transition);
+/// Name of the input that picks the rate of `variable` (PrintOptions::explicit_rates).
+std::string RateInput(const std::string& variable);
 
 /// A random automaton: 1 to 3 variables (some with a domain), 0 to 3 inputs whose bounds take
 /// every sign ([-a, 0], [0, a], [0, 0], [-a, b], [a, b], [-b, -a]), 0 to 2 parameters (most with a
 /// range, some degenerate), 1 to 3 modes whose flows are constant rates, affine in the inputs
-/// (also with parameter coefficients), zero, or occasionally affine in the state, conjunctive
+/// (also with parameter coefficients), zero, rectangular rates `x' in [lo, hi]` (some with
+/// lo == hi), or occasionally affine in the state, conjunctive
 /// invariants, 0 to 5 transitions (urgent, explicitly urgent or lazy; guards on variables,
 /// parameters and sometimes inputs, strict or not; resets to constants, shifts, other variables,
 /// parameters), 1 or 2 initial states (points and intervals), and 2 to 5 properties (`always`,

@@ -264,6 +264,15 @@ double DrawInRange(std::mt19937_64& rng, double lo, double hi, double nominal) {
 }
 
 /// A random run of `a` for an attack.
+// The variables that have a rectangular rate in some mode of `a`.
+std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
+  std::set<std::string> out;
+  for (const ht::RandomMode& m : a.modes) {
+    for (const ht::RandomRate& r : m.rates) out.insert(r.variable);
+  }
+  return out;
+}
+
 ConcreteRun DrawAttack(const RandomHybridAutomaton& a, std::mt19937_64& rng) {
   ConcreteRun run{a, {}, {}, {}, "", {}};
   RandomHybridAutomaton& c = run.automaton;
@@ -290,6 +299,11 @@ ConcreteRun DrawAttack(const RandomHybridAutomaton& a, std::mt19937_64& rng) {
       if (c.transitions[i].urgency != ht::RandomTransition::Urgency::kLazy) continue;
       scenario.steps.emplace_back(ht::LazyChoiceInput(i), DrawChoice(rng, scenario.until));
     }
+  }
+  // Rectangular rates: a random rate in the range, segment by segment.
+  run.print.explicit_rates = true;
+  for (const std::string& v : RatedVariables(c)) {
+    scenario.steps.emplace_back(ht::RateInput(v), DrawSignal(rng, 0.0, 1.0, scenario.until));
   }
   for (const auto& [name, points] : scenario.steps) {
     for (const auto& [t, v] : points) run.sample_times.push_back(t);
@@ -459,11 +473,30 @@ ConcreteRun TraceRun(const RandomHybridAutomaton& a, const System& system, const
   }
   ht::RandomScenario scenario;
   scenario.until = t.inputs.until;
+  run.print.explicit_rates = true;
   for (const InputSignal& signal : t.inputs.inputs) {
     if (signal.shape != InputSignal::Shape::kStep) problem += "a signal is not a step; ";
-    scenario.steps.emplace_back(system.symbols()[signal.slot].name, signal.points);
+    const std::string& name = system.symbols()[signal.slot].name;
+    if (!name.empty() && name.back() == '\'') {
+      // The rate input x' in [-1, 1] of `x' in [lo, hi]` (rate (lo + hi)/2 + (hi - lo)/2 * w)
+      // is the explicit rate input in [0, 1] at (w + 1) / 2 (rate lo + (hi - lo) * z).
+      std::vector<std::pair<double, double>> points = signal.points;
+      for (auto& [time, w] : points) w = (w + 1) / 2;
+      scenario.steps.emplace_back(ht::RateInput(name.substr(0, name.size() - 1)), points);
+    } else {
+      scenario.steps.emplace_back(name, signal.points);
+    }
     for (const auto& [time, value] : signal.points) run.sample_times.push_back(time);
   }
+  for (const std::string& v : RatedVariables(c)) {  // an unlisted rate input is 0: the midpoint
+    const bool listed =
+        std::any_of(scenario.steps.begin(), scenario.steps.end(),
+                    [&](const auto& step) { return step.first == ht::RateInput(v); });
+    if (!listed)
+      scenario.steps.emplace_back(ht::RateInput(v),
+                                  std::vector<std::pair<double, double>>{{0.0, 0.5}});
+  }
+
   c.scenario = scenario;
   run.schedule = t.schedule;  // transition indices: the text keeps the declaration order
   for (const ScheduledJump& j : t.schedule) run.sample_times.push_back(j.time);
@@ -892,6 +925,14 @@ TEST(SoundnessTest, GeneratedModelsParseAndCoverTheIssueShapes) {
       if (p.within) seen["within"]++;
     }
     if (a.inits.size() > 1) seen["two inits"]++;
+    for (const ht::RandomMode& m : a.modes) {
+      for (const ht::RandomRate& r : m.rates) seen[r.lo < r.hi ? "rate range" : "rate point"]++;
+    }
+    if (!RatedVariables(a).empty()) {
+      ht::PrintOptions explicit_rates;
+      explicit_rates.explicit_rates = true;
+      ASSERT_NO_THROW(ParseModel(a.Text(explicit_rates), "random.ha")) << a.Text(explicit_rates);
+    }
     for (const ht::RandomInit& init : a.inits) {
       for (const auto& [v, range] : init.values) {
         if (range.first < range.second) seen["interval init"]++;
@@ -909,10 +950,11 @@ TEST(SoundnessTest, GeneratedModelsParseAndCoverTheIssueShapes) {
     for (const auto& p : a.properties) names.insert(p.name);
   }
   for (const char* shape :
-       {"[-a, 0]",   "[0, a]",    "[0, 0]",    "[-a, b]",   "[a, b]",        "[-b, -a]", "flow + d",
-        "urgency 0", "urgency 1", "urgency 2", "reset",     "uncertain",     "fixed",    "always",
-        "never",     "reach",     "within",    "two inits", "interval init", " > ",      " < ",
-        "*",         "' = 0;",    " := -",     " in "}) {
+       {"[-a, 0]",       "[0, a]",     "[0, 0]",    "[-a, b]",   "[a, b]", "[-b, -a]",
+        "flow + d",      "urgency 0",  "urgency 1", "urgency 2", "reset",  "uncertain",
+        "fixed",         "always",     "never",     "reach",     "within", "two inits",
+        "interval init", " > ",        " < ",       "*",         "' = 0;", " := -",
+        " in ",          "rate range", "rate point"}) {
     EXPECT_GT(seen[shape], 0) << shape;
   }
   for (const std::string& n : ht::ShortNamePool()) EXPECT_TRUE(names.count(n)) << n;
