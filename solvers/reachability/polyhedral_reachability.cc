@@ -67,7 +67,12 @@ struct Goal {
   bool decided = false;
   bool met = false;  // the reachable set met its bad (target) states without a replayed trace
   std::string why_no_trace;
+  int concretizations = 0;  // runs sought for it (at most kMaxConcretizations)
 };
+
+// Most runs sought per goal: each walks its path backwards with polyhedra, so a goal met by many
+// symbolic states whose runs do not replay would otherwise cost a pre-image walk per state.
+constexpr int kMaxConcretizations = 32;
 
 // The time-elapse successor of `set` in `loc`, kept inside its elapse invariant and `extra`.
 // `set` (entry states, inside the invariant) is reachable at once; time elapses only from its
@@ -133,8 +138,11 @@ class Explorer {
 
   // Explores until every goal is decided, the reachable set is complete or a bound is hit;
   // then writes every goal's result.
+  // True once the exploration has used its CPU-time safety net.
+  bool OutOfTime() const { return ThreadCpuSeconds() - start_ > options_.cpu_seconds; }
+
   void Run() {
-    const double start = ThreadCpuSeconds();
+    start_ = ThreadCpuSeconds();
     for (int i = 0; i < static_cast<int>(initial_.size()); ++i) {
       const LinearLocation& loc = lhs_.At(initial_[i].tuple);
       ConvexPolyhedron set = initial_[i].set;
@@ -147,7 +155,7 @@ class Explorer {
         stopped = "stopped after " + std::to_string(options_.max_states) + " symbolic states";
         break;
       }
-      if (ThreadCpuSeconds() - start > options_.cpu_seconds) {
+      if (OutOfTime()) {
         stopped = "stopped by the CPU-time safety net after " +
                   std::to_string(static_cast<int>(options_.cpu_seconds)) + " s";
         break;
@@ -220,6 +228,8 @@ class Explorer {
     for (const BadPart& bad : Bad(index, loc)) {
       if (!bad.set.Intersects(nodes_[n].set)) continue;
       g.met = true;
+      if (g.concretizations >= kMaxConcretizations || OutOfTime()) continue;
+      ++g.concretizations;
       std::optional<Trace> trace = Concretize(n, bad.constraints, &g.why_no_trace);
       if (!trace) continue;
       CheckResult& r = *g.result;
@@ -265,6 +275,7 @@ class Explorer {
   LinearHybridSystem lhs_;
   std::vector<Goal> goals_;
   PolyhedralReachability::Options options_;
+  double start_ = 0.0;  // thread CPU time at the start of Run
   std::vector<LinearHybridSystem::Initial> initial_;
   Conjunction horizon_;
   ConvexPolyhedron horizon_set_;
@@ -469,7 +480,12 @@ void Explorer::Finish(const std::string& stopped) {
     r.trace.reset();
     if (g.met) {
       r.reason = "the reachable set meets the property's states, but no run found replays (" +
-                 g.why_no_trace + ")";
+                 g.why_no_trace +
+                 (g.concretizations >= kMaxConcretizations
+                      ? "; runs sought along the first " + std::to_string(kMaxConcretizations) +
+                            " paths that meet them"
+                      : std::string()) +
+                 ")";
     } else if (!complete) {
       r.reason = "reachability " + (stopped.empty() ? std::string("stopped") : stopped) +
                  " before a fixpoint (" + size.str() + ")";
