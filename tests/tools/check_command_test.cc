@@ -11,7 +11,6 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -410,14 +409,12 @@ void ExpectChainVerdicts(const json& report) {
   }
 }
 
-TEST(CheckCommand, BudgetFiveBoundsAThreeHundredModeChainToTenSeconds) {
+// The budget counts Z3's resource units, not seconds, so what it stops is the same on a loaded
+// machine (no wall-clock assertion here: docs/verification.md gives the measured times).
+TEST(CheckCommand, BudgetFiveStopsAThreeHundredModeChain) {
   TempDir dir;
   const std::string model = dir.Write("chain300.ha", Chain(300)).string();
-  const auto start = std::chrono::steady_clock::now();
   const json report = RunHybridJson("check " + Quote(model) + " --method prove --budget 5", 7);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 10.0);
   ExpectChainVerdicts(report);
   EXPECT_NE(Property(report, "far").value("reason", "").find("budget"), std::string::npos)
       << report.dump(2);
