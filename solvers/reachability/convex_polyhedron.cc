@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <ppl.hh>
 #include <stdexcept>
 #include <string>
@@ -23,6 +25,22 @@ namespace ppl = Parma_Polyhedra_Library;
   ppl::restore_pre_PPL_rounding();
   return true;
 }();
+
+// The double nearest to `q` (ties to even). GMP's get_d truncates towards zero, so the rational
+// ToRational(1.8) = 9/5 would come back as 1.7999999999999998: a trace would then start 1 ulp
+// outside an initial point (`out = 1.8`) and take a guard `out < 1.8` the model never takes.
+double NearestDouble(const mpq_class& q) {
+  const double truncated = q.get_d();
+  if (!std::isfinite(truncated) || mpq_class(truncated) == q) return truncated;
+  const double away = std::nextafter(truncated, sgn(q) > 0 ? INFINITY : -INFINITY);
+  if (!std::isfinite(away)) return truncated;
+  const mpq_class below = abs(q - mpq_class(truncated));
+  const mpq_class above = abs(mpq_class(away) - q);
+  if (below != above) return below < above ? truncated : away;
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &truncated, sizeof bits);
+  return (bits & 1u) == 0 ? truncated : away;
+}
 
 // The rational written by the shortest decimal that reads back as `value` (finite).
 mpq_class ToRational(double value) {
@@ -135,7 +153,7 @@ ppl::Constraint ToPpl(const LinearConstraint& c, bool closed) {
 }
 
 double ToDouble(const ppl::Coefficient& numerator, const ppl::Coefficient& denominator) {
-  return mpq_class(ToInteger(numerator), ToInteger(denominator)).get_d();
+  return NearestDouble(mpq_class(ToInteger(numerator), ToInteger(denominator)));
 }
 
 }  // namespace
@@ -303,7 +321,7 @@ std::optional<double> ConvexPolyhedron::Supremum(std::span<const double> objecti
   bool maximum = false;
   if (!impl_->p.maximize(e, n, d, maximum)) return std::nullopt;
   if (attained) *attained = maximum;
-  return mpq_class(ToInteger(n), ToInteger(d) * lcm).get_d();
+  return NearestDouble(mpq_class(ToInteger(n), ToInteger(d) * lcm));
 }
 
 bool ConvexPolyhedron::RestrictToMaximum(std::span<const double> objective) {
@@ -343,7 +361,7 @@ ConvexPolyhedron ConvexPolyhedron::CentralPoint() const {
   for (size_t i = 0; i < centre.size(); ++i) {
     centre[i] = centre[i] / count + rays[i];
     centre[i].canonicalize();
-    rounded.push_back(centre[i].get_d());
+    rounded.push_back(NearestDouble(centre[i]));
   }
   if (std::all_of(rounded.begin(), rounded.end(), [](double v) { return std::isfinite(v); })) {
     ConvexPolyhedron simple = Point(rounded);
@@ -375,8 +393,8 @@ std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
     }
   }
   for (size_t i = 0; i < n; ++i) {
-    out[i].first = below[i] ? -INFINITY : lo[i]->get_d();
-    out[i].second = above[i] ? INFINITY : hi[i]->get_d();
+    out[i].first = below[i] ? -INFINITY : NearestDouble(*lo[i]);
+    out[i].second = above[i] ? INFINITY : NearestDouble(*hi[i]);
   }
   return out;
 }
@@ -389,7 +407,7 @@ std::vector<double> ConvexPolyhedron::PointCoordinates() const {
   for (const ppl::Generator& g : impl_->p.minimized_generators()) {
     if (!g.is_point()) continue;
     std::vector<double> x;
-    for (const mpq_class& v : Coordinates(g)) x.push_back(v.get_d());
+    for (const mpq_class& v : Coordinates(g)) x.push_back(NearestDouble(v));
     return x;
   }
   throw std::logic_error("the coordinates of a point of an empty polyhedron");

@@ -168,12 +168,12 @@ double IntoInitialRange(const Component& c, int slot, const std::string& name, d
 
 // Applies the trace's choice of initial states, then its initial values, each checked against
 // (and moved onto) the chosen initial state's range: no start outside every `init` is simulated.
-void ApplyStart(System& copy, const Trace& trace) {
+// The trace keeps the values simulated, so that it states the run it stands for.
+void ApplyStart(System& copy, Trace& trace) {
   for (const auto& [component, index] : trace.initial_states) {
     copy.SelectInitialState(component, index);
   }
-  for (const auto& [name, given] : trace.initial_values) {
-    double value = given;
+  for (auto& [name, value] : trace.initial_values) {
     for (const Component& c : copy.components()) {
       const std::optional<int> slot = c.automaton.symbols().Find(name);
       if (!slot || c.automaton.symbols()[*slot].kind != SymbolKind::kVariable) continue;

@@ -72,8 +72,8 @@ struct ReplayOptions {
 /// horizon of a bounded property (`within T`) caps the states considered. Throws
 /// std::invalid_argument for a trace naming unknown parameters, variables or initial states, inputs
 /// out of bounds, or an initial value outside the chosen initial state's range (beyond 1e-9
-/// relative; within it, the value is moved onto the range): a start that no `init` of the model
-/// admits is never replayed.
+/// relative; within it, the value is moved onto the range, in trace.initial_values too): a start
+/// that no `init` of the model admits is never replayed.
 bool ReplayTrace(const System& system, const Property& property, Trace& trace,
                  const ReplayOptions& options = {});
 

@@ -687,7 +687,8 @@ RandomHybridAutomaton IssueTank() {
   const ht::RandomSum h{{{1.0, {"h"}}}};
   a.modes = {{"fill",
               {{"h", ht::RandomSum{{{0.5, {}}, {1.0, {"d"}}}}}},
-              {{h, ht::RandomRelation::kLessEqual, 8.0}}}};
+              {{h, ht::RandomRelation::kLessEqual, 8.0}},
+              {}}};
   a.inits = {{"fill", {{"h", {5.0, 5.0}}}}};
   ht::RandomPredicate below_6, above_7;
   below_6.comparison = {h, ht::RandomRelation::kLessEqual, 6.0};
@@ -733,7 +734,7 @@ std::vector<std::pair<std::string, RandomHybridAutomaton>> KnownCases() {
   vard.name = "a";
   vard.variables = {{"x", std::nullopt}, {"d", std::nullopt}};
   vard.declaration_order = {{0, 0}, {0, 1}};
-  vard.modes = {{"m", {{"x", Rate(1.0)}}, {}}};
+  vard.modes = {{"m", {{"x", Rate(1.0)}}, {}, {}}};
   vard.inits = {{"m", {{"x", {0.0, 0.0}}, {"d", {-1.0, -1.0}}}}};
   vard.properties = {{"p", K::kNever,
                       Both(ht::RandomPredicate::Kind::kAnd, Atom(Compare("x", R::kGreaterEqual, 2)),
@@ -745,7 +746,7 @@ std::vector<std::pair<std::string, RandomHybridAutomaton>> KnownCases() {
   strict.name = "a";
   strict.variables = {{"x", std::nullopt}};
   strict.declaration_order = {{0, 0}};
-  strict.modes = {{"run", {{"x", Rate(1.0)}}, {}}, {"stop", {}, {}}};
+  strict.modes = {{"run", {{"x", Rate(1.0)}}, {}, {}}, {"stop", {}, {}, {}}};
   strict.transitions = {{"go", "run", "stop", {Compare("x", R::kGreater, 1)}, {}, {}}};
   strict.inits = {{"run", {{"x", {0.0, 0.0}}}}};
   strict.properties = {{"p", K::kAlways, InMode("run"), std::nullopt},
@@ -757,7 +758,7 @@ std::vector<std::pair<std::string, RandomHybridAutomaton>> KnownCases() {
   start.variables = {{"x", std::nullopt}};
   start.inputs = {{"u", 1.0, 2.0}};
   start.declaration_order = {{0, 0}, {1, 0}};
-  start.modes = {{"m", {}, {}}};
+  start.modes = {{"m", {}, {}, {}}};
   start.inits = {{"m", {{"x", {0.0, 0.0}}}}};
   start.properties = {{"f", K::kAlways, Atom(Compare("x", R::kGreaterEqual, 100)), std::nullopt},
                       {"r", K::kReach, Atom(Compare("x", R::kLessEqual, 8.5)), std::nullopt}};
@@ -767,7 +768,7 @@ std::vector<std::pair<std::string, RandomHybridAutomaton>> KnownCases() {
   mix.name = "mix";
   mix.variables = {{"x", std::nullopt}, {"y", std::nullopt}};
   mix.declaration_order = {{0, 0}, {0, 1}};
-  mix.modes = {{"a", {}, {}}, {"b", {{"x", Term(-0.5, "x")}}, {}}};
+  mix.modes = {{"a", {}, {}, {}}, {"b", {{"x", Term(-0.5, "x")}}, {}, {}}};
   mix.inits = {{"a", {{"x", {0.0, 1.0}}, {"y", {0.0, 0.0}}}},
                {"b", {{"x", {5.0, 6.0}}, {"y", {10.0, 10.0}}}}};
   mix.properties = {
@@ -841,8 +842,8 @@ TEST(SoundnessTest, LazyChoicesFireEarly) {
   a.declaration_order = {{0, 0}};
   const ht::RandomSum x{{{1.0, {"x"}}}};
   a.modes = {
-      {"up", {{"x", ht::RandomSum{{{1.0, {}}}}}}, {{x, ht::RandomRelation::kLessEqual, 5.0}}},
-      {"down", {}, {}}};
+      {"up", {{"x", ht::RandomSum{{{1.0, {}}}}}}, {{x, ht::RandomRelation::kLessEqual, 5.0}}, {}},
+      {"down", {}, {}, {}}};
   ht::RandomTransition t;
   t.name = "fall";
   t.source = "up";
