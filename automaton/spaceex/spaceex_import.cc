@@ -184,6 +184,8 @@ class Translator {
   std::string ParamLine(const Instance& inst, const SxParam& p) const;
   const Bound& InitialBound(const Instance& inst, const std::string& param) const;
   std::string Forbidden(const Located& f, const SxFormula& node) const;
+  Lines SystemLines(const SxComponent& system, const std::vector<std::string>& automaton_of,
+                    const std::optional<Located>& forbidden) const;
   Translation Emit(const SxComponent& system);
 
   const SpaceExDocument& doc_;
@@ -764,6 +766,38 @@ std::string Join(const std::vector<std::string>& lines) {
   return out;
 }
 
+// The `system` block of a network: one instance per bind, then the property.
+Lines Translator::SystemLines(const SxComponent& system,
+                              const std::vector<std::string>& automaton_of,
+                              const std::optional<Located>& forbidden) const {
+  Lines out;
+  out.Add("", {doc_.file(), 1, 1});
+  out.Add("system " + Names().Add(system.id, At(system.offset), "component") + " {",
+          At(system.offset));
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    const Instance& inst = instances_[i];
+    std::string binds;
+    for (const SxParam& p : inst.tmpl->sx->params) {
+      const Target& target = inst.targets.at(p.name);
+      const std::string& ours = *inst.tmpl->names.Find(p.name);
+      if (!inst.tmpl->used.count(p.name) || !target.constant.empty() ||
+          target.our_name == inst.name + "." + ours) {
+        continue;
+      }
+      binds += " " + ours + " = " + target.our_name + ";";
+    }
+    out.Add("  instance " + inst.name + " = " + automaton_of[i] +
+                (binds.empty() ? ";" : " {" + binds + " }"),
+            inst.at);
+  }
+  if (forbidden) {
+    out.Add("  property forbidden: never " + Forbidden(*forbidden, forbidden->formula) + ";",
+            forbidden->where(0));
+  }
+  out.Add("}", At(system.offset));
+  return out;
+}
+
 Translation Translator::Emit(const SxComponent& system) {
   Lines out;
   const Origin top{doc_.file(), 1, 1};
@@ -804,32 +838,7 @@ Translation Translator::Emit(const SxComponent& system) {
     }
     out.Add("}", At(inst.tmpl->sx->offset));
   }
-  if (system.IsNetwork()) {
-    out.Add("", top);
-    out.Add("system " + Names().Add(system.id, At(system.offset), "component") + " {",
-            At(system.offset));
-    for (std::size_t i = 0; i < instances_.size(); ++i) {
-      const Instance& inst = instances_[i];
-      std::string binds;
-      for (const SxParam& p : inst.tmpl->sx->params) {
-        const Target& target = inst.targets.at(p.name);
-        const std::string& ours = *inst.tmpl->names.Find(p.name);
-        if (!inst.tmpl->used.count(p.name) || !target.constant.empty() ||
-            target.our_name == inst.name + "." + ours) {
-          continue;
-        }
-        binds += " " + ours + " = " + target.our_name + ";";
-      }
-      out.Add("  instance " + inst.name + " = " + automaton_of[i] +
-                  (binds.empty() ? ";" : " {" + binds + " }"),
-              inst.at);
-    }
-    if (forbidden) {
-      out.Add("  property forbidden: never " + Forbidden(*forbidden, forbidden->formula) + ";",
-              forbidden->where(0));
-    }
-    out.Add("}", At(system.offset));
-  }
+  if (system.IsNetwork()) out.Append(SystemLines(system, automaton_of, forbidden));
   return {Join(out.text), out.origins, notes_};
 }
 
