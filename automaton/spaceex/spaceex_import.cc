@@ -175,8 +175,8 @@ class Translator {
   std::string InitialBoundSide(const Located& f, const SxFormula& side) const;
 
   std::string TemplateName(const Template& t, const std::string& name) const;
-  std::string Expr(const Template& t, const Located& f, const SxFormula& e) const;
-  std::string Conjunction(const Template& t, const Located& f, const char* what) const;
+  static std::string Expr(const Template& t, const SxFormula& e);
+  static std::string Conjunction(const Template& t, const Located& f);
   Lines AutomatonBody(const Instance& inst) const;
   void ModeLines(const Instance& inst, std::size_t l, Lines& out) const;
   void TransitionLines(const Instance& inst, std::size_t i, Lines& out) const;
@@ -576,20 +576,18 @@ void Translator::ReadInitially() {
   }
 }
 
-std::string Translator::Expr(const Template& t, const Located& f, const SxFormula& e) const {
-  (void)f;
+std::string Translator::Expr(const Template& t, const SxFormula& e) {
   return WriteExpression(e, [&t](const SxFormula& n) { return *t.names.Find(n.text); });
 }
 
 // A guard or invariant: comparisons joined by `and`.
-std::string Translator::Conjunction(const Template& t, const Located& f, const char* what) const {
-  (void)what;
+std::string Translator::Conjunction(const Template& t, const Located& f) {
   std::string out;
   for (const SxFormula* c : f.formula.Conjuncts()) {
     if (!out.empty()) out += " and ";
     out += c->kind == Kind::kFalse
                ? "1 < 0"
-               : Expr(t, f, c->children[0]) + " " + c->text + " " + Expr(t, f, c->children[1]);
+               : Expr(t, c->children[0]) + " " + c->text + " " + Expr(t, c->children[1]);
   }
   return out;
 }
@@ -621,16 +619,13 @@ void Translator::ModeLines(const Instance& inst, std::size_t l, Lines& out) cons
     if (it == t.flows[l].end() || inst.dropped_flows.count(p.name) || !t.used.count(p.name))
       continue;
     const Flow& f = it->second;
-    const Located& formula = *t.flow_formulas[l];
     const std::string& x = *t.names.Find(p.name);
-    out.Add(f.equal ? "    " + x + "' = " + Expr(t, formula, *f.equal) + ";"
-                    : "    " + x + "' in [" + Expr(t, formula, *f.lo) + ", " +
-                          Expr(t, formula, *f.hi) + "];",
+    out.Add(f.equal ? "    " + x + "' = " + Expr(t, *f.equal) + ";"
+                    : "    " + x + "' in [" + Expr(t, *f.lo) + ", " + Expr(t, *f.hi) + "];",
             f.at);
   }
   if (t.invariants[l] && !t.invariants[l]->formula.Conjuncts().empty()) {
-    out.Add("    inv " + Conjunction(t, *t.invariants[l], "invariants") + ";",
-            t.invariants[l]->where(0));
+    out.Add("    inv " + Conjunction(t, *t.invariants[l]) + ";", t.invariants[l]->where(0));
   }
   out.Add("  }", at);
 }
@@ -642,7 +637,7 @@ void Translator::TransitionLines(const Instance& inst, std::size_t i, Lines& out
   out.Add("  transition " + t.mode_of_id.at(tr.source) + " -> " + t.mode_of_id.at(tr.target) + " {",
           at);
   if (const auto& guard = t.guards[i]; guard && !guard->formula.Conjuncts().empty()) {
-    out.Add("    guard " + Conjunction(t, *guard, "guards") + ";", guard->where(0));
+    out.Add("    guard " + Conjunction(t, *guard) + ";", guard->where(0));
   }
   if (const auto& assignment = t.assignments[i]) {
     std::string resets;
@@ -659,8 +654,7 @@ void Translator::TransitionLines(const Instance& inst, std::size_t i, Lines& out
       }
       const SxFormula& e = c->children[1];
       if (e.kind == Kind::kName && e.text == x.text && !e.primed) continue;  // x := x
-      resets +=
-          (resets.empty() ? "" : ", ") + *t.names.Find(x.text) + " := " + Expr(t, *assignment, e);
+      resets += (resets.empty() ? "" : ", ") + *t.names.Find(x.text) + " := " + Expr(t, e);
     }
     if (!resets.empty()) out.Add("    reset " + resets + ";", assignment->where(0));
   }
@@ -813,20 +807,22 @@ Translation Translator::Emit(const SxComponent& system) {
   std::optional<Located> forbidden;
   if (const auto value = cfg_ ? cfg_->Find("forbidden") : std::nullopt)
     forbidden = ParseOption(*value);
+  std::vector<Lines> body_of;
+  std::map<const Template*, std::set<std::string>> bodies;  // distinct bodies per template
+  for (const Instance& inst : instances_) {
+    body_of.push_back(AutomatonBody(inst));
+    bodies[inst.tmpl].insert(Join(body_of.back().text));
+  }
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     const Instance& inst = instances_[i];
-    const Lines body = AutomatonBody(inst);
-    std::set<std::string> bodies;
-    for (const Instance& other : instances_) {
-      if (other.tmpl == inst.tmpl) bodies.insert(Join(AutomatonBody(other).text));
-    }
+    const Lines& body = body_of[i];
     const std::string key = inst.tmpl->sx->id + "\n" + Join(body.text);
     if (const auto it = name_of_body.find(key); it != name_of_body.end()) {
       automaton_of[i] = it->second;
       continue;
     }
     const std::string name = automata.Add(
-        bodies.size() == 1 ? inst.tmpl->sx->id : inst.tmpl->sx->id + "_" + inst.sx_name,
+        bodies[inst.tmpl].size() == 1 ? inst.tmpl->sx->id : inst.tmpl->sx->id + "_" + inst.sx_name,
         At(inst.tmpl->sx->offset), "component");
     name_of_body[key] = automaton_of[i] = name;
     out.Add("", top);
