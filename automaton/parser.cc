@@ -1308,6 +1308,8 @@ System ParseModel(std::string_view text, const std::string& file_name) {
   });
 }
 
+std::string ReadModelText(const std::filesystem::path& path) { return ReadFile(path); }
+
 System ParseModelFile(const std::filesystem::path& path) {
   return ParseModel(ReadFile(path), path.string());
 }

@@ -46,6 +46,11 @@ inline constexpr int kMaxImportDepth = 64;
 /// anything else for bad input.
 System ParseModel(std::string_view text, const std::string& file_name);
 
+/// The whole content of the model file `path` (of any language), read as a stream (pipes and
+/// /dev/stdin work). Throws ParseError (line 0, column 0) when it cannot be read, is a directory,
+/// or is larger than kMaxModelFileBytes.
+std::string ReadModelText(const std::filesystem::path& path);
+
 /// Reads and parses a model file. The file is read as a stream, so a pipe, a FIFO or /dev/stdin
 /// works like a regular file. Throws ParseError (with line 0, column 0 when the file cannot be
 /// read, is a directory, or is larger than kMaxModelFileBytes).

@@ -2,14 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cstdlib>
-#include <cstring>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <set>
-#include <sstream>
 #include <utility>
 
 #include "automaton/parser.h"
@@ -862,25 +858,6 @@ Translation Translator::Run() {
   return Emit(system);
 }
 
-// Reads a whole file for the import (ParseError at line 0 when it cannot).
-std::string ReadFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ParseError(path.string(), 0, 0, "cannot read file: it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw ParseError(path.string(), 0, 0, "cannot read file: " + std::string(std::strerror(errno)));
-  std::string text;
-  char buffer[1 << 16];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-    text.append(buffer, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxModelFileBytes) {
-      throw ParseError(path.string(), 0, 0, "file larger than 4 MiB");
-    }
-  }
-  return text;
-}
-
 }  // namespace
 
 System Translation::Parse(const std::string& name) const {
@@ -913,8 +890,8 @@ std::optional<std::filesystem::path> DefaultConfigFile(const std::filesystem::pa
 Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg) {
   const std::optional<std::filesystem::path> cfg_path = cfg ? cfg : DefaultConfigFile(xml);
-  const std::string xml_text = ReadFile(xml);
-  const std::string cfg_text = cfg_path ? ReadFile(*cfg_path) : std::string();
+  const std::string xml_text = ReadModelText(xml);
+  const std::string cfg_text = cfg_path ? ReadModelText(*cfg_path) : std::string();
   return TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path ? cfg_path->string() : "");
 }
 
