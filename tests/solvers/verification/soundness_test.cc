@@ -263,7 +263,6 @@ double DrawInRange(std::mt19937_64& rng, double lo, double hi, double nominal) {
   return std::clamp(ht::UniformReal(rng, lo, hi), lo, hi);
 }
 
-/// A random run of `a` for an attack.
 // The variables that have a rectangular rate in some mode of `a`.
 std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
   std::set<std::string> out;
@@ -273,6 +272,7 @@ std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
   return out;
 }
 
+/// A random run of `a` for an attack.
 ConcreteRun DrawAttack(const RandomHybridAutomaton& a, std::mt19937_64& rng) {
   ConcreteRun run{a, {}, {}, {}, "", {}};
   RandomHybridAutomaton& c = run.automaton;
@@ -496,7 +496,6 @@ ConcreteRun TraceRun(const RandomHybridAutomaton& a, const System& system, const
       scenario.steps.emplace_back(ht::RateInput(v),
                                   std::vector<std::pair<double, double>>{{0.0, 0.5}});
   }
-
   c.scenario = scenario;
   run.schedule = t.schedule;  // transition indices: the text keeps the declaration order
   for (const ScheduledJump& j : t.schedule) run.sample_times.push_back(j.time);
