@@ -232,8 +232,17 @@ struct LinearHybridSystem::Forms {
   }
 };
 
-LinearHybridSystem::LinearHybridSystem(const System& system, bool clock)
+LinearHybridSystem::LinearHybridSystem(const System& system, bool clock,
+                                       const std::vector<const Property*>& observed)
     : system_(system), forms_(new Forms{system, {}, {}, {}, {}, 0}) {
+  std::vector<int> read;
+  for (const Property* p : observed) {
+    p->predicate.ForEachComparison([&read](const Comparison& c) {
+      for (const int s : c.lhs.Slots()) read.push_back(s);
+      for (const int s : c.rhs.Slots()) read.push_back(s);
+    });
+  }
+  liveness_ = std::make_unique<VariableLiveness>(system, read);
   const SymbolTable& symbols = system.symbols();
   const int n = symbols.size();
   Forms& f = *forms_;
@@ -343,6 +352,11 @@ LinearLocation LinearHybridSystem::Build(const std::vector<int>& tuple) const {
   }
   loc.invariant_set = Polyhedron(loc.invariant);
   loc.elapse_set = Polyhedron(loc.elapse_invariant);
+  for (int c = 0; c < static_cast<int>(tuple.size()); ++c) {
+    for (const int s : liveness_->DeadAt(c, tuple[static_cast<size_t>(c)])) {
+      loc.dead.push_back(f.dim_of_slot[static_cast<size_t>(s)]);
+    }
+  }
   return loc;
 }
 

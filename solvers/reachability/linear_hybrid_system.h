@@ -9,6 +9,7 @@
 
 #include "automaton/system.h"
 #include "solvers/reachability/convex_polyhedron.h"
+#include "solvers/reachability/variable_liveness.h"
 
 namespace hybrid {
 
@@ -54,6 +55,9 @@ struct LinearLocation {
   std::string name;
   /// The discrete variables' values in this location (System slots).
   std::vector<std::pair<int, int>> discrete_values;
+  /// Variable dimensions dead here (VariableLiveness): nothing reads them before a reset writes
+  /// them, so exploration may forget their values on entry.
+  std::vector<int> dead;
 };
 
 /// The linear hybrid automaton behind a System, built location by location as exploration
@@ -76,8 +80,10 @@ class LinearHybridSystem {
     using std::invalid_argument::invalid_argument;
   };
 
-  /// The view of `system`; with `clock`, a clock dimension is added.
-  LinearHybridSystem(const System& system, bool clock);
+  /// The view of `system`; with `clock`, a clock dimension is added. `observed`: the properties
+  /// to be checked (the variables they read are live in every location).
+  LinearHybridSystem(const System& system, bool clock,
+                     const std::vector<const Property*>& observed);
   ~LinearHybridSystem();
 
   const System& system() const { return system_; }
@@ -131,6 +137,7 @@ class LinearHybridSystem {
   std::vector<int> inputs_;
   std::vector<std::pair<double, double>> input_bounds_;
   std::unique_ptr<Forms> forms_;
+  std::unique_ptr<VariableLiveness> liveness_;
   std::map<std::vector<int>, LinearLocation> locations_;
 };
 

@@ -55,9 +55,10 @@ bool MayContain(const Box& outer, const Box& inner) {
 struct Node {
   std::vector<int> tuple;
   ConvexPolyhedron set;
-  int parent = -1;  // -1 for an initial state
-  int edge = -1;    // index into the parent location's edges, or of the initial set
-  Box box = {};     // BoxOf(set), once pushed
+  int parent = -1;        // -1 for an initial state
+  int edge = -1;          // index into the parent location's edges, or of the initial set
+  Box box = {};           // BoxOf(set), once pushed
+  bool subsumed = false;  // contained in a state pushed after it at its location
 };
 
 // What is known about one property during the exploration.
@@ -74,23 +75,56 @@ struct Goal {
 // symbolic states whose runs do not replay would otherwise cost a pre-image walk per state.
 constexpr int kMaxConcretizations = 32;
 
-// The time-elapse successor of `set` in `loc`, kept inside its elapse invariant and `extra`.
-// `set` (entry states, inside the invariant) is reachable at once; time elapses only from its
-// states inside the elapse invariant (an urgent guard that holds on entry fires at once). The
-// result is the convex hull of both parts (exact when the entry states all lie inside the
-// elapse invariant, as usual; an over-approximation otherwise).
+// The time-elapse successor of `set` in `loc`, kept inside its elapse invariant and `extra` (none
+// if null). `set` (entry states, inside the invariant) is reachable at once; time elapses only
+// from its states inside the elapse invariant (an urgent guard that holds on entry fires at
+// once). The result is the convex hull of both parts (exact when the entry states all lie inside
+// the elapse invariant, as usual; an over-approximation otherwise). Where the elapse invariant is
+// the invariant (no urgent guard stops time), `set` lies inside it and inside its own time
+// elapse, so neither is tested.
 ConvexPolyhedron Flow(const LinearLocation& loc, ConvexPolyhedron set,
-                      const ConvexPolyhedron& extra) {
-  set.Intersect(extra);
-  if (set.IsEmpty()) return set;
+                      const ConvexPolyhedron* extra) {
+  if (extra) {
+    set.Intersect(*extra);
+    if (set.IsEmpty()) return set;
+  }
+  if (loc.elapse_invariant.size() == loc.invariant.size()) {
+    set.TimeElapse(loc.rates);
+    if (!loc.invariant.empty()) set.Intersect(loc.invariant_set);
+    if (extra) set.Intersect(*extra);
+    return set;
+  }
   ConvexPolyhedron flowing = set;
   flowing.Intersect(loc.elapse_set);
   if (flowing.IsEmpty()) return set;
   flowing.TimeElapse(loc.rates);
   flowing.Intersect(loc.elapse_set);
-  flowing.Intersect(extra);
+  if (extra) flowing.Intersect(*extra);
   if (!flowing.Contains(set)) flowing.Hull(set);
   return flowing;
+}
+
+// Whether no point of `box` satisfies `guard`, as far as interval arithmetic on the box tells
+// with a relative margin of 1e-9 (false whenever in doubt): lets Expand skip an edge without a
+// polyhedron operation.
+bool CertainlyMisses(const Box& box, const Conjunction& guard) {
+  for (const LinearConstraint& c : guard) {
+    double lo = c.b, hi = c.b, scale = std::abs(c.b);
+    for (size_t i = 0; i < c.a.size(); ++i) {
+      const double a = c.a[i];
+      if (a == 0.0) continue;
+      const double from = a > 0 ? box.lo_down[i] : box.hi_up[i];
+      const double to = a > 0 ? box.hi_up[i] : box.lo_down[i];
+      lo += a * from;
+      hi += a * to;
+      scale += std::abs(a) * std::max(std::abs(from), std::abs(to));
+    }
+    if (!std::isfinite(scale)) continue;
+    const double margin = 1e-9 * (1.0 + scale);
+    if (lo > margin) return true;  // c.a x + c.b > 0 on the whole box
+    if (c.kind == Kind::kEqual && hi < -margin) return true;
+  }
+  return false;
 }
 
 // `p` with `count` unconstrained dimensions added after its own.
@@ -104,6 +138,18 @@ std::vector<double> Unit(int n, int i) {
   std::vector<double> e(static_cast<size_t>(n), 0.0);
   e[static_cast<size_t>(i)] = 1.0;
   return e;
+}
+
+std::vector<const Property*> PropertiesOf(const std::vector<Goal>& goals) {
+  std::vector<const Property*> out;
+  for (const Goal& g : goals) out.push_back(g.property);
+  return out;
+}
+
+// `set` (entry states of `loc`) with the values of the variables dead at `loc` forgotten.
+ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set) {
+  for (const int d : loc.dead) set.Unconstrain(d);
+  return set;
 }
 
 // A concrete run along a path, as Explorer::Concretize picks it: the values of the dimensions at
@@ -125,7 +171,7 @@ class Explorer {
   Explorer(const System& system, std::vector<Goal> goals, std::optional<double> horizon,
            const PolyhedralReachability::Options& options)
       : system_(system),
-        lhs_(system, horizon.has_value()),
+        lhs_(system, horizon.has_value(), PropertiesOf(goals)),
         goals_(std::move(goals)),
         options_(options),
         initial_(lhs_.InitialSets()),
@@ -145,9 +191,9 @@ class Explorer {
     start_ = ThreadCpuSeconds();
     for (int i = 0; i < static_cast<int>(initial_.size()); ++i) {
       const LinearLocation& loc = lhs_.At(initial_[i].tuple);
-      ConvexPolyhedron set = initial_[i].set;
+      ConvexPolyhedron set = Forgetting(loc, initial_[i].set);
       set.Intersect(loc.invariant_set);
-      Push({initial_[i].tuple, Flow(loc, std::move(set), horizon_set_), -1, i});
+      Push({initial_[i].tuple, Flow(loc, std::move(set), Horizon()), -1, i});
     }
     std::string stopped;
     while (!queue_.empty() && !AllDecided()) {
@@ -162,12 +208,15 @@ class Explorer {
       }
       const int n = queue_.front();
       queue_.pop_front();
-      Expand(n);
+      if (!nodes_[n].subsumed) Expand(n);
     }
     Finish(stopped);
   }
 
  private:
+  // The horizon's states, or null without a horizon.
+  const ConvexPolyhedron* Horizon() const { return horizon_.empty() ? nullptr : &horizon_set_; }
+
   bool AllDecided() const {
     return std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
   }
@@ -178,26 +227,43 @@ class Explorer {
     const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
     for (int e = 0; e < static_cast<int>(loc.edges.size()); ++e) {
       const LinearEdge& edge = loc.edges[static_cast<size_t>(e)];
+      if (CertainlyMisses(nodes_[n].box, edge.guard)) continue;
       ConvexPolyhedron set = nodes_[n].set;
-      set.Intersect(edge.guard_set);
-      if (set.IsEmpty()) continue;
+      if (!edge.guard.empty()) {
+        set.Intersect(edge.guard_set);
+        if (set.IsEmpty()) continue;
+      }
       set.Assign(edge.resets);
       const LinearLocation& target = lhs_.At(edge.target);
-      set.Intersect(target.invariant_set);
-      if (set.IsEmpty()) continue;
-      Push({edge.target, Flow(target, std::move(set), horizon_set_), n, e});
+      set = Forgetting(target, std::move(set));
+      if (!target.invariant.empty()) {  // else every state (and `set` is not empty)
+        set.Intersect(target.invariant_set);
+        if (set.IsEmpty()) continue;
+      }
+      // Where time elapse is exact (Flow), a state found before contains the flow of every set
+      // of entry states it contains: such an entry set is dropped before its flow is computed.
+      if (target.elapse_invariant.size() == target.invariant.size() &&
+          Covered(edge.target, set, BoxOf(set))) {
+        continue;
+      }
+      Push({edge.target, Flow(target, std::move(set), Horizon()), n, e});
     }
   }
 
   // Adds `node` unless it is empty or contained in a state found before at its location (their
-  // bounding boxes rule most out cheaply); checks the goals on it.
+  // bounding boxes rule most out cheaply); checks the goals on it. The states found before that
+  // `node` contains no longer count at the location (`node` covers them), and those not yet
+  // expanded never will be: `node`'s successors contain theirs.
   void Push(Node node) {
     if (node.set.IsEmpty()) return;
     node.box = BoxOf(node.set);
+    if (Covered(node.tuple, node.set, node.box)) return;
     std::vector<int>& here = passed_[node.tuple];
-    for (const int i : here) {
-      if (MayContain(nodes_[i].box, node.box) && nodes_[i].set.Contains(node.set)) return;
-    }
+    std::erase_if(here, [&](int i) {
+      if (!MayContain(node.box, nodes_[i].box) || !node.set.Contains(nodes_[i].set)) return false;
+      nodes_[i].subsumed = true;
+      return true;
+    });
     const int index = static_cast<int>(nodes_.size());
     nodes_.push_back(std::move(node));
     here.push_back(index);
@@ -205,6 +271,14 @@ class Explorer {
     for (int g = 0; g < static_cast<int>(goals_.size()); ++g) {
       if (!goals_[g].decided) CheckGoal(g, index);
     }
+  }
+
+  // Whether `set` (with bounding box `box`) lies inside a state found before at `tuple`.
+  bool Covered(const std::vector<int>& tuple, const ConvexPolyhedron& set, const Box& box) {
+    for (const int i : passed_[tuple]) {
+      if (MayContain(nodes_[i].box, box) && nodes_[i].set.Contains(set)) return true;
+    }
+    return false;
   }
 
   // The bad (target) states of goal g at `loc`: where an `always` predicate fails, where a
@@ -502,7 +576,9 @@ void Explorer::Finish(const std::string& stopped) {
 bool PolyhedralReachability::Handles(const System& system, const std::vector<Property>& properties,
                                      std::string* why) {
   try {
-    LinearHybridSystem lhs(system, false);
+    std::vector<const Property*> observed;
+    for (const Property& p : properties) observed.push_back(&p);
+    LinearHybridSystem lhs(system, false, observed);
     const std::vector<LinearHybridSystem::Initial> initial = lhs.InitialSets();
     if (initial.empty()) {
       *why = "no initial state";
