@@ -16,9 +16,13 @@ namespace hybrid {
 /// From the initial sets, each symbolic state (a location and a convex polyhedron) is let flow
 /// (time elapse at the location's rates, kept inside its invariant and stopped where an urgent
 /// single-inequality guard starts to hold), then every edge is taken (guard, reset, target
-/// invariant). A new state contained in one already found at its location is dropped; when none
-/// is left the reachable set is complete (a fixpoint) and every property it does not meet is
-/// `proved` (`unreachable` for `reach`). A state that meets a property's bad (target) states is
+/// invariant). On entering a location the values of the variables dead there are forgotten
+/// (VariableLiveness: nothing reads them before a reset writes them; the variables the checked
+/// properties read are never dead), so states that differ only in them coincide. A new state
+/// contained in one already found at its location is dropped (before its time elapse where that is
+/// exact), and states it contains are not expanded; when none is left the reachable set is
+/// complete (a fixpoint) and every property it does not meet is `proved` (`unreachable` for
+/// `reach`): exact on the live variables. A state that meets a property's bad (target) states is
 /// turned into a concrete run along its path, exactly: the states from which the rest of the path
 /// reaches the bad states with a margin are propagated backward (inverse time elapse, guard,
 /// reset pre-image), the margin (at most 1) is maximised over the initial set, and the run is
