@@ -1,7 +1,9 @@
 #include "gripper/finger_closed_form.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -251,6 +253,27 @@ void FingerClosedForm::PackEnds() {
   for (size_t k = 0; k < pieces_.size(); ++k) ends_[k] = pieces_[k].g1;
 }
 
+namespace {
+
+// The fraction of phase 3's way done, (1 - f) / f (g - g_s) / (255 - g) clamped to [0, 1], from
+// moved = g - g_s >= 0 and rest = 255 - g >= 0, without branches (At is called with random g).
+// rest is 0 only at g = 255, where the fraction is 1 once anything moved and 0 otherwise: the
+// division by the smallest normal double gives a huge (or infinite) ratio or 0 there; any
+// positive rest (at least an ulp of 255) is itself.
+inline double Phase3Fraction(double moved, double rest, double m3_scale) {
+  const double ratio = (m3_scale * moved) / std::max(rest, std::numeric_limits<double>::min());
+  return std::min(std::max(ratio, 0.0), 1.0);
+}
+
+void CheckMotorRange(double g, double motor_max) {
+  if (!(g >= 0.0 && g <= motor_max)) {
+    throw std::out_of_range("FingerClosedForm::At: g = " + std::to_string(g) +
+                            " is outside the motor range [0, " + std::to_string(motor_max) + "]");
+  }
+}
+
+}  // namespace
+
 Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
   // Branch-free (At is called with random g): linear part plus the phase-3 term, which is 0
   // outside phase 3 (span3 = 0).
@@ -258,25 +281,59 @@ Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
   const double rest = parameters_.motor_max - g;
   // (1 - f) / f (g - g_s) / (255 - g), which reaches 1 the fraction f of the way from g_s to
   // 255; clamped there. At g = g_s = 255 nothing has moved: 0.
-  const double scaled = parameters_.m3_scale() * moved;
-  const double ratio = scaled / (rest > 0.0 ? rest : 1.0);
-  const double fraction = moved > 0.0 && scaled >= rest ? 1.0 : std::clamp(ratio, 0.0, 1.0);
   Eigen::Vector3d theta = piece.theta0 + piece.rate * moved;
-  theta[2] += piece.span3 * fraction;
+  theta[2] += piece.span3 * Phase3Fraction(moved, rest, parameters_.m3_scale());
   return theta;
 }
 
-FingerConfiguration FingerClosedForm::At(double g) const {
-  if (!(g >= 0.0 && g <= parameters_.motor_max)) {
-    throw std::out_of_range("FingerClosedForm::At: g = " + std::to_string(g) +
-                            " is outside the motor range [0, " +
-                            std::to_string(parameters_.motor_max) + "]");
-  }
+const FingerClosedForm::Piece& FingerClosedForm::PieceAt(double g) const {
   // The piece index is the number of piece ends below g (ends_ is sorted; unused entries are
   // +inf and the last piece ends at motor_max >= g), counted without branches.
   size_t k = 0;
   for (double end : ends_) k += g > end ? 1 : 0;
-  const Piece& piece = pieces_[k];
+  return pieces_[k];
+}
+
+void FingerClosedForm::AnglesAt(std::span<const double> g, std::span<double> theta) const {
+  if (theta.size() != 3 * g.size()) {
+    throw std::invalid_argument("FingerClosedForm::AnglesAt: 3 angles per motor position");
+  }
+  for (const double x : g) CheckMotorRange(x, parameters_.motor_max);
+  // Evaluate's arithmetic on the pieces laid out column by column (at most 8), so that the loop
+  // below is straight-line code the compiler can keep in registers.
+  struct Columns {
+    std::array<double, 8> g0{}, g1{}, t0{}, t1{}, t2{}, r0{}, r1{}, r2{}, span3{};
+  } p;
+  for (size_t k = 0; k < pieces_.size(); ++k) {
+    const Piece& q = pieces_[k];
+    p.g0[k] = q.g0;
+    p.g1[k] = q.g1;
+    p.t0[k] = q.theta0[0];
+    p.t1[k] = q.theta0[1];
+    p.t2[k] = q.theta0[2];
+    p.r0[k] = q.rate[0];
+    p.r1[k] = q.rate[1];
+    p.r2[k] = q.rate[2];
+    p.span3[k] = q.span3;
+  }
+  const double motor_max = parameters_.motor_max;
+  const double m3_scale = parameters_.m3_scale();
+  for (size_t i = 0; i < g.size(); ++i) {
+    size_t k = 0;
+    for (double end : ends_) k += g[i] > end ? 1 : 0;
+    // As Evaluate(pieces_[k], min(g, g1)), operation for operation (the same values).
+    const double x = std::min(g[i], p.g1[k]);
+    const double moved = x - p.g0[k];
+    const double fraction = Phase3Fraction(moved, motor_max - x, m3_scale);
+    theta[3 * i] = p.t0[k] + p.r0[k] * moved;
+    theta[3 * i + 1] = p.t1[k] + p.r1[k] * moved;
+    theta[3 * i + 2] = (p.t2[k] + p.r2[k] * moved) + p.span3[k] * fraction;
+  }
+}
+
+FingerConfiguration FingerClosedForm::At(double g) const {
+  CheckMotorRange(g, parameters_.motor_max);
+  const Piece& piece = PieceAt(g);
   FingerConfiguration out;
   out.theta = Evaluate(piece, std::min(g, piece.g1));
   out.motor = std::min(g, stop_);

@@ -80,6 +80,12 @@ class FingerClosedForm {
   /// belong to the piece that ends there, as in the report's tables (g = 110 is phase 1).
   FingerConfiguration At(double g) const;
 
+  /// The joint angles At(g[k]).theta of every g[k], written to theta[3 k .. 3 k + 2] (the same
+  /// values, bit for bit), without the rest of the configuration: the batch form for many
+  /// queries. Precondition: theta.size() == 3 g.size(); throws std::out_of_range as At does for
+  /// the first g outside [0, motor_max] (nothing written then), std::invalid_argument on sizes.
+  void AnglesAt(std::span<const double> g, std::span<double> theta) const;
+
   /// The motor position where the finger stops (phase 4), or nullopt-like +inf when it is still
   /// moving at motor_max.
   double stop() const { return stop_; }
@@ -104,6 +110,7 @@ class FingerClosedForm {
   const FingerContacts& contacts() const { return contacts_; }
 
  private:
+  const Piece& PieceAt(double g) const;
   Eigen::Vector3d Evaluate(const Piece& piece, double g) const;
   void PackEnds();
 

@@ -317,10 +317,12 @@ std::string ReportText(const CheckArgs& args, const System& system, const Simula
 
 }  // namespace
 
-int RunCheck(const CheckArgs& args) {
+namespace {
+
+// Checks the chosen properties of `system` (and with --modes its discrete states).
+Findings FindingsOf(const CheckArgs& args, const System& system) {
   CheckOptions(args);
   const auto start = std::chrono::steady_clock::now();
-  const System system = spaceex::ReadModelFile(args.model);
   Findings found;
   found.chosen = ChosenProperties(args, DeclaredProperties(system));
   // One solver budget for the whole command: the properties, then --modes, draw from it.
@@ -336,6 +338,22 @@ int RunCheck(const CheckArgs& args) {
     }
   }
   found.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return found;
+}
+
+}  // namespace
+
+json CheckReport(const CheckArgs& args, const System& system, int* exit_code) {
+  const Findings found = FindingsOf(args, system);
+  const Simulator sim(system);
+  if (exit_code) *exit_code = ExitCode(found.results);
+  return ReportJson(args, system, sim, found);
+}
+
+int RunCheck(const CheckArgs& args) {
+  CheckOptions(args);
+  const System system = spaceex::ReadModelFile(args.model);
+  const Findings found = FindingsOf(args, system);
   const Simulator sim(system);
   const int code = ExitCode(found.results);
   if (args.json) {

@@ -1,8 +1,11 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "automaton/system.h"
 
 namespace hybrid::cli {
 
@@ -26,5 +29,10 @@ struct CheckArgs {
 /// bad options (an unknown property name, a method other than prove/sample, a depth outside
 /// [0, 1000], a non-positive budget), and OutputError when standard output cannot be written.
 int RunCheck(const CheckArgs& args);
+
+/// The report `hybrid check --json` writes (docs/cli.md) for `system` checked with `args`
+/// (`args.model` is only the name the report gives; `args.json` is ignored), and in `exit_code`
+/// (if not null) the exit code RunCheck would return. Throws as RunCheck for bad options.
+nlohmann::ordered_json CheckReport(const CheckArgs& args, const System& system, int* exit_code);
 
 }  // namespace hybrid::cli

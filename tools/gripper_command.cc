@@ -18,6 +18,7 @@
 #include "gripper/measured_data.h"
 #include "gripper/svg_figures.h"
 #include "solvers/simulation/simulator.h"
+#include "tools/finger_batch.h"
 #include "tools/options.h"
 #include "tools/output.h"
 #include "tools/user_message.h"
@@ -35,6 +36,9 @@ using gripper::Obstacle;
 using json = nlohmann::ordered_json;
 
 constexpr int kExitDisagrees = 5;
+// Most motor positions one batch (--queries, --g-range) answers: its output stays under about
+// 100 MB (CSV) or 150 MB (JSON).
+constexpr std::size_t kMaxBatchQueries = 1000000;
 constexpr double kAgreement = 1e-6;  // degrees: simulation against the closed form
 
 std::vector<Obstacle> ParseObjects(const std::vector<std::string>& texts) {
@@ -218,11 +222,31 @@ bool AnyGob(const FingerArgs& args) {
 
 // Validates the options of `hybrid finger` (throwing as RunFinger documents) and returns the
 // contact positions given by --gob1..3 (the others at their default). Turns a --g of -0 into 0.
+// The batch options (--queries, --g-range) and what they cannot be combined with.
+void CheckBatchArgs(const FingerArgs& args) {
+  if (args.queries.empty() && args.g_range.empty()) {
+    if (!args.output.empty()) throw UsageError("-o/--output needs --queries or --g-range");
+    return;
+  }
+  if (!args.queries.empty() && !args.g_range.empty()) {
+    throw UsageError("--queries and --g-range cannot be combined (one batch at a time)");
+  }
+  const char* batch = args.queries.empty() ? "--g-range" : "--queries";
+  if (args.g || !args.requests.empty() || args.simulate || !args.draw.empty() ||
+      !args.plot.empty()) {
+    throw UsageError(std::string(batch) +
+                     " cannot be combined with --g, --requests, --simulate, --draw or --plot");
+  }
+}
+
 FingerContacts CheckFingerArgs(FingerArgs& args) {
-  const std::vector<NamedFile> outputs = {{"--draw", args.draw}, {"--plot", args.plot}};
+  CheckBatchArgs(args);
+  const std::vector<NamedFile> outputs = {
+      {"--draw", args.draw}, {"--plot", args.plot}, {"-o/--output", args.output}};
   std::vector<NamedFile> inputs;
   if (!args.model.empty()) inputs.push_back({"--model", args.model});
   if (!args.data.empty()) inputs.push_back({"--data", args.data});
+  if (!args.queries.empty()) inputs.push_back({"--queries", args.queries});
   CheckDistinctFiles(inputs, outputs);
   CheckOutputPlaces(outputs);
   if (args.g) {
@@ -246,8 +270,10 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   if (!args.data.empty() && args.plot.empty()) {
     throw UsageError("--data needs --plot (it overlays the runs on the plot)");
   }
-  if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty()) {
-    throw std::invalid_argument("nothing to do: give --g, --requests, --draw or --plot");
+  if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty() &&
+      args.queries.empty() && args.g_range.empty()) {
+    throw std::invalid_argument(
+        "nothing to do: give --g, --queries, --g-range, --requests, --draw or --plot");
   }
   return contacts;
 }
@@ -609,6 +635,13 @@ int RunFinger(const FingerArgs& args_in) {
   const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
   const FingerClosedForm closed =
       geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
+  if (!args.queries.empty() || !args.g_range.empty()) {
+    const std::vector<double> g = args.queries.empty()
+                                      ? MotorRange(args.g_range, kMaxBatchQueries)
+                                      : ReadMotorPositions(args.queries, kMaxBatchQueries);
+    WriteOutput(args.output, args.json ? BatchJson(closed, g) : BatchCsv(closed, g));
+    return 0;
+  }
   json report = FingerReport(args, closed, geometric, objects);
   int code = 0;
   if (args.simulate) {

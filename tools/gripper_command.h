@@ -21,6 +21,9 @@ struct FingerArgs {
   std::string data;             ///< measured runs to overlay on --plot
   bool simulate = false;        ///< also simulate the automaton and compare
   std::string model;            ///< the finger automaton for --simulate
+  std::string queries;          ///< --queries: a file of motor positions (batch)
+  std::string g_range;          ///< --g-range START:STOP:COUNT (batch)
+  std::string output;           ///< -o/--output: where a batch's answers go ("-": stdout)
 };
 
 /// Options of `hybrid hand`.

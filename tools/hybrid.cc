@@ -228,7 +228,14 @@ void AddFinger(CLI::App& app, Commands& c) {
                       "A history of position requests R1,R2,... (each in [0, 255]): the settled "
                       "motor position, controller status and angles after each, as the gripper's "
                       "controller drives the motor (it stops where the finger stalls)");
-  finger->add_flag("--json", a.json, "Machine-readable output");
+  finger->add_option("--queries", a.queries,
+                     "Batch: a file of motor positions (header 'g', one per line); answers one "
+                     "CSV row (or JSON record) per position: g, motor, theta1..3, phase, mode");
+  finger->add_option("--g-range", a.g_range,
+                     "Batch: START:STOP:COUNT, COUNT positions evenly spaced from START to STOP");
+  finger->add_option("-o,--output", a.output,
+                     "Where a batch's answers go (default: standard output)");
+  finger->add_flag("--json", a.json, "Machine-readable output (a batch: a JSON array, else CSV)");
   finger->add_option("--draw", a.draw, "Write an SVG drawing of the finger (see --at)");
   AddNumberListOption(finger, "--at", &a.draw_at,
                       "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)");

@@ -23,6 +23,8 @@ packages=(
   clang libclang-rt-14-dev  # libFuzzer harnesses (tests/fuzz/, tools/fuzz.sh) and their sanitizer runtimes
   python3                # tools/generate_finger.py (checked by a test), benchmark scripts
   python3-scipy python3-numpy  # tools/compare_scipy.py: the finger simulated by solve_ivp
+  pybind11-dev python3-dev     # the Python module (python/, docs/python.md)
+  python3-pytest               # its test suite (tests/python/)
 )
 
 sudo_cmd=()

@@ -1,0 +1,42 @@
+from os import PathLike
+from typing import Any, Mapping, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+Signal = Union[float, Sequence[tuple[float, float]], str]
+
+class ModelError(ValueError): ...
+
+def finger_angles(
+    g: Union[float, npt.ArrayLike],
+    gob1: float | None = ...,
+    gob2: float | None = ...,
+    gob3: float | None = ...,
+    model: str | None = ...,
+) -> npt.NDArray[np.float64]: ...
+
+class Model:
+    def __init__(self, path: Union[str, PathLike[str]]) -> None: ...
+    @property
+    def path(self) -> str: ...
+    @property
+    def name(self) -> str: ...
+    def info(self) -> dict[str, Any]: ...
+    def dot(self, product: bool = ...) -> str: ...
+    def simulate(
+        self,
+        until: float | None = ...,
+        inputs: Mapping[str, Signal] | None = ...,
+        sample: float | None = ...,
+        parameters: Mapping[str, float] | None = ...,
+    ) -> dict[str, Any]: ...
+    def check(
+        self,
+        properties: Sequence[str] | None = ...,
+        method: str = ...,
+        budget: float = ...,
+        depth: int = ...,
+    ) -> dict[str, Any]: ...
+
+def load(path: Union[str, PathLike[str]]) -> Model: ...

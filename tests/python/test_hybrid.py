@@ -1,0 +1,163 @@
+"""Tests of the Python module `hybrid` (python/, docs/python.md), run by ctest (python_tests) with
+PYTHONPATH=build/python. Oracles written apart from the code under test: the plain-Python finger
+of tools/report_finger.py (the report's tables), the command line's answers
+(`hybrid finger --queries`, `hybrid info --json`, `hybrid check --json`), and analytic solutions
+(the thermostat's exponential relaxation, a constant-rate tank)."""
+
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import hybrid
+
+SOURCE = os.environ.get("HYBRID_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "tools", "hybrid"))
+sys.path.insert(0, os.path.join(SOURCE, "tools"))
+import report_finger  # noqa: E402
+
+CONTACTS = [{}, {"gob1": 80.0}, {"gob1": 80.0, "gob2": 150.0}, {"gob2": 50.0},
+            {"gob1": 60.0, "gob3": 200.0}, {"gob1": 140.0}, {"gob3": 30.0}]
+
+
+def run(*args):
+    return subprocess.run([BINARY, *args], capture_output=True, text=True)
+
+
+@pytest.mark.parametrize("contacts", CONTACTS)
+def test_finger_angles_equal_the_plain_python_finger(contacts):
+    g = np.linspace(0.0, 255.0, 5101)
+    ours = hybrid.finger_angles(g, **contacts)
+    reference = np.array([report_finger.finger_angles(x, **contacts) for x in g])
+    assert ours.shape == (g.size, 3) and ours.dtype == np.float64
+    assert np.abs(ours - reference).max() <= 1e-9
+
+
+@pytest.mark.parametrize("contacts", CONTACTS)
+def test_finger_angles_equal_the_command_line(tmp_path, contacts):
+    g = np.random.default_rng(7).uniform(0.0, 255.0, 200000)  # two threads past 65536
+    queries = tmp_path / "q.csv"
+    np.savetxt(queries, g, fmt="%.17g", header="g", comments="")
+    options = sum((["--" + k, repr(v)] for k, v in contacts.items()), [])
+    out = run("finger", "--queries", str(queries), *options)
+    assert out.returncode == 0, out.stderr
+    rows = list(csv.DictReader(out.stdout.splitlines()))
+    cli = np.array([[float(r["theta" + str(i)]) for i in (1, 2, 3)] for r in rows])
+    assert np.abs(hybrid.finger_angles(g, **contacts) - cli).max() <= 1e-9
+
+
+def test_finger_angles_shapes_and_errors():
+    assert hybrid.finger_angles(102.0).tolist() == [[51.0, 0.0, -51.0]]
+    assert hybrid.finger_angles([[0.0, 255.0]]).shape == (2, 3)
+    assert hybrid.finger_angles(np.array([], dtype=float)).shape == (0, 3)
+    for bad in (-1.0, 255.5, float("nan")):
+        with pytest.raises(ValueError, match=r"g must be a motor position in \[0, 255\]"):
+            hybrid.finger_angles([1.0, bad])
+    with pytest.raises(ValueError, match="gob2"):
+        hybrid.finger_angles(1.0, gob2=300.0)
+
+
+def test_finger_angles_read_a_models_constants(tmp_path):
+    # The bundled finger model gives the report's constants, so the same angles.
+    model = os.path.join(SOURCE, "spec", "finger.ha")
+    g = np.linspace(0, 255, 256)
+    assert np.array_equal(hybrid.finger_angles(g, model=model), hybrid.finger_angles(g))
+    two = tmp_path / "two.ha"
+    two.write_text("automaton a { mode m {} init m {} }\nautomaton b { mode m {} init m {} }\n"
+                   "system s { instance A = a; instance B = b; }\n")
+    with pytest.raises(ValueError, match="not a finger model"):
+        hybrid.finger_angles(1.0, model=str(two))
+
+
+def test_model_errors_name_file_line_and_column(tmp_path):
+    bad = tmp_path / "bad.ha"
+    bad.write_text("automaton a {\n  mode m { x' = 1; }\n}\n")
+    with pytest.raises(hybrid.ModelError) as e:
+        hybrid.load(bad)
+    assert str(e.value).startswith(str(bad) + ":2:")
+    assert isinstance(e.value, ValueError)
+    with pytest.raises(hybrid.ModelError, match="cannot"):
+        hybrid.load(tmp_path / "missing.ha")
+
+
+def test_info_is_the_command_lines(tmp_path):
+    path = os.path.join(SOURCE, "spec", "thermostat.ha")
+    model = hybrid.load(path)
+    assert model.name == "thermostat" and model.path == path
+    out = run("info", path, "--json")
+    assert out.returncode == 0, out.stderr
+    assert model.info() == json.loads(out.stdout)
+
+
+def test_dot_draws_every_mode():
+    dot = hybrid.load(os.path.join(SOURCE, "spec", "thermostat.ha")).dot()
+    assert dot.startswith("digraph") and "switch_on" in dot and "switch_off" in dot
+
+
+def test_thermostat_relaxes_exponentially():
+    # Mode off: x' = a (u - x), a = 0.1, from x = 20 with u = 10: x(t) = 10 + 10 exp(-0.1 t),
+    # which reaches the invariant's bound 18 at t = 10 ln(1.25), where the lazy switch_on fires.
+    model = hybrid.load(os.path.join(SOURCE, "spec", "thermostat.ha"))
+    r = model.simulate(until=2.0, inputs={"u": 10.0}, sample=0.25)
+    assert r["status"] == "completed", r["message"]
+    t, x = r["time"], r["states"]["x"]
+    assert t.shape == x.shape and t[0] == 0.0 and t[-1] == 2.0
+    assert np.abs(x - (10.0 + 10.0 * np.exp(-0.1 * t))).max() <= 1e-6
+    assert set(r["modes"]) == {"off"} and r["events"] == []
+    r = model.simulate(until=3.0, inputs={"u": [(0.0, 10.0)]})
+    event = r["events"][0]
+    assert abs(event["time"] - 10.0 * math.log(1.25)) <= 1e-6
+    assert event["transitions"] == ["switch_on"]
+    assert (event["modes_before"], event["modes_after"]) == ("off", "on")
+
+
+TANK = textwrap.dedent("""\
+    automaton tank {
+      var h in [0, 10];
+      input d in [-0.2, 0];
+      mode fill { h' = 0.5 + d; inv h <= 8; }
+      init fill { h = 5; }
+      property stays_below_6: always h <= 6;
+      property reaches_7: reach h >= 7;
+      property below_8: always h <= 8;
+    }
+    """)
+
+
+def test_tank_inputs_and_parameters(tmp_path):
+    # h' = 0.5 + d from h = 5: with d = -0.2 then 0 after t = 2, h(4) = 5 + 0.3 * 2 + 0.5 * 2.
+    path = tmp_path / "tank.ha"
+    path.write_text(TANK)
+    model = hybrid.load(path)
+    r = model.simulate(until=4.0, inputs={"d": "step(0: -0.2, 2: 0)"})
+    assert r["status"] == "completed", r["message"]
+    assert abs(r["states"]["h"][-1] - 6.6) <= 1e-9
+    with pytest.raises(KeyError):
+        model.simulate(until=1.0, inputs={"nope": 0.0})
+    with pytest.raises(ValueError):
+        model.simulate(until=1.0, inputs={"d": 5.0})  # outside the input's bounds
+
+
+def test_check_verdicts_and_traces_match_the_command_line(tmp_path):
+    # The tank rises at 0.3 to 0.5 per second from 5 and is kept below 8 by its invariant: h > 6
+    # and h >= 7 are reached (after 2 s at most), h <= 8 always holds.
+    path = tmp_path / "tank.ha"
+    path.write_text(TANK)
+    report = hybrid.load(path).check(method="auto")
+    verdicts = {p["name"]: p["verdict"] for p in report["properties"]}
+    assert verdicts == {"stays_below_6": "violated", "reaches_7": "reachable",
+                        "below_8": "proved"}
+    violated = next(p for p in report["properties"] if p["name"] == "stays_below_6")
+    assert violated["trace"]
+    out = run("check", str(path), "--json")
+    cli = json.loads(out.stdout)
+    assert [(p["name"], p["verdict"]) for p in cli["properties"]] == \
+        [(p["name"], p["verdict"]) for p in report["properties"]]
+    with pytest.raises(ValueError):
+        hybrid.load(path).check(properties=["no_such_property"])
