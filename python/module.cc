@@ -24,9 +24,14 @@
 #include "automaton/spaceex/spaceex_import.h"
 #include "gripper/finger_closed_form.h"
 #include "gripper/finger_parameters.h"
+#include "gripper/measured_data.h"
 #include "solvers/simulation/simulator.h"
+#include "tools/bundled_files.h"
 #include "tools/check_command.h"
+#include "tools/diagnose_command.h"
+#include "tools/gripper_command.h"
 #include "tools/info_command.h"
+#include "tools/options.h"
 
 namespace py = pybind11;
 
@@ -216,6 +221,34 @@ py::dict Model::Simulate(std::optional<double> until,
   return out;
 }
 
+// `hybrid hand --json` (without --simulate): the report as JSON text.
+std::string HandJsonText(const std::vector<std::string>& objects, const std::string& mode,
+                         std::optional<double> spread, double g, std::optional<double> g_a,
+                         std::optional<double> g_b, std::optional<double> g_c) {
+  cli::HandArgs args;
+  args.objects = objects;
+  args.mode = mode;
+  args.spread = spread;
+  args.g = g;
+  args.g_a = g_a;
+  args.g_b = g_b;
+  args.g_c = g_c;
+  py::gil_scoped_release release;
+  return cli::HandReport(args).dump();
+}
+
+// `hybrid diagnose DATA --json`: the report as JSON text (the bundled finger without a model).
+std::string DiagnoseJsonText(const std::string& data, const std::optional<std::string>& model,
+                             double significance, int threads) {
+  cli::DiagnoseArgs args;
+  args.data = data;
+  args.model = model ? *model : cli::BundledFile("spec/finger.ha").string();
+  args.significance = significance;
+  args.threads = threads;
+  py::gil_scoped_release release;
+  return cli::DiagnoseReport(args).dump();
+}
+
 }  // namespace
 }  // namespace hybrid::python
 
@@ -223,6 +256,7 @@ PYBIND11_MODULE(_hybrid, m) {
   using namespace hybrid::python;
   m.doc() = "C++ core of the hybrid package (see the package docstrings; docs/python.md).";
   static py::exception<hybrid::ParseError> model_error(m, "ModelError", PyExc_ValueError);
+  static py::exception<hybrid::DataError> data_error(m, "DataError", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -230,12 +264,22 @@ PYBIND11_MODULE(_hybrid, m) {
       model_error(e.what());
     } catch (const std::invalid_argument& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const hybrid::DataError& e) {
+      data_error(e.what());
+    } catch (const hybrid::cli::UsageError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const hybrid::cli::InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const std::out_of_range& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }
   });
   m.def("finger_angles", &FingerAngles, py::arg("g"), py::arg("gob1") = py::none(),
         py::arg("gob2") = py::none(), py::arg("gob3") = py::none(), py::arg("model") = py::none());
+  m.def("hand_json", &HandJsonText, py::arg("objects"), py::arg("mode"), py::arg("spread"),
+        py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"));
+  m.def("diagnose_json", &DiagnoseJsonText, py::arg("data"), py::arg("model"),
+        py::arg("significance"), py::arg("threads"));
   py::class_<Model>(m, "Model")
       .def(py::init<std::string>(), py::arg("path"))
       .def_property_readonly("path", &Model::path)

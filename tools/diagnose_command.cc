@@ -188,13 +188,41 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
 
 }  // namespace
 
-int RunDiagnose(const DiagnoseArgs& args) {
+namespace {
+
+void CheckDiagnoseOptions(const DiagnoseArgs& args) {
   if (args.threads < 1 || args.threads > 64) {
     throw UsageError("--threads must lie in [1, 64]");
   }
   if (!(args.significance > 0) || !std::isfinite(args.significance)) {
     throw UsageError("--significance must be positive");
   }
+}
+
+// The diagnosis of args.data (its model, the options) and how long it took.
+Diagnosis Diagnosed(const DiagnoseArgs& args, const FingerPredictor& predictor, double& seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  MeasuredData data = ReadMeasuredDataFile(args.data);
+  FingerDiagnosisOptions options;
+  options.significance = args.significance;
+  options.threads = args.threads;
+  Diagnosis d = Diagnose(predictor, std::move(data), options);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return d;
+}
+
+}  // namespace
+
+nlohmann::ordered_json DiagnoseReport(const DiagnoseArgs& args) {
+  CheckDiagnoseOptions(args);
+  const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::FastOptions());
+  double seconds = 0.0;
+  const Diagnosis d = Diagnosed(args, predictor, seconds);
+  return ToJson(d, args, seconds);
+}
+
+int RunDiagnose(const DiagnoseArgs& args) {
+  CheckDiagnoseOptions(args);
   const std::vector<NamedFile> inputs = {{"DATA", args.data}, {"--model", args.model}};
   const auto outputs = [&](const std::vector<std::pair<std::string, std::string>>& report) {
     std::vector<NamedFile> out = {{"--out-model", args.out_model}};
@@ -210,15 +238,9 @@ int RunDiagnose(const DiagnoseArgs& args) {
   }
   CheckDistinctFiles(inputs, outputs(report_files));
   CheckOutputPlaces({{"--out-model", args.out_model}}, {{"--report", args.report}});
-  const auto start = std::chrono::steady_clock::now();
-  MeasuredData data = ReadMeasuredDataFile(args.data);
   const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::FastOptions());
-  FingerDiagnosisOptions options;
-  options.significance = args.significance;
-  options.threads = args.threads;
-  const Diagnosis d = Diagnose(predictor, std::move(data), options);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double seconds = 0.0;
+  const Diagnosis d = Diagnosed(args, predictor, seconds);
   const json report = ToJson(d, args, seconds);
   std::vector<std::pair<std::string, std::string>> files;
   if (!args.out_model.empty()) {

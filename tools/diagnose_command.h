@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct DiagnoseArgs {
 /// report directory (created with its parents) and every file appear only when all are
 /// written; on a failure nothing new is left.
 int RunDiagnose(const DiagnoseArgs& args);
+
+/// The report `hybrid diagnose --json` writes for `args` (data, model, significance, threads;
+/// the output options are ignored: nothing is written). Throws as RunDiagnose.
+nlohmann::ordered_json DiagnoseReport(const DiagnoseArgs& args);
 
 /// Options of `hybrid synthesize`: data with hidden effects, for demos and tests.
 struct SynthesizeArgs {

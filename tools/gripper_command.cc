@@ -659,6 +659,28 @@ int RunFinger(const FingerArgs& args_in) {
   return code;
 }
 
+namespace {
+
+// The report of `hybrid hand` before any simulation (the spread, each finger, their touches).
+json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread,
+              const std::array<double, 3>& commands) {
+  return {{"mode", args.mode},
+          {"spread", spread},
+          {"spread_angle_deg", hand.spread_angle()},
+          {"fingers", HandFingersJson(hand, commands)},
+          {"finger_touches", HandTouchesJson(hand)}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json HandReport(const HandArgs& args) {
+  CheckMotor("--g", args.g);
+  const std::array<double, 3> commands = HandCommands(args);
+  const double spread = HandSpread(args);
+  const gripper::Hand hand = HandOnObjects(ParseObjects(args.objects), spread, commands);
+  return HandJson(args, hand, spread, commands);
+}
+
 int RunHand(const HandArgs& args) {
   CheckDistinctFiles(
       args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
@@ -671,11 +693,7 @@ int RunHand(const HandArgs& args) {
   for (double g : args.draw_at) CheckMotor("--at", g);
   const std::vector<Obstacle> objects = ParseObjects(args.objects);
   const gripper::Hand hand = HandOnObjects(objects, spread, commands);
-  json report = {{"mode", args.mode},
-                 {"spread", spread},
-                 {"spread_angle_deg", hand.spread_angle()},
-                 {"fingers", HandFingersJson(hand, commands)},
-                 {"finger_touches", HandTouchesJson(hand)}};
+  json report = HandJson(args, hand, spread, commands);
   int code = 0;
   if (args.simulate) {
     const Comparison c = SimulateHand(args, hand, commands, per_finger);

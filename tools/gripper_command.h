@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -49,6 +50,10 @@ struct HandArgs {
 /// directory; the files are written all or nothing).
 int RunFinger(const FingerArgs& args);
 int RunHand(const HandArgs& args);
+
+/// The report `hybrid hand --json` writes for `args` without --simulate and --draw (the spread,
+/// each finger's final configuration and contacts, the finger touches). Throws as RunHand.
+nlohmann::ordered_json HandReport(const HandArgs& args);
 
 /// A bad object description or an object the gripper cannot hold (exit code 1).
 struct InputError : std::runtime_error {

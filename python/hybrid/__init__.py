@@ -4,6 +4,8 @@ The C++ library behind the ``hybrid`` command line, in-process:
 
 - :func:`finger_angles` -- the Robotiq finger's closed-form (quasistatic) joint angles, vectorised
   over numpy arrays of motor positions;
+- :func:`hand` -- the three-finger hand closing on objects (``hybrid hand --json``);
+- :func:`diagnose` -- measured finger data against the model (``hybrid diagnose --json``);
 - :func:`load` -- a model (``.ha``, or SpaceEx ``.xml`` with its ``.cfg``) to inspect
   (:meth:`Model.info`), draw (:meth:`Model.dot`), simulate (:meth:`Model.simulate`) and check
   (:meth:`Model.check`).
@@ -17,8 +19,9 @@ import json as _json
 from . import _hybrid
 
 ModelError = _hybrid.ModelError
+DataError = _hybrid.DataError
 
-__all__ = ["ModelError", "Model", "finger_angles", "load"]
+__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger_angles", "hand", "load"]
 
 
 def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):
@@ -116,3 +119,49 @@ def load(path):
     the same name next to it). Raises ModelError (file:line:col: message) if it does not parse,
     OSError-like ValueError if it cannot be read."""
     return Model(path)
+
+
+def hand(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c=None):
+    """The three-finger hand closing on objects, quasistatically (``hybrid hand --json``).
+
+    Args:
+        objects: object descriptions in the palm's x-y plane (metres), as ``--object`` takes
+            them: ``"circle:X,Y,R"`` (a cylinder across the hand) or
+            ``"segment:X1,Y1,X2,Y2[,R]"``.
+        mode: the operating mode setting the spread: "basic", "wide", "pinch" or "scissor".
+        spread: the spread motor position in [0, 255] (overrides the mode's).
+        g: one motor command for all fingers, in [0, 255].
+        g_a, g_b, g_c: per-finger commands (override g).
+
+    Returns:
+        The report of ``hybrid hand --json`` (docs/cli.md): ``spread``, ``spread_angle_deg``,
+        ``fingers`` (per finger: ``finger``, ``command``, ``motor``, ``theta1..3``, ``phase``,
+        ``mode``, ``contacts`` with the link, motor position and what blocks it) and
+        ``finger_touches``.
+
+    Raises:
+        ValueError: a malformed object or a position out of range, or objects no finger reaches.
+    """
+    report = _hybrid.hand_json(list(objects), mode, spread, float(g), g_a, g_b, g_c)
+    return _json.loads(report)
+
+
+def diagnose(data, model=None, significance=25.0, threads=2):
+    """Measured finger data against the model (``hybrid diagnose DATA --json``; docs/diagnosis.md).
+
+    Args:
+        data: the measured CSV (the format of docs/diagnosis.md; data/finger_demo.csv).
+        model: the finger automaton (default: the bundled spec/finger.ha).
+        significance: how much a cause must improve the fit to be named.
+        threads: worker threads.
+
+    Returns:
+        The report of ``hybrid diagnose --json``: residuals per joint, mode and direction, the
+        cause named, the fitted parameters and the held-out gain. Nothing is written.
+
+    Raises:
+        DataError: bad data (a ValueError naming the file, line and column).
+    """
+    report = _hybrid.diagnose_json(str(data), None if model is None else str(model),
+                                   float(significance), int(threads))
+    return _json.loads(report)

@@ -7,6 +7,7 @@ import numpy.typing as npt
 Signal = Union[float, Sequence[tuple[float, float]], str]
 
 class ModelError(ValueError): ...
+class DataError(ValueError): ...
 
 def finger_angles(
     g: Union[float, npt.ArrayLike],
@@ -40,3 +41,18 @@ class Model:
     ) -> dict[str, Any]: ...
 
 def load(path: Union[str, PathLike[str]]) -> Model: ...
+def hand(
+    objects: Sequence[str] = ...,
+    mode: str = ...,
+    spread: float | None = ...,
+    g: float = ...,
+    g_a: float | None = ...,
+    g_b: float | None = ...,
+    g_c: float | None = ...,
+) -> dict[str, Any]: ...
+def diagnose(
+    data: Union[str, PathLike[str]],
+    model: Union[str, PathLike[str], None] = ...,
+    significance: float = ...,
+    threads: int = ...,
+) -> dict[str, Any]: ...

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "automaton/parser.h"
 #include "solvers/simulation/simulator.h"
@@ -28,6 +29,39 @@ FingerContacts Contacts(double gob1, double gob2, double gob3) {
 
 // Section 4.1, the table without object, reproduced exactly at every integer motor position
 // (the formulas are evaluated in the table's own form; integer g makes both sides exact).
+// The batch form gives At's angles bit for bit, for every contact case, at random positions and
+// at the pieces' own ends (the breakpoints, where the phase-3 fraction and the clamps act), and
+// refuses what At refuses without writing anything.
+RC_GTEST_PROP(FingerClosedFormTest, AnglesAtIsAtBitForBit, ()) {
+  FingerContacts contacts;
+  for (double& gob : contacts.gob) {
+    if (*rc::gen::arbitrary<bool>()) gob = *rc::gen::inRange(0, 25500) / 100.0;
+  }
+  const FingerClosedForm closed(contacts);
+  std::vector<double> g = {0.0, 255.0, std::nextafter(255.0, 0.0)};
+  for (const auto& piece : closed.pieces()) {
+    g.push_back(piece.g0);
+    g.push_back(std::min(piece.g1, 255.0));
+  }
+  for (int k = 0; k < 50; ++k) g.push_back(*rc::gen::inRange(0, 2550000) / 10000.0);
+  std::vector<double> theta(3 * g.size());
+  closed.AnglesAt(g, theta);
+  for (size_t k = 0; k < g.size(); ++k) {
+    const Eigen::Vector3d at = closed.At(g[k]).theta;
+    for (int j = 0; j < 3; ++j) RC_ASSERT(theta[3 * k + j] == at[j]);
+  }
+}
+
+TEST(FingerClosedFormTest, AnglesAtRefusesWhatAtRefuses) {
+  const FingerClosedForm closed;
+  std::vector<double> theta(6, -1.0);
+  const std::vector<double> outside = {10.0, 255.5};
+  EXPECT_THROW(closed.AnglesAt(outside, theta), std::out_of_range);
+  EXPECT_EQ(theta, std::vector<double>(6, -1.0));  // nothing written
+  const std::vector<double> fine = {10.0};
+  EXPECT_THROW(closed.AnglesAt(fine, theta), std::invalid_argument);  // 3 angles per position
+}
+
 TEST(FingerClosedFormTest, FreeSpaceTableOfSection41) {
   const FingerClosedForm f;
   for (int k = 0; k <= 255; ++k) {

@@ -161,3 +161,32 @@ def test_check_verdicts_and_traces_match_the_command_line(tmp_path):
         [(p["name"], p["verdict"]) for p in report["properties"]]
     with pytest.raises(ValueError):
         hybrid.load(path).check(properties=["no_such_property"])
+
+
+def test_hand_is_the_command_lines():
+    objects = ["circle:0,0.15,0.03"]
+    report = hybrid.hand(objects=objects, g=200.0)
+    out = run("hand", "--object", objects[0], "--g", "200", "--json")
+    assert out.returncode == 0, out.stderr
+    assert report == json.loads(out.stdout)
+    assert [f["finger"] for f in report["fingers"]] == ["A", "B", "C"]
+    with pytest.raises(ValueError, match="circle"):
+        hybrid.hand(objects=["circle:0,0.15"])
+
+
+def test_diagnose_is_the_command_lines():
+    data = os.path.join(SOURCE, "data", "finger_demo.csv")
+    report = hybrid.diagnose(data)
+    out = run("diagnose", data, "--json")
+    assert out.returncode == 0, out.stderr
+    cli = json.loads(out.stdout)
+    del report["seconds"], cli["seconds"]  # wall times
+    assert report == cli
+
+
+def test_diagnose_bad_data_names_the_row(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("nothing,useful\n1,2\n")
+    with pytest.raises(hybrid.DataError) as e:
+        hybrid.diagnose(bad)
+    assert str(e.value).startswith(str(bad) + ":")
