@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -17,8 +18,10 @@
 #include <iostream>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "automaton/dot_writer.h"
 #include "automaton/parser.h"
@@ -27,6 +30,7 @@
 #include "gripper/measured_data.h"
 #include "tools/bundled_files.h"
 #include "tools/check_command.h"
+#include "tools/closest_name.h"
 #include "tools/diagnose_command.h"
 #include "tools/gripper_command.h"
 #include "tools/info_command.h"
@@ -170,7 +174,8 @@ void AddSimulate(CLI::App& app, Commands& c) {
   AddNumberOption(simulate, "--sample", &a.sample,
                   "Also record the state every DT (default: only the start, the end and "
                   "both sides of each event)");
-  simulate->add_option("--out", a.out, "Trajectory CSV: time, kind, mode, variables");
+  simulate->add_option("-o,--output,--out", a.out,
+                       "Trajectory CSV: time, kind, mode, variables (--out: the old spelling)");
   simulate->add_option("--events", a.events, "Event log CSV");
   simulate->add_flag("--json", a.json, "JSON summary with every event on standard output");
 }
@@ -314,7 +319,8 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
   AddNumberOption(synthesize, "--free-runs", &s.free_runs, "Runs without an object");
   AddNumberOption(synthesize, "--samples", &s.samples, "Samples per run (even)");
   synthesize->add_option("--model", s.model, "Finger automaton (default: the bundled finger.ha)");
-  synthesize->add_option("-o,--out", s.out, "Output CSV (default: standard output)");
+  synthesize->add_option("-o,--output,--out", s.out,
+                         "Output CSV (default: standard output; --out: the old spelling)");
 }
 
 // The bundled model `name` where a command's --model was not given and the command reads it.
@@ -417,6 +423,43 @@ int Run(Commands& c) {
   }
 }
 
+// A message for a first argument that is no option and no command ("unknown command 'simulat';
+// did you mean 'simulate'?"), or nullopt.
+std::optional<std::string> UnknownCommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return std::nullopt;
+  const std::string word = argv[1];
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+  if (std::find(names.begin(), names.end(), word) != names.end()) return std::nullopt;
+  std::string message = "unknown command '" + word + "'";
+  if (const auto closest = hybrid::cli::ClosestName(word, names)) {
+    message += "; did you mean '" + *closest + "'?";
+  }
+  message += " (commands:";
+  for (const std::string& name : names) message += " " + name;
+  return message + ")";
+}
+
+// Each command's help lists the exit codes it can return.
+void SetExitCodeFooters(Commands& c) {
+  const std::string common =
+      "0 success; 1 invalid model or data (FILE:LINE:COL: message on stderr); 2 usage error (a "
+      "bad option value, named); 3 cannot write output; 4 out of memory or internal error";
+  const std::string more = ". Numbers, output files and limits: docs/cli.md.";
+  for (CLI::App* app : {c.info, c.dot, c.import, c.diagnose, c.synthesize}) {
+    app->footer("Exit codes: " + common + more);
+  }
+  c.simulate->footer("Exit codes: " + common + "; 5 simulation stopped early" + more);
+  c.check->footer("Exit codes: " + common +
+                  "; 6 a property violated (or a reach target unreachable); 7 no violation, but "
+                  "a verdict unknown" +
+                  more);
+  for (CLI::App* app : {c.finger, c.hand}) {
+    app->footer("Exit codes: " + common +
+                "; 5 --simulate disagrees with the closed form or stops early" + more);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -435,6 +478,11 @@ int main(int argc, char** argv) {
   AddFinger(app, commands);
   AddHand(app, commands);
   AddDiagnosis(app, commands);
+  SetExitCodeFooters(commands);
+  if (const auto unknown = UnknownCommand(app, argc, argv)) {
+    std::cerr << "hybrid: " << *unknown << "\nRun with --help for more information.\n";
+    return kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

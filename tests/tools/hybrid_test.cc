@@ -49,6 +49,54 @@ TEST(HybridCli, HelpExitsZero) {
   EXPECT_EQ(RunHybrid("dot --help").exit_code, 0);
 }
 
+// An unknown command is named, with the closest command when it looks like a typo, and the list.
+TEST(HybridCli, UnknownCommandsAreNamedWithTheClosestMatch) {
+  const Result typo = RunHybrid("simulat spec/thermostat.ha");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.err.find("unknown command 'simulat'; did you mean 'simulate'?"), std::string::npos)
+      << typo.err;
+  const Result other = RunHybrid("frobnicate");
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("unknown command 'frobnicate' (commands: info dot import simulate"),
+            std::string::npos)
+      << other.err;
+  EXPECT_EQ(other.err.find("did you mean"), std::string::npos) << other.err;
+}
+
+// -o/--output is the one spelling of a command's one output file; the old --out still works.
+TEST(HybridCli, OutputOptionIsOneSpellingAndOldOnesStillWork) {
+  TempDir dir;
+  const std::string model = Quote((kSourceDir / "spec" / "thermostat.ha").string());
+  std::string texts[3];
+  const char* spellings[3] = {"-o", "--output", "--out"};
+  for (int i = 0; i < 3; ++i) {
+    const std::string path = (dir.path() / ("t" + std::to_string(i) + ".csv")).string();
+    const Result r = RunHybrid("simulate " + model + " --until 1 " + spellings[i] + " " + path);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(path);
+    texts[i].assign(std::istreambuf_iterator<char>(in), {});
+  }
+  EXPECT_NE(texts[0].find("time,kind,mode,x"), std::string::npos) << texts[0];
+  EXPECT_EQ(texts[0], texts[1]);
+  EXPECT_EQ(texts[0], texts[2]);
+  const Result synthesize = RunHybrid("synthesize --free-runs 1 --samples 64 --output " +
+                                      Quote((dir.path() / "s.csv").string()));
+  EXPECT_EQ(synthesize.exit_code, 0) << synthesize.err;
+}
+
+// Each command's help lists its own exit codes only.
+TEST(HybridCli, EachCommandsHelpListsItsExitCodes) {
+  const Result check = RunHybrid("check --help");
+  EXPECT_NE(check.out.find("6 a property violated"), std::string::npos) << check.out;
+  EXPECT_EQ(check.out.find("simulation stopped early"), std::string::npos) << check.out;
+  const Result simulate = RunHybrid("simulate --help");
+  EXPECT_NE(simulate.out.find("5 simulation stopped early"), std::string::npos) << simulate.out;
+  EXPECT_EQ(simulate.out.find("property violated"), std::string::npos) << simulate.out;
+  const Result info = RunHybrid("info --help");
+  EXPECT_NE(info.out.find("4 out of memory"), std::string::npos) << info.out;
+  EXPECT_EQ(info.out.find("5 "), std::string::npos) << info.out;
+}
+
 TEST(HybridCli, VersionExitsZero) {
   const Result r = RunHybrid("--version");
   EXPECT_EQ(r.exit_code, 0);
