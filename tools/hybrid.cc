@@ -176,6 +176,9 @@ void AddSimulate(CLI::App& app, Commands& c) {
                   "both sides of each event)");
   simulate->add_option("-o,--output,--out", a.out,
                        "Trajectory CSV: time, kind, mode, variables (--out: the old spelling)");
+  simulate->add_option("--plot", a.plot,
+                       "SVG plot of the run: each variable and input against time, jumps and "
+                       "modes marked");
   simulate->add_option("--events", a.events, "Event log CSV");
   simulate->add_flag("--json", a.json, "JSON summary with every event on standard output");
 }

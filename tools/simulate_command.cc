@@ -1,5 +1,6 @@
 #include "tools/simulate_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "solvers/simulation/simulator.h"
 #include "tools/options.h"
 #include "tools/output.h"
+#include "tools/trajectory_plot.h"
 #include "tools/user_message.h"
 
 namespace hybrid::cli {
@@ -278,7 +280,7 @@ void OverrideInputs(const std::vector<std::string>& specs, const SymbolTable& sy
 
 int RunSimulate(const SimulateArgs& args) {
   CheckDistinctFiles({{"MODEL", args.model}, {"--input-csv", args.input_csv}},
-                     {{"--out", args.out}, {"--events", args.events}});
+                     {{"--out", args.out}, {"--events", args.events}, {"--plot", args.plot}});
   if (args.input_csv.empty() ? false : args.csv_shape != "step" && args.csv_shape != "linear") {
     throw UsageError("--csv-shape must be 'step' or 'linear'");
   }
@@ -286,7 +288,7 @@ int RunSimulate(const SimulateArgs& args) {
   if (args.until && !(*args.until > 0.0)) {
     throw UsageError("--until: the horizon must be positive and finite");
   }
-  CheckOutputPlaces({{"--out", args.out}, {"--events", args.events}});
+  CheckOutputPlaces({{"--out", args.out}, {"--events", args.events}, {"--plot", args.plot}});
   System system = spaceex::ReadModelFile(args.model);
   SetParameters(args.parameters, system);
   const SymbolTable& symbols = system.symbols();
@@ -316,6 +318,19 @@ int RunSimulate(const SimulateArgs& args) {
   std::vector<std::pair<std::string, std::string>> files;
   if (!args.out.empty()) files.emplace_back(args.out, TraceCsv(sim, result));
   if (!args.events.empty()) files.emplace_back(args.events, EventsCsv(sim, result));
+  if (!args.plot.empty()) {
+    // The inputs as the run saw them: the scenario's signals where no option replaced them.
+    std::vector<InputSignal> drawn = signals;
+    if (system.scenario()) {
+      for (const InputSignal& s : system.scenario()->inputs) {
+        if (std::none_of(drawn.begin(), drawn.end(),
+                         [&](const InputSignal& d) { return d.slot == s.slot; })) {
+          drawn.push_back(s);
+        }
+      }
+    }
+    files.emplace_back(args.plot, TrajectoryPlotSvg(sim, result, drawn, system.name()));
+  }
   WriteOutputs(files);
   WriteOutput("-", args.json ? ResultJson(sim, result, until).dump(2) + "\n"
                              : SummaryText(sim, result, until));

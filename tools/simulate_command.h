@@ -17,6 +17,7 @@ struct SimulateArgs {
   double sample = 0.0;                  ///< 0: start, end and events only
   std::string out;                      ///< trajectory CSV
   std::string events;                   ///< event log CSV
+  std::string plot;                     ///< SVG of the run (variables, inputs, jumps, modes)
   bool json = false;                    ///< JSON summary (with every event) on standard output
 };
 
