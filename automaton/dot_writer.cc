@@ -1,6 +1,8 @@
 #include "automaton/dot_writer.h"
 
+#include <map>
 #include <sstream>
+#include <vector>
 
 #include "automaton/printer.h"
 
@@ -21,7 +23,8 @@ std::string Escape(const std::string& text) {
   return out;
 }
 
-std::string ModeLabel(const Automaton& a, const Mode& m) {
+// The mode's name with its discrete values: "name (c1=0, l3=-1)".
+std::string ModeName(const Automaton& a, const Mode& m) {
   std::string text = m.name;
   if (!m.discrete_values.empty()) {
     text += " (";
@@ -31,7 +34,11 @@ std::string ModeLabel(const Automaton& a, const Mode& m) {
     }
     text += ")";
   }
-  text += "\n";
+  return text;
+}
+
+std::string ModeLabel(const Automaton& a, const Mode& m) {
+  std::string text = ModeName(a, m) + "\n";
   for (const auto& [slot, rhs] : m.flows) {
     text += a.symbols()[slot].name + "'" + FlowText(rhs) + "\n";
   }
@@ -61,21 +68,44 @@ std::string InitLabel(const Automaton& a, const InitialState& s) {
   return text;
 }
 
-void WriteAutomaton(const Automaton& a, const std::string& prefix, const std::string& indent,
-                    std::ostream& out) {
+// The modes of `a`, one node each, in clusters by options.group (when set).
+void WriteModes(const Automaton& a, const std::string& prefix, const std::string& indent,
+                const DotOptions& options, std::ostream& out) {
+  std::map<std::string, std::vector<int>> groups;  // by name: one cluster each, sorted
   for (int m = 0; m < a.num_modes(); ++m) {
-    out << indent << prefix << "m" << m << " [shape=box, style=rounded, label=\""
-        << Escape(ModeLabel(a, a.modes()[m])) << "\"];\n";
+    groups[options.group ? options.group(a, a.modes()[m]) : ""].push_back(m);
   }
+  int cluster = 0;
+  for (const auto& [name, modes] : groups) {
+    std::string inner = indent;
+    if (!name.empty()) {
+      out << indent << "subgraph cluster_" << prefix << "g" << cluster++ << " {\n"
+          << indent << "  label=\"" << Escape(name) << "\"; style=rounded; color=\"#999999\";\n";
+      inner += "  ";
+    }
+    for (const int m : modes) {
+      const Mode& mode = a.modes()[m];
+      const std::string label = options.compact ? mode.name : ModeLabel(a, mode);
+      out << inner << prefix << "m" << m << " [shape=box, style=rounded, label=\"" << Escape(label)
+          << "\"];\n";
+    }
+    if (!name.empty()) out << indent << "}\n";
+  }
+}
+
+void WriteAutomaton(const Automaton& a, const std::string& prefix, const std::string& indent,
+                    const DotOptions& options, std::ostream& out) {
+  WriteModes(a, prefix, indent, options, out);
   for (size_t i = 0; i < a.initial_states().size(); ++i) {
     const InitialState& s = a.initial_states()[i];
     out << indent << prefix << "init" << i << " [shape=point, width=0.12];\n";
     out << indent << prefix << "init" << i << " -> " << prefix << "m" << s.mode.value()
-        << " [label=\"" << Escape(InitLabel(a, s)) << "\"];\n";
+        << " [label=\"" << (options.compact ? "" : Escape(InitLabel(a, s))) << "\"];\n";
   }
   for (const Transition& t : a.transitions()) {
+    const std::string label = options.compact ? t.label : TransitionLabel(a, t);
     out << indent << prefix << "m" << t.source.value() << " -> " << prefix << "m"
-        << t.target.value() << " [label=\"" << Escape(TransitionLabel(a, t)) << "\"";
+        << t.target.value() << " [label=\"" << Escape(label) << "\"";
     if (t.urgency == Urgency::kLazy) out << ", style=dashed";
     out << "];\n";
   }
@@ -86,20 +116,25 @@ void WriteAutomaton(const Automaton& a, const std::string& prefix, const std::st
 std::string WriteDot(const System& system, const DotOptions& options) {
   std::ostringstream out;
   out << "digraph \"" << Escape(system.name()) << "\" {\n"
-      << "  rankdir=LR;\n  node [fontname=\"Helvetica\", fontsize=10];\n"
+      << "  rankdir=LR;\n"
+      // Clusters inside clusters (components, then groups) need the newer ranking.
+      << (options.group && !options.product && system.components().size() > 1
+              ? "  newrank=true;\n"
+              : "")
+      << "  node [fontname=\"Helvetica\", fontsize=10];\n"
       << "  edge [fontname=\"Helvetica\", fontsize=9];\n";
   const auto components = system.components();
   if (options.product || components.size() == 1) {
     const Automaton a =
         options.product ? system.Product(options.max_product_modes) : components[0].automaton;
-    WriteAutomaton(a, "", "  ", out);
+    WriteAutomaton(a, "", "  ", options, out);
   } else {
     for (size_t c = 0; c < components.size(); ++c) {
       const Component& comp = components[c];
       out << "  subgraph cluster_" << c << " {\n    label=\""
           << Escape((comp.instance.empty() ? "" : comp.instance + ": ") + comp.automaton.name())
           << "\";\n";
-      WriteAutomaton(comp.automaton, "c" + std::to_string(c) + "_", "    ", out);
+      WriteAutomaton(comp.automaton, "c" + std::to_string(c) + "_", "    ", options, out);
       out << "  }\n";
     }
   }

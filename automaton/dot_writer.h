@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "automaton/system.h"
@@ -14,6 +15,13 @@ struct DotOptions {
   /// Largest product drawn; a larger one throws std::invalid_argument (a graph that size is not
   /// readable; draw the components as clusters instead).
   int max_product_modes = 2000;
+  /// Short labels for a graph that fits a page: modes by name, transitions by their
+  /// synchronisation label only (none without); no discrete values, flows, invariants, guards,
+  /// resets or initial values.
+  bool compact = false;
+  /// Groups the modes of each automaton drawn into clusters named by this function's text (modes
+  /// for which it returns "" stay outside any cluster); no grouping when empty.
+  std::function<std::string(const Automaton&, const Mode&)> group;
 };
 
 /// A Graphviz `digraph` of `system`. Nodes are modes, labelled with the mode name, each flow

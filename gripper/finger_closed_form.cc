@@ -199,6 +199,14 @@ std::string PhaseName(FingerPhase phase) {
   return "?";
 }
 
+FingerPhase PhaseOfState(const std::array<int, 3>& c, const std::array<int, 3>& l) {
+  const bool palm = l[0] == 1 && l[1] == 1 && l[2] == -1 && c == std::array<int, 3>{0, 0, 0};
+  if (c[2] == 1 || l[2] == 1 || palm) return FingerPhase::k4;
+  if (c[1] == 1 || l[1] == 1) return FingerPhase::k3;
+  if (c[0] == 1 || l[0] == 1) return l[2] == -1 ? FingerPhase::k2Prime : FingerPhase::k2;
+  return l[2] == -1 ? FingerPhase::k1Prime : FingerPhase::k1;
+}
+
 std::string FingerModeName(const FingerConfiguration& q) {
   std::string name = "c";
   auto digit = [&](int v) { name.push_back(v == -1 ? 'n' : static_cast<char>('0' + v)); };

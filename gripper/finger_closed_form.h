@@ -26,6 +26,12 @@ enum class FingerPhase { k1, k1Prime, k2, k2Prime, k3, k4 };
 /// "1", "1'", "2", "2'", "3" or "4".
 std::string PhaseName(FingerPhase phase);
 
+/// The phase of the discrete state (c1, c2, c3), (l1, l2, l3) (l3 = -1 at link 3's lower limit),
+/// by section 3's table with decision D3: 4 when link 3 is blocked (c3 or l3 = 1) or the free
+/// finger is against the palm (l1 = l2 = 1, l3 = -1, no contact); else 3 when link 2 is blocked;
+/// else 2 (2' with l3 = -1) when link 1 is; else 1 (1' with l3 = -1).
+FingerPhase PhaseOfState(const std::array<int, 3>& c, const std::array<int, 3>& l);
+
 /// The quasistatic state of a finger at a commanded motor position.
 struct FingerConfiguration {
   /// Joint angles (theta1, theta2, theta3) in degrees; theta3 relative to link 2.

@@ -34,6 +34,7 @@
 #include "tools/diagnose_command.h"
 #include "tools/gripper_command.h"
 #include "tools/info_command.h"
+#include "tools/mode_groups.h"
 #include "tools/options.h"
 #include "tools/output.h"
 #include "tools/simulate_command.h"
@@ -118,6 +119,8 @@ struct Commands {
   std::string output;
   std::string config;  // import
   bool product = false;
+  bool compact = false;  // dot
+  std::string group_by;  // dot
   hybrid::cli::SimulateArgs simulate_args;
   hybrid::cli::CheckArgs check_args;
   hybrid::cli::FingerArgs finger_args;
@@ -142,6 +145,11 @@ void AddModelCommands(CLI::App& app, Commands& c) {
   c.dot->add_flag("--product", c.product,
                   "Draw a composed model as its product automaton instead of one cluster per "
                   "component");
+  c.dot->add_flag("--compact", c.compact,
+                  "Short labels (mode and transition names only) for a graph that fits a page");
+  c.dot->add_option("--group-by", c.group_by,
+                    "Cluster the modes: 'phase' (a finger's phases 1, 1', 2, 2', 3, 4) or "
+                    "discrete variables V1,V2,...");
 
   c.import = app.add_subcommand(
       "import",
@@ -385,7 +393,9 @@ int RunModelCommand(const Commands& c) {
   }
   std::string text;
   try {
-    text = hybrid::WriteDot(system, {.product = c.product});
+    hybrid::DotOptions options{.product = c.product, .compact = c.compact};
+    if (!c.group_by.empty()) options.group = hybrid::cli::ModeGroups(c.group_by, system);
+    text = hybrid::WriteDot(system, options);
   } catch (const std::invalid_argument& e) {
     std::cerr << c.model << ": cannot draw the product: " << hybrid::cli::UserMessage(e.what())
               << " (omit --product to draw one cluster per component)\n";

@@ -221,3 +221,32 @@ TEST(DotWriter, FingerProductIsTheSameDrawing) {
 
 }  // namespace
 }  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+TEST(DotWriter, CompactLabelsAndGroupsClusterTheModes) {
+  const System s = ParseModel(kTwoComponents, "house.ha");
+  DotOptions options;
+  options.compact = true;
+  // Group the light's modes by whether it is on; the door's modes stay ungrouped.
+  options.group = [](const Automaton& a, const Mode& m) -> std::string {
+    for (const auto& [slot, value] : m.discrete_values) {
+      if (a.symbols()[slot].name == "L.on") return value ? "lit" : "dark";
+    }
+    return "";
+  };
+  const std::string dot = WriteDot(s, options);
+  EXPECT_EQ(Count(dot, "subgraph cluster_"), 4u) << dot;  // two components, two groups
+  EXPECT_NE(dot.find("label=\"lit\"; style=rounded"), std::string::npos) << dot;
+  EXPECT_NE(dot.find("newrank=true;"), std::string::npos);
+  EXPECT_EQ(dot.find("guard"), std::string::npos) << "no guards in compact labels";
+  EXPECT_EQ(dot.find("L.b'"), std::string::npos) << "no flows in compact labels";
+  EXPECT_NE(dot.find("c0_m0 -> c0_m1 [label=\"push\"];"), std::string::npos) << dot;
+  const std::string svg = RenderSvg(dot);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  EXPECT_NE(svg.find(">lit<"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hybrid

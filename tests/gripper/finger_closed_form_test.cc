@@ -7,7 +7,10 @@
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -60,6 +63,37 @@ TEST(FingerClosedFormTest, AnglesAtRefusesWhatAtRefuses) {
   EXPECT_EQ(theta, std::vector<double>(6, -1.0));  // nothing written
   const std::vector<double> fine = {10.0};
   EXPECT_THROW(closed.AnglesAt(fine, theta), std::invalid_argument);  // 3 angles per position
+}
+
+// PhaseOfState against the phases tools/generate_finger.py wrote into spec/finger.ha (a "# phase
+// P" comment before each mode, from the script's own rules), and against the closed form's own
+// phases (every piece of every contact case).
+TEST(FingerClosedFormTest, PhaseOfStateIsTheGeneratedModelsPhase) {
+  std::ifstream in(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
+  std::string line, phase;
+  int checked = 0;
+  const std::regex comment(R"(^  # phase (1'?|2'?|3|4)$)");
+  const std::regex mode(
+      R"(^  mode \S+ \(c1 = (\d), c2 = (\d), c3 = (\d), l1 = (\d), l2 = (\d), l3 = (-?\d)\))");
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (std::regex_search(line, m, comment)) phase = m[1];
+    if (!std::regex_search(line, m, mode)) continue;
+    const std::array<int, 3> c = {std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3])};
+    const std::array<int, 3> l = {std::stoi(m[4]), std::stoi(m[5]), std::stoi(m[6])};
+    EXPECT_EQ(PhaseName(PhaseOfState(c, l)), phase) << line;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 31);
+  for (const double gob1 : {FingerContacts::kNone, 60.0, 140.0}) {
+    for (const double gob2 : {FingerContacts::kNone, 50.0, 170.0}) {
+      FingerContacts contacts;
+      contacts.gob = {gob1, gob2, FingerContacts::kNone};
+      for (const auto& piece : FingerClosedForm(contacts).pieces()) {
+        EXPECT_EQ(PhaseOfState(piece.c, piece.l), piece.phase) << gob1 << " " << gob2;
+      }
+    }
+  }
 }
 
 TEST(FingerClosedFormTest, FreeSpaceTableOfSection41) {
