@@ -89,7 +89,8 @@ TEST(FingerClosedFormTest, PhaseOfStateIsTheGeneratedModelsPhase) {
     for (const double gob2 : {FingerContacts::kNone, 50.0, 170.0}) {
       FingerContacts contacts;
       contacts.gob = {gob1, gob2, FingerContacts::kNone};
-      for (const auto& piece : FingerClosedForm(contacts).pieces()) {
+      const FingerClosedForm closed(contacts);  // pieces() views it: it must outlive the loop
+      for (const auto& piece : closed.pieces()) {
         EXPECT_EQ(PhaseOfState(piece.c, piece.l), piece.phase) << gob1 << " " << gob2;
       }
     }
