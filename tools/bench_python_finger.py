@@ -8,7 +8,8 @@ For N motor positions (default 10^6, uniform in [0, 255], fixed seed) and each c
   3. tools/report_finger.py, a plain-Python quasistatic finger written apart from the C++ (the
      report's tables, like Klamp't's emulator), one query at a time on the first --python-queries
      positions: the largest difference (<= 1e-9 expected) and the time per query of both.
-Prints a table and the speed ratio (plain Python time per query / hybrid's); exits 1 if an
+Each timing is the best of --repeat runs after one untimed warm-up run. Prints a table and the
+speed ratio (plain Python time per query / hybrid's); exits 1 if an
 agreement check fails (never on timings: they are measured, not asserted).
 
 Usage: PYTHONPATH=build/python /usr/bin/python3 tools/bench_python_finger.py [--n N]
@@ -51,6 +52,7 @@ def cli_angles(binary, g, contacts, folder):
 
 
 def best_time(f, repeat):
+    f()  # warm-up, untimed: first-call costs (allocator growth, page faults, threads)
     best = float("inf")
     for _ in range(repeat):
         start = time.perf_counter()
