@@ -19,14 +19,12 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_utilities/text_count.h"
+
 namespace hybrid::gripper {
 namespace {
 
-int Count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using testing::Count;
 
 // The basic shape of a standalone document: one root, balanced groups, nothing non-finite.
 void ExpectWellShaped(const std::string& svg) {

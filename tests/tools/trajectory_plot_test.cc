@@ -14,15 +14,12 @@
 #include <vector>
 
 #include "automaton/parser.h"
+#include "tests/test_utilities/text_count.h"
 
 namespace hybrid::cli {
 namespace {
 
-int Count(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using testing::Count;
 
 // x' = 1 from 0; a jump a -> b at x = 1 and b -> a at x = 2 (reset x := 0 there): over 2.5 time
 // units the modes are a [0, 1], b [1, 2], a [2, 2.5]: two jumps, three stays.
