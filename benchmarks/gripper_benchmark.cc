@@ -50,6 +50,30 @@ void BM_ClosedFormQuery_Link1And2(benchmark::State& state) {
 }
 BENCHMARK(BM_ClosedFormQuery_Link1And2);
 
+// The batch kernel behind the Python module's finger_angles: Arg(0) positions per call (the
+// output preallocated), reported per position.
+void BM_ClosedFormBatch(benchmark::State& state, const FingerContacts& contacts) {
+  const FingerClosedForm f(contacts);
+  const std::vector<double> pool = QueryPoints();
+  std::vector<double> g(static_cast<size_t>(state.range(0)));
+  for (size_t i = 0; i < g.size(); ++i) g[i] = pool[i & 4095] * (1.0 - 1e-9 * (i >> 12));
+  std::vector<double> theta(3 * g.size());
+  for (auto _ : state) {
+    f.AnglesAt(g, theta);
+    benchmark::DoNotOptimize(theta.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+void BM_ClosedFormBatch_FreeSpace(benchmark::State& state) { BM_ClosedFormBatch(state, {}); }
+BENCHMARK(BM_ClosedFormBatch_FreeSpace)->Arg(4096)->Arg(1 << 20);
+void BM_ClosedFormBatch_Link1And2(benchmark::State& state) {
+  FingerContacts c;
+  c.gob = {60.0, 120.0, FingerContacts::kNone};
+  BM_ClosedFormBatch(state, c);
+}
+BENCHMARK(BM_ClosedFormBatch_Link1And2)->Arg(4096)->Arg(1 << 20);
+
 // Building the closed form itself (once per object).
 void BM_ClosedFormBuild(benchmark::State& state) {
   FingerContacts c;

@@ -268,9 +268,23 @@ namespace {
 // rest is 0 only at g = 255, where the fraction is 1 once anything moved and 0 otherwise: the
 // division by the smallest normal double gives a huge (or infinite) ratio or 0 there; any
 // positive rest (at least an ulp of 255) is itself.
+// std::max and std::min on values, the same expressions: on references (std::) GCC keeps a
+// branch, which random g mispredicts; on values it emits maxsd/minsd.
+inline double Max(double a, double b) { return a < b ? b : a; }
+inline double Min(double a, double b) { return b < a ? b : a; }
+
+// The index of g's piece: the number of piece ends below g (`ends` is sorted; unused entries
+// are +inf and the last piece ends at motor_max >= g), counted without branches.
+inline size_t PieceIndex(const std::array<double, 8>& ends, double g) {
+  size_t k = 0;
+#pragma GCC unroll 8
+  for (size_t j = 0; j < ends.size(); ++j) k += g > ends[j] ? 1 : 0;
+  return k;
+}
+
 inline double Phase3Fraction(double moved, double rest, double m3_scale) {
-  const double ratio = (m3_scale * moved) / std::max(rest, std::numeric_limits<double>::min());
-  return std::min(std::max(ratio, 0.0), 1.0);
+  const double ratio = (m3_scale * moved) / Max(rest, std::numeric_limits<double>::min());
+  return Min(Max(ratio, 0.0), 1.0);
 }
 
 void CheckMotorRange(double g, double motor_max) {
@@ -295,20 +309,15 @@ Eigen::Vector3d FingerClosedForm::Evaluate(const Piece& piece, double g) const {
 }
 
 const FingerClosedForm::Piece& FingerClosedForm::PieceAt(double g) const {
-  // The piece index is the number of piece ends below g (ends_ is sorted; unused entries are
-  // +inf and the last piece ends at motor_max >= g), counted without branches.
-  size_t k = 0;
-  for (double end : ends_) k += g > end ? 1 : 0;
-  return pieces_[k];
+  return pieces_[PieceIndex(ends_, g)];
 }
 
 void FingerClosedForm::AnglesAt(std::span<const double> g, std::span<double> theta) const {
   if (theta.size() != 3 * g.size()) {
     throw std::invalid_argument("FingerClosedForm::AnglesAt: 3 angles per motor position");
   }
-  for (const double x : g) CheckMotorRange(x, parameters_.motor_max);
   // Evaluate's arithmetic on the pieces laid out column by column (at most 8), so that the loop
-  // below is straight-line code the compiler can keep in registers.
+  // below is straight-line code without branches (random g would mispredict them).
   struct Columns {
     std::array<double, 8> g0{}, g1{}, t0{}, t1{}, t2{}, r0{}, r1{}, r2{}, span3{};
   } p;
@@ -326,16 +335,20 @@ void FingerClosedForm::AnglesAt(std::span<const double> g, std::span<double> the
   }
   const double motor_max = parameters_.motor_max;
   const double m3_scale = parameters_.m3_scale();
+  bool in_range = true;  // checked in the same pass, without a call per position
   for (size_t i = 0; i < g.size(); ++i) {
-    size_t k = 0;
-    for (double end : ends_) k += g[i] > end ? 1 : 0;
+    in_range &= (g[i] >= 0.0) & (g[i] <= motor_max);
+    const size_t k = PieceIndex(ends_, g[i]);
     // As Evaluate(pieces_[k], min(g, g1)), operation for operation (the same values).
-    const double x = std::min(g[i], p.g1[k]);
+    const double x = Min(g[i], p.g1[k]);
     const double moved = x - p.g0[k];
     const double fraction = Phase3Fraction(moved, motor_max - x, m3_scale);
     theta[3 * i] = p.t0[k] + p.r0[k] * moved;
     theta[3 * i + 1] = p.t1[k] + p.r1[k] * moved;
     theta[3 * i + 2] = (p.t2[k] + p.r2[k] * moved) + p.span3[k] * fraction;
+  }
+  if (!in_range) {
+    for (const double x : g) CheckMotorRange(x, motor_max);
   }
 }
 
@@ -343,7 +356,7 @@ FingerConfiguration FingerClosedForm::At(double g) const {
   CheckMotorRange(g, parameters_.motor_max);
   const Piece& piece = PieceAt(g);
   FingerConfiguration out;
-  out.theta = Evaluate(piece, std::min(g, piece.g1));
+  out.theta = Evaluate(piece, Min(g, piece.g1));
   out.motor = std::min(g, stop_);
   out.c = piece.c;
   out.l = piece.l;

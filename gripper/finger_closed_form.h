@@ -89,7 +89,8 @@ class FingerClosedForm {
   /// The joint angles At(g[k]).theta of every g[k], written to theta[3 k .. 3 k + 2] (the same
   /// values, bit for bit), without the rest of the configuration: the batch form for many
   /// queries. Precondition: theta.size() == 3 g.size(); throws std::out_of_range as At does for
-  /// the first g outside [0, motor_max] (nothing written then), std::invalid_argument on sizes.
+  /// the first g outside [0, motor_max] (theta's contents are unspecified then: the range is
+  /// checked in the same pass), std::invalid_argument on sizes.
   void AnglesAt(std::span<const double> g, std::span<double> theta) const;
 
   /// The motor position where the finger stops (phase 4), or nullopt-like +inf when it is still

@@ -81,20 +81,33 @@ py::array_t<double> FingerAngles(
   const FingerClosedForm closed(contacts, model ? ParametersOfModel(*model) : FingerParameters{});
   const size_t n = static_cast<size_t>(g.size());
   const std::span<const double> in(g.data(), n);
-  for (const double x : in) MotorPosition("g", x);
   py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
   const std::span<double> theta(out.mutable_data(), 3 * n);
+  bool out_of_range = false;  // the kernel checks the range in the same pass
   {
     py::gil_scoped_release release;
+    const auto angles = [&closed](std::span<const double> part, std::span<double> to,
+                                  bool* failed) {
+      try {
+        closed.AnglesAt(part, to);
+      } catch (const std::out_of_range&) {
+        *failed = true;
+      }
+    };
     constexpr size_t kThreadBatch = 1 << 16;  // below this a thread costs more than it saves
     if (n < kThreadBatch) {
-      closed.AnglesAt(in, theta);
+      angles(in, theta, &out_of_range);
     } else {
       const size_t half = n / 2;
-      std::thread first([&] { closed.AnglesAt(in.first(half), theta.first(3 * half)); });
-      closed.AnglesAt(in.subspan(half), theta.subspan(3 * half));
+      bool first_failed = false;
+      std::thread first(angles, in.first(half), theta.first(3 * half), &first_failed);
+      angles(in.subspan(half), theta.subspan(3 * half), &out_of_range);
       first.join();
+      out_of_range = out_of_range || first_failed;
     }
+  }
+  if (out_of_range) {
+    for (const double x : in) MotorPosition("g", x);  // throws, naming the first one outside
   }
   return out;
 }

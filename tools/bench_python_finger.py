@@ -68,7 +68,7 @@ def main():
                         help="positions the plain-Python finger answers (default 10^5)")
     parser.add_argument("--hybrid", default=os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "..", "build", "tools", "hybrid"))
-    parser.add_argument("--repeat", type=int, default=3, help="timing runs, best kept")
+    parser.add_argument("--repeat", type=int, default=5, help="timing runs, best kept (default 5)")
     args = parser.parse_args()
     if args.n < 1 or not 1 <= args.python_queries <= args.n or args.repeat < 1:
         parser.error("need n >= python-queries >= 1 and repeat >= 1")

@@ -60,7 +60,16 @@ TEST(FingerClosedFormTest, AnglesAtRefusesWhatAtRefuses) {
   std::vector<double> theta(6, -1.0);
   const std::vector<double> outside = {10.0, 255.5};
   EXPECT_THROW(closed.AnglesAt(outside, theta), std::out_of_range);
-  EXPECT_EQ(theta, std::vector<double>(6, -1.0));  // nothing written
+  const std::vector<double> nan = {std::nan(""), 10.0};
+  EXPECT_THROW(closed.AnglesAt(nan, theta), std::out_of_range);
+  // The first position outside is the one named (the range is checked in the computing pass).
+  const std::vector<double> two_outside = {-1.0, 300.0};
+  try {
+    closed.AnglesAt(two_outside, theta);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::out_of_range& e) {
+    EXPECT_NE(std::string(e.what()).find("g = -1"), std::string::npos) << e.what();
+  }
   const std::vector<double> fine = {10.0};
   EXPECT_THROW(closed.AnglesAt(fine, theta), std::invalid_argument);  // 3 angles per position
 }
