@@ -1,7 +1,9 @@
 #include "automaton/dot_writer.h"
 
 #include <map>
+#include <span>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "automaton/printer.h"
@@ -23,9 +25,9 @@ std::string Escape(const std::string& text) {
   return out;
 }
 
-// The mode's name with its discrete values: "name (c1=0, l3=-1)".
-std::string ModeName(const Automaton& a, const Mode& m) {
-  std::string text = m.name;
+// The mode's name (`name`) with its discrete values: "name (c1=0, l3=-1)".
+std::string ModeName(const Automaton& a, const Mode& m, const std::string& name) {
+  std::string text = name;
   if (!m.discrete_values.empty()) {
     text += " (";
     for (size_t i = 0; i < m.discrete_values.size(); ++i) {
@@ -37,8 +39,8 @@ std::string ModeName(const Automaton& a, const Mode& m) {
   return text;
 }
 
-std::string ModeLabel(const Automaton& a, const Mode& m) {
-  std::string text = ModeName(a, m) + "\n";
+std::string ModeLabel(const Automaton& a, const Mode& m, const std::string& name) {
+  std::string text = ModeName(a, m, name) + "\n";
   for (const auto& [slot, rhs] : m.flows) {
     text += a.symbols()[slot].name + "'" + FlowText(rhs) + "\n";
   }
@@ -69,8 +71,9 @@ std::string InitLabel(const Automaton& a, const InitialState& s) {
 }
 
 // The modes of `a`, one node each, in clusters by options.group (when set).
-void WriteModes(const Automaton& a, const std::string& prefix, const std::string& indent,
-                const DotOptions& options, std::ostream& out) {
+// `names`: the modes' names to show, by id (empty: their own names).
+void WriteModes(const Automaton& a, std::span<const std::string> names, const std::string& prefix,
+                const std::string& indent, const DotOptions& options, std::ostream& out) {
   std::map<std::string, std::vector<int>> groups;  // by name: one cluster each, sorted
   for (int m = 0; m < a.num_modes(); ++m) {
     groups[options.group ? options.group(a, a.modes()[m]) : ""].push_back(m);
@@ -85,7 +88,8 @@ void WriteModes(const Automaton& a, const std::string& prefix, const std::string
     }
     for (const int m : modes) {
       const Mode& mode = a.modes()[m];
-      const std::string label = options.compact ? mode.name : ModeLabel(a, mode);
+      const std::string& shown = names.empty() ? mode.name : names[m];
+      const std::string label = options.compact ? shown : ModeLabel(a, mode, shown);
       out << inner << prefix << "m" << m << " [shape=box, style=rounded, label=\"" << Escape(label)
           << "\"];\n";
     }
@@ -93,9 +97,21 @@ void WriteModes(const Automaton& a, const std::string& prefix, const std::string
   }
 }
 
-void WriteAutomaton(const Automaton& a, const std::string& prefix, const std::string& indent,
-                    const DotOptions& options, std::ostream& out) {
-  WriteModes(a, prefix, indent, options, out);
+// A product mode's name: each component's mode, qualified by its instance, joined with "|".
+std::string QualifiedModeName(const System& system, std::span<const int> tuple) {
+  std::string out;
+  for (size_t c = 0; c < tuple.size(); ++c) {
+    const Component& comp = system.components()[c];
+    const std::string& mode = comp.automaton.mode(ModeId(tuple[c])).name;
+    out += (c > 0 ? "|" : "") + (comp.instance.empty() ? mode : comp.instance + "." + mode);
+  }
+  return out;
+}
+
+void WriteAutomaton(const Automaton& a, std::span<const std::string> names,
+                    const std::string& prefix, const std::string& indent, const DotOptions& options,
+                    std::ostream& out) {
+  WriteModes(a, names, prefix, indent, options, out);
   for (size_t i = 0; i < a.initial_states().size(); ++i) {
     const InitialState& s = a.initial_states()[i];
     out << indent << prefix << "init" << i << " [shape=point, width=0.12];\n";
@@ -118,23 +134,27 @@ std::string WriteDot(const System& system, const DotOptions& options) {
   out << "digraph \"" << Escape(system.name()) << "\" {\n"
       << "  rankdir=LR;\n"
       // Clusters inside clusters (components, then groups) need the newer ranking.
-      << (options.group && !options.product && system.components().size() > 1
-              ? "  newrank=true;\n"
-              : "")
+      << (options.group && !options.product && system.components().size() > 1 ? "  newrank=true;\n"
+                                                                              : "")
       << "  node [fontname=\"Helvetica\", fontsize=10];\n"
       << "  edge [fontname=\"Helvetica\", fontsize=9];\n";
   const auto components = system.components();
-  if (options.product || components.size() == 1) {
-    const Automaton a =
-        options.product ? system.Product(options.max_product_modes) : components[0].automaton;
-    WriteAutomaton(a, "", "  ", options, out);
+  if (options.product) {
+    // Product modes shown as the simulator and the verifier name them: "P1.idle|P2.req".
+    std::vector<std::vector<int>> tuples;
+    const Automaton a = system.Product(options.max_product_modes, &tuples);
+    std::vector<std::string> names;
+    for (const std::vector<int>& tuple : tuples) names.push_back(QualifiedModeName(system, tuple));
+    WriteAutomaton(a, names, "", "  ", options, out);
+  } else if (components.size() == 1) {
+    WriteAutomaton(components[0].automaton, {}, "", "  ", options, out);
   } else {
     for (size_t c = 0; c < components.size(); ++c) {
       const Component& comp = components[c];
       out << "  subgraph cluster_" << c << " {\n    label=\""
           << Escape((comp.instance.empty() ? "" : comp.instance + ": ") + comp.automaton.name())
           << "\";\n";
-      WriteAutomaton(comp.automaton, "c" + std::to_string(c) + "_", "    ", options, out);
+      WriteAutomaton(comp.automaton, {}, "c" + std::to_string(c) + "_", "    ", options, out);
       out << "  }\n";
     }
   }

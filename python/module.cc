@@ -32,6 +32,7 @@
 #include "tools/gripper_command.h"
 #include "tools/info_command.h"
 #include "tools/options.h"
+#include "tools/simulate_command.h"
 
 namespace py = pybind11;
 
@@ -181,21 +182,6 @@ std::vector<InputSignal> Model::Signals(const std::map<std::string, SignalValue>
   return signals;
 }
 
-// The events of a run as a list of dicts (time, transitions, label, modes before and after).
-py::list EventsOf(const Simulator& sim, const SimulationResult& r) {
-  py::list events;
-  for (const EventRecord& e : r.events) {
-    py::dict d;
-    d["time"] = e.time;
-    d["transitions"] = e.transitions;
-    d["label"] = e.label;
-    d["modes_before"] = sim.ModeLabel(e.modes_before);
-    d["modes_after"] = sim.ModeLabel(e.modes_after);
-    events.append(d);
-  }
-  return events;
-}
-
 py::dict Model::Simulate(std::optional<double> until,
                          const std::map<std::string, SignalValue>& inputs,
                          std::optional<double> sample,
@@ -230,7 +216,9 @@ py::dict Model::Simulate(std::optional<double> until,
   out["time"] = time;
   out["states"] = states;
   out["modes"] = modes;
-  out["events"] = EventsOf(sim, r);
+  // final, events, steps, until (and zeno): the command's JSON, parsed by the package.
+  const double horizon = until ? *until : system_.scenario() ? system_.scenario()->until : 0.0;
+  out["report_json"] = cli::SimulationReport(sim, r, horizon).dump();
   return out;
 }
 

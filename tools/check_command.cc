@@ -64,10 +64,8 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
   json events = json::array();
   for (const EventRecord& e : t.run.events) {
     if (!EventBeforeState(t, e)) break;
-    std::string names;
-    for (const auto& n : e.transitions) names += (names.empty() ? "" : "+") + n;
     events.push_back({{"time", e.time},
-                      {"transitions", names},
+                      {"transitions", e.transitions},
                       {"mode_before", sim.ModeLabel(e.modes_before)},
                       {"mode_after", sim.ModeLabel(e.modes_after)}});
   }

@@ -73,7 +73,7 @@ json ConfigurationJson(double g, const FingerConfiguration& q) {
           {"theta3", q.theta[2]},
           {"phase", gripper::PhaseName(q.phase)},
           {"mode", gripper::FingerModeName(q)},
-          {"state",
+          {"discrete",
            {{"c1", q.c[0]},
             {"c2", q.c[1]},
             {"c3", q.c[2]},
@@ -550,9 +550,11 @@ json HandFingersJson(const gripper::Hand& hand, const std::array<double, 3>& com
 json HandTouchesJson(const gripper::Hand& hand) {
   json touches = json::array();
   for (const auto& t : hand.touches()) {
-    touches.push_back({{"fingers", std::string{kFingerNames[t.finger_a], kFingerNames[t.finger_b]}},
-                       {"links", {t.link_a + 1, t.link_b + 1}},
-                       {"g", t.g}});
+    touches.push_back(
+        {{"fingers",
+          {std::string(1, kFingerNames[t.finger_a]), std::string(1, kFingerNames[t.finger_b])}},
+         {"links", {t.link_a + 1, t.link_b + 1}},
+         {"g", t.g}});
   }
   return touches;
 }
@@ -610,8 +612,8 @@ std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spr
     out << "\n";
   }
   for (const auto& t : report.at("finger_touches")) {
-    out << "fingers " << t["fingers"].get<std::string>() << " touch (links "
-        << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
+    out << "fingers " << t["fingers"][0].get<std::string>() << t["fingers"][1].get<std::string>()
+        << " touch (links " << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
         << ") at g = " << Fixed(t["g"].get<double>(), 4) << "\n";
   }
   if (args.simulate) {

@@ -176,33 +176,6 @@ json State(const Simulator& sim, const Eigen::VectorXd& x) {
   return j;
 }
 
-json ResultJson(const Simulator& sim, const SimulationResult& r, double until) {
-  json events = json::array();
-  for (const EventRecord& e : r.events) {
-    events.push_back({{"time", e.time},
-                      {"cause", CauseName(e.cause)},
-                      {"transitions", e.transitions},
-                      {"label", e.label},
-                      {"mode_before", sim.ModeLabel(e.modes_before)},
-                      {"mode_after", sim.ModeLabel(e.modes_after)},
-                      {"before", State(sim, e.before)},
-                      {"after", State(sim, e.after)}});
-  }
-  const StateSample& last = r.samples.back();
-  json out = {
-      {"status", std::string(StatusName(r.status))},
-      {"message", r.message},
-      {"until", until},
-      {"final",
-       {{"time", last.time}, {"mode", sim.ModeLabel(last.modes)}, {"state", State(sim, last.x)}}},
-      {"steps", r.steps},
-      {"events", events}};
-  if (r.zeno) {
-    out["zeno"] = {{"accumulation_time", r.zeno->accumulation_time}, {"cycle", r.zeno->cycle}};
-  }
-  return out;
-}
-
 std::string SummaryText(const Simulator& sim, const SimulationResult& r, double until) {
   std::ostringstream out;
   out.precision(10);
@@ -278,6 +251,34 @@ void OverrideInputs(const std::vector<std::string>& specs, const SymbolTable& sy
 
 }  // namespace
 
+nlohmann::ordered_json SimulationReport(const Simulator& sim, const SimulationResult& r,
+                                        double until) {
+  json events = json::array();
+  for (const EventRecord& e : r.events) {
+    events.push_back({{"time", e.time},
+                      {"cause", CauseName(e.cause)},
+                      {"transitions", e.transitions},
+                      {"label", e.label},
+                      {"mode_before", sim.ModeLabel(e.modes_before)},
+                      {"mode_after", sim.ModeLabel(e.modes_after)},
+                      {"before", State(sim, e.before)},
+                      {"after", State(sim, e.after)}});
+  }
+  const StateSample& last = r.samples.back();
+  json out = {
+      {"status", std::string(StatusName(r.status))},
+      {"message", r.message},
+      {"until", until},
+      {"final",
+       {{"time", last.time}, {"mode", sim.ModeLabel(last.modes)}, {"values", State(sim, last.x)}}},
+      {"steps", r.steps},
+      {"events", events}};
+  if (r.zeno) {
+    out["zeno"] = {{"accumulation_time", r.zeno->accumulation_time}, {"cycle", r.zeno->cycle}};
+  }
+  return out;
+}
+
 int RunSimulate(const SimulateArgs& args) {
   CheckDistinctFiles({{"MODEL", args.model}, {"--input-csv", args.input_csv}},
                      {{"--out", args.out}, {"--events", args.events}, {"--plot", args.plot}});
@@ -332,7 +333,7 @@ int RunSimulate(const SimulateArgs& args) {
     files.emplace_back(args.plot, TrajectoryPlotSvg(sim, result, drawn, system.name()));
   }
   WriteOutputs(files);
-  WriteOutput("-", args.json ? ResultJson(sim, result, until).dump(2) + "\n"
+  WriteOutput("-", args.json ? SimulationReport(sim, result, until).dump(2) + "\n"
                              : SummaryText(sim, result, until));
   return result.status == SimulationStatus::kCompleted ? 0 : kExitStoppedEarly;
 }

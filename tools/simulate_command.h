@@ -1,8 +1,11 @@
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "solvers/simulation/simulator.h"
 
 namespace hybrid::cli {
 
@@ -30,5 +33,11 @@ struct SimulateArgs {
 /// model refuses (a value outside its bounds, an initial state outside its invariant). Writes
 /// --out and --events all or nothing (OutputError when a file cannot be written).
 int RunSimulate(const SimulateArgs& args);
+
+/// The JSON document of `hybrid simulate --json` for run `r` of `sim` to horizon `until`:
+/// status, message, until, final (a state: time, mode, values), steps, events (time, cause,
+/// transitions, label, mode_before, mode_after, before and after as values), zeno if detected.
+nlohmann::ordered_json SimulationReport(const Simulator& sim, const SimulationResult& r,
+                                        double until);
 
 }  // namespace hybrid::cli

@@ -84,13 +84,17 @@ class Model:
             parameters: {parameter name: value} overrides.
 
         Returns:
-            A dict: ``status`` ("completed" or why the run stopped early) and ``message``;
-            ``time`` (numpy array of the recorded instants: the start, samples, both sides of
-            every jump, the end); ``states`` ({variable name: numpy array}, aligned with
-            ``time``); ``modes`` (the mode at each instant, ``A.m|B.n`` for several components);
-            ``events`` (one dict per jump: time, transitions, label, modes_before, modes_after).
+            A dict: ``hybrid simulate --json``'s members (``status``, ``message``, ``until``,
+            ``final``: a state {time, mode, values}, ``steps``, ``events``: one dict per jump
+            with time, cause, transitions, label, mode_before, mode_after, before and after,
+            and ``zeno`` when detected), plus the trajectory as numpy arrays: ``time`` (the
+            recorded instants: the start, samples, both sides of every jump, the end),
+            ``states`` ({variable name: numpy array}, aligned with ``time``) and ``modes`` (the
+            mode at each instant, ``A.m|B.n`` for several components).
         """
-        return self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}))
+        result = self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}))
+        result.update(_json.loads(result.pop("report_json")))
+        return result
 
     def check(self, properties=None, method="auto", budget=60.0, depth=10):
         """Checks the model's properties (``hybrid check --json``).

@@ -175,8 +175,9 @@ TEST(DotWriter, ProductDrawing) {
   const std::string dot = WriteDot(s, {.product = true});
   EXPECT_EQ(Count(dot, "subgraph"), 0u);
   EXPECT_EQ(Count(dot, "[shape=box"), static_cast<size_t>(s.Product().num_modes()));
-  EXPECT_NE(dot.find("label=\"closed__dark (L.on=0)\\l"), std::string::npos) << dot;
-  EXPECT_NE(dot.find("label=\"open__lit (L.on=1)\\l"), std::string::npos) << dot;
+  // Product modes named as the simulator names them: instance.mode joined with "|".
+  EXPECT_NE(dot.find("label=\"D.closed|L.dark (L.on=0)\\l"), std::string::npos) << dot;
+  EXPECT_NE(dot.find("label=\"D.open|L.lit (L.on=1)\\l"), std::string::npos) << dot;
   EXPECT_NE(dot.find("[push]"), std::string::npos);
   const std::string svg = RenderSvg(dot);
   EXPECT_NE(svg.find("<svg"), std::string::npos);

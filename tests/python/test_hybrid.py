@@ -114,7 +114,18 @@ def test_thermostat_relaxes_exponentially():
     event = r["events"][0]
     assert abs(event["time"] - 10.0 * math.log(1.25)) <= 1e-6
     assert event["transitions"] == ["switch_on"]
-    assert (event["modes_before"], event["modes_after"]) == ("off", "on")
+    assert (event["mode_before"], event["mode_after"]) == ("off", "on")
+    assert event["before"]["x"] == pytest.approx(18.0) and event["cause"] == "invariant"
+    assert r["final"]["time"] == 3.0 and r["final"]["values"]["x"] == r["states"]["x"][-1]
+
+
+def test_simulate_has_the_command_lines_members():
+    model = hybrid.load(os.path.join(SOURCE, "spec", "thermostat.ha"))
+    r = model.simulate(until=30.0, inputs={"u": 10.0})
+    cli = json.loads(run("simulate", os.path.join(SOURCE, "spec", "thermostat.ha"), "--until",
+                         "30", "--input", "u=10", "--json").stdout)
+    assert len(cli["events"]) >= 2
+    assert {k: v for k, v in r.items() if k not in ("time", "states", "modes")} == cli
 
 
 TANK = textwrap.dedent("""\

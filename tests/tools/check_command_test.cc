@@ -222,7 +222,7 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   ASSERT_TRUE(replay.exit_code == 0 || replay.exit_code == 5) << replay.err;
   const json run = json::parse(replay.out);
   ASSERT_TRUE(run.contains("final")) << run.dump(2);
-  EXPECT_GT(Field(run, "final", "state").value("theta1", 0.0), 70.0) << run.dump(2);
+  EXPECT_GT(Field(run, "final", "values").value("theta1", 0.0), 70.0) << run.dump(2);
 
   // ... and at the violating state's time it is in the same mode with the same values, after
   // the same events.
@@ -230,7 +230,7 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   ASSERT_TRUE(at.contains("final")) << at.dump(2);
   EXPECT_EQ(Field(at, "final").value("mode", ""), Field(trace, "state").value("mode", "?"));
   for (const auto& [name, value] : Field(trace, "state", "values").items()) {
-    EXPECT_NEAR(Field(at, "final", "state").value(name, 1e300), value.get<double>(), 1e-6) << name;
+    EXPECT_NEAR(Field(at, "final", "values").value(name, 1e300), value.get<double>(), 1e-6) << name;
   }
   ASSERT_EQ(at.value("events", json::array()).size(), Field(trace, "events").size()) << at.dump(2);
   for (std::size_t i = 0; i < Field(trace, "events").size(); ++i) {
@@ -373,7 +373,7 @@ TEST(CheckCommand, TankOfTheIssueIsViolatedAndReachableByBothMethods) {
     const double at = Field(trace, "state").value("time", -1.0);
     ASSERT_GT(at, 0.0) << trace.dump(2);
     const json sim = RunHybridJson("simulate " + Quote(model) + ReplayArguments(trace, at), 0);
-    EXPECT_GT(Field(sim, "final", "state").value("h", 0.0), 6.0) << sim.dump(2);
+    EXPECT_GT(Field(sim, "final", "values").value("h", 0.0), 6.0) << sim.dump(2);
   }
   const Result text = RunHybrid("check " + Quote(model));
   EXPECT_EQ(text.out.find("proved"), std::string::npos) << text.out;

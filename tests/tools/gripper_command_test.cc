@@ -114,7 +114,7 @@ TEST(HybridFinger, JsonAtG120HasEveryKey) {
   EXPECT_EQ(Field(j, "motor"), 120.0);
   EXPECT_EQ(Field(j, "phase"), "1'");
   EXPECT_EQ(Field(j, "mode"), "c000_l00n");
-  EXPECT_EQ(Field(j, "state"),
+  EXPECT_EQ(Field(j, "discrete"),
             (json{{"c1", 0}, {"c2", 0}, {"c3", 0}, {"l1", 0}, {"l2", 0}, {"l3", -1}}));
   ASSERT_TRUE(Field(j, "contacts").is_array());
   EXPECT_TRUE(Field(j, "contacts").empty());
@@ -145,8 +145,8 @@ TEST(HybridFinger, Link1ContactFollowsTheContactTable) {
   EXPECT_NEAR(Field(j, "theta3").get<double>(), -55.0 + 98.0 * (200.0 - 180.0) / (255.0 - 200.0),
               1e-9);
   EXPECT_EQ(Field(j, "phase"), "3");
-  EXPECT_EQ(Field(j, "state", "c1"), 1);
-  EXPECT_EQ(Field(j, "state", "l2"), 1);
+  EXPECT_EQ(Field(j, "discrete", "c1"), 1);
+  EXPECT_EQ(Field(j, "discrete", "l2"), 1);
   EXPECT_NEAR(Field(j, "stop").get<double>(), 217.5, 1e-9);
   ASSERT_EQ(Field(j, "contacts").size(), 1u) << j.dump(2);
   EXPECT_EQ(Field(j, "contacts", 0, "link"), 1);
@@ -167,7 +167,7 @@ TEST(HybridFinger, CircleBlocksLink1AtTheAnalyticPosition) {
   EXPECT_EQ(Field(c, "by"), "object 1");
   EXPECT_NEAR(Field(c, "g").get<double>(), Link1CircleGob1(), 1e-6);
   EXPECT_NEAR(Field(j, "theta1").get<double>(), 0.5 * Link1CircleGob1(), 1e-6);
-  EXPECT_EQ(Field(j, "state", "c1"), 1);
+  EXPECT_EQ(Field(j, "discrete", "c1"), 1);
   ASSERT_EQ(Field(j, "objects").size(), 1u);
   // Link 2 then reaches its limit 100 counts later and phase 3 ends half way to 255 (C3).
   EXPECT_NEAR(Field(j, "stop").get<double>(), (Link1CircleGob1() + 100.0 + 255.0) / 2.0, 1e-6);
@@ -486,13 +486,13 @@ TEST(HybridHand, EveryFingerTouchesACentredCylinderWithLink2) {
     const json& finger = Field(j, "fingers", f);
     SCOPED_TRACE(std::string("finger ") + "ABC"[f]);
     EXPECT_EQ(Field(finger, "finger"), std::string(1, "ABC"[f]));
-    for (const char* k : {"theta1", "theta2", "theta3", "motor", "command", "state", "stop"}) {
+    for (const char* k : {"theta1", "theta2", "theta3", "motor", "command", "discrete", "stop"}) {
       EXPECT_TRUE(finger.contains(k)) << k;
     }
     ASSERT_EQ(Field(finger, "contacts").size(), 1u) << finger.dump(2);
     EXPECT_EQ(Field(finger, "contacts", 0, "link"), 2);
     EXPECT_EQ(Field(finger, "contacts", 0, "by"), "object 1");
-    EXPECT_EQ(Field(finger, "state", "c2"), 1);
+    EXPECT_EQ(Field(finger, "discrete", "c2"), 1);
   }
   ASSERT_TRUE(Field(j, "finger_touches").is_array());
   EXPECT_TRUE(Field(j, "finger_touches").empty());
@@ -537,7 +537,8 @@ TEST(HybridHand, PinchWithPerFingerCommandReportsFingerTouches) {
   ASSERT_TRUE(Field(j, "finger_touches").is_array());
   EXPECT_FALSE(Field(j, "finger_touches").empty()) << j.dump(2);
   for (const json& t : Field(j, "finger_touches")) {
-    EXPECT_EQ(Field(t, "fingers").get<std::string>().size(), 2u);
+    ASSERT_EQ(Field(t, "fingers").size(), 2u);  // two finger names, as in fingers[].finger
+    EXPECT_NE(Field(t, "fingers", 0).get<std::string>(), Field(t, "fingers", 1).get<std::string>());
     EXPECT_EQ(Field(t, "links").size(), 2u);
   }
 }

@@ -379,7 +379,12 @@ system s { instance A = a; instance B = a; }
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string written = ReadAll(out);
   EXPECT_EQ(written, WriteDot(ParseModelFile(model), {.product = true}));
-  EXPECT_NE(written.find("n__n"), std::string::npos);
+  // Product modes named as simulate and check name them (instance.mode joined with "|").
+  EXPECT_NE(written.find("label=\"A.n|B.n\\l"), std::string::npos) << written;
+  const Result sim = RunHybrid("simulate " + Quote(model) + " --until 1 --json");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_NE(sim.out.find("\"mode\": \"A.n|B.n\""), std::string::npos) << sim.out;
+  EXPECT_NE(written.find("label=\"A.m|B.m\\l"), std::string::npos);
 }
 
 TEST(HybridCli, UnwritableOutputExitsThreeAndLeavesNoFile) {

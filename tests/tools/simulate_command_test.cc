@@ -94,13 +94,13 @@ TEST(HybridSimulate, JsonHasStatusEventsAndStatesByName) {
   EXPECT_EQ(Field(j, "events", 3, "cause"), "enabled");  // u reverses at t = 265
   EXPECT_EQ(Field(j, "final", "time"), 530.0);
   EXPECT_EQ(Field(j, "final", "mode"), "c000_l000");
-  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 0.0, 1e-8);
+  EXPECT_NEAR(Field(j, "final", "values", "g").get<double>(), 0.0, 1e-8);
   EXPECT_GE(Field(j, "steps").get<long>(), 0);  // CVODE steps: none for constant-rate modes
   EXPECT_FALSE(j.contains("zeno"));
   // A composed model: qualified variable and mode names.
   const json hand = SimulateJson(Quote(Spec("hand")));
   EXPECT_EQ(Field(hand, "status"), "completed");
-  EXPECT_TRUE(Field(hand, "final", "state").contains("B.theta2"));
+  EXPECT_TRUE(Field(hand, "final", "values").contains("B.theta2"));
   EXPECT_EQ(Field(hand, "events", 0, "transitions"), json::array({"A.t5_c000_l000_to_c000_l00n"}));
 }
 
@@ -185,18 +185,18 @@ TEST(HybridSimulate, InputOverridesTheScenario) {
   ASSERT_EQ(Field(j, "status"), "completed");
   EXPECT_TRUE(Field(j, "events").empty());
   EXPECT_EQ(Field(j, "until"), 50.0);
-  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 10.0, 1e-9);
-  EXPECT_NEAR(Field(j, "final", "state", "theta1").get<double>(), 5.0, 1e-9);
-  EXPECT_NEAR(Field(j, "final", "state", "theta3").get<double>(), -5.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "values", "g").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "values", "theta1").get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "values", "theta3").get<double>(), -5.0, 1e-9);
   // A constant and a linear signal.
   const json c = SimulateJson(Quote(Spec("finger")) + " --input u=0.5 --until 20");
-  EXPECT_NEAR(Field(c, "final", "state", "g").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(c, "final", "values", "g").get<double>(), 10.0, 1e-9);
   const json l = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=linear(0: 0, 10: 1)") +
                               " --until 20");
-  EXPECT_NEAR(Field(l, "final", "state", "g").get<double>(), 5.0 + 10.0, 1e-9);  // t^2/20, then t
+  EXPECT_NEAR(Field(l, "final", "values", "g").get<double>(), 5.0 + 10.0, 1e-9);  // t^2/20, then t
   // The last --input for a name wins.
   const json last = SimulateJson(Quote(Spec("finger")) + " --input u=1 --input u=0.25 --until 20");
-  EXPECT_NEAR(Field(last, "final", "state", "g").get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(Field(last, "final", "values", "g").get<double>(), 5.0, 1e-9);
 }
 
 TEST(HybridSimulate, InputCsvDrivesTheInputs) {
@@ -205,15 +205,15 @@ TEST(HybridSimulate, InputCsvDrivesTheInputs) {
   const json j =
       SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) + " --until 50");
   ASSERT_EQ(Field(j, "status"), "completed");
-  EXPECT_NEAR(Field(j, "final", "state", "g").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(j, "final", "values", "g").get<double>(), 10.0, 1e-9);
   const std::string ramp = dir.Write("ramp.csv", "time, u\n0, 0\n10, 1\n");
   const json l = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(ramp) +
                               " --csv-shape linear --until 20");
-  EXPECT_NEAR(Field(l, "final", "state", "g").get<double>(), 15.0, 1e-9);
+  EXPECT_NEAR(Field(l, "final", "values", "g").get<double>(), 15.0, 1e-9);
   // --input overrides the CSV.
   const json o = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) +
                               " --input u=0.5 --until 20");
-  EXPECT_NEAR(Field(o, "final", "state", "g").get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(Field(o, "final", "values", "g").get<double>(), 10.0, 1e-9);
 }
 
 // ---------------------------------------------------------------------------------------------
