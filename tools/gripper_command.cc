@@ -241,6 +241,11 @@ void CheckBatchArgs(const FingerArgs& args) {
 
 FingerContacts CheckFingerArgs(FingerArgs& args) {
   CheckBatchArgs(args);
+  // Asked nothing else, the finger answers for the fully closing command, as `hand` does.
+  if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty() &&
+      args.queries.empty() && args.g_range.empty()) {
+    args.g = kDefaultMotorCommand;
+  }
   const std::vector<NamedFile> outputs = {
       {"--draw", args.draw}, {"--plot", args.plot}, {"-o/--output", args.output}};
   std::vector<NamedFile> inputs;
@@ -269,11 +274,6 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   }
   if (!args.data.empty() && args.plot.empty()) {
     throw UsageError("--data needs --plot (it overlays the runs on the plot)");
-  }
-  if (!args.g && args.requests.empty() && args.draw.empty() && args.plot.empty() &&
-      args.queries.empty() && args.g_range.empty()) {
-    throw std::invalid_argument(
-        "nothing to do: give --g, --queries, --g-range, --requests, --draw or --plot");
   }
   return contacts;
 }

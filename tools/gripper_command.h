@@ -9,9 +9,12 @@
 
 namespace hybrid::cli {
 
+/// The motor command `finger` and `hand` use when none is given: 255, fully closing.
+inline constexpr double kDefaultMotorCommand = 255.0;
+
 /// Options of `hybrid finger` (see docs/cli.md).
 struct FingerArgs {
-  std::optional<double> g;                   ///< commanded motor position (required unless drawing)
+  std::optional<double> g;  ///< commanded motor position (kDefaultMotorCommand if nothing else asked)
   std::vector<double> requests;              ///< --requests: a history of position requests
   std::array<std::optional<double>, 3> gob;  ///< --gob1..3 when given
   std::vector<std::string> objects;          ///< --object descriptions (finger frame)
@@ -32,7 +35,7 @@ struct HandArgs {
   std::vector<std::string> objects;     ///< --object descriptions (palm x-y plane)
   std::string mode = "basic";           ///< operating mode (sets the spread)
   std::optional<double> spread;         ///< spread motor position (overrides the mode's)
-  double g = 255.0;                     ///< one motor command for all fingers
+  double g = kDefaultMotorCommand;      ///< one motor command for all fingers
   std::optional<double> g_a, g_b, g_c;  ///< per-finger commands (override g)
   bool json = false;
   std::string draw;  ///< SVG of the hand at `draw_at`

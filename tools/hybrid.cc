@@ -230,7 +230,9 @@ void AddFinger(CLI::App& app, Commands& c) {
       "finger",
       "One Robotiq finger, closed form (report section 4): joint angles at motor position G, "
       "against objects given by contact positions or by geometry");
-  AddNumberOption(finger, "--g", &a.g, "Motor position in [0, 255]");
+  AddNumberOption(finger, "--g", &a.g,
+                  "Motor position in [0, 255] (default 255, the fully closing command, when "
+                  "neither --queries, --g-range, --requests, --draw nor --plot is given)");
   for (int i = 0; i < 3; ++i) {
     AddNumberOption(finger, "--gob" + std::to_string(i + 1), &a.gob[i],
                     "Motor position where link " + std::to_string(i + 1) +

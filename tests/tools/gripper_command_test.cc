@@ -407,8 +407,23 @@ TEST(HybridFinger, BadOptionValuesAreExit2) {
   EXPECT_TRUE(dir.Files().empty());
   ExpectRejected("finger --gob1 80 --object " + Link1Circle() + " --g 100", 2,
                  {"--gob", "--object"});
-  ExpectRejected("finger", 2, {"--g", "--draw", "--plot"});
-  ExpectRejected("finger --json", 2, {"nothing to do"});
+}
+
+// Asked nothing else, `finger` answers for g = 255 as `hand` does: the free finger against the
+// palm (table 4.1 with decision D3: theta = (70, 90, -55)).
+TEST(HybridFinger, GDefaultsToTheFullyClosingCommand) {
+  const Result r = RunHybrid("finger --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(Field(j, "g"), 255.0);
+  EXPECT_NEAR(Field(j, "theta1").get<double>(), 70.0, 1e-12);
+  EXPECT_NEAR(Field(j, "theta2").get<double>(), 90.0, 1e-12);
+  EXPECT_NEAR(Field(j, "theta3").get<double>(), -55.0, 1e-12);
+  EXPECT_EQ(RunHybrid("finger").out, RunHybrid("finger --g 255").out);
+  // With another question, no default position is added.
+  const Result batch = RunHybrid("finger --g-range 0:10:2 --json");
+  ASSERT_EQ(batch.exit_code, 0) << batch.err;
+  EXPECT_EQ(json::parse(batch.out).size(), 2u);
 }
 
 // Numbers are numbers: an empty value is not 0, hexadecimal, doubled signs, inf, blanks and
