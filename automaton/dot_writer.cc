@@ -101,9 +101,7 @@ void WriteModes(const Automaton& a, std::span<const std::string> names, const st
 std::string QualifiedModeName(const System& system, std::span<const int> tuple) {
   std::string out;
   for (size_t c = 0; c < tuple.size(); ++c) {
-    const Component& comp = system.components()[c];
-    const std::string& mode = comp.automaton.mode(ModeId(tuple[c])).name;
-    out += (c > 0 ? "|" : "") + (comp.instance.empty() ? mode : comp.instance + "." + mode);
+    out += (c > 0 ? "|" : "") + system.QualifiedModeName(static_cast<int>(c), ModeId(tuple[c]));
   }
   return out;
 }

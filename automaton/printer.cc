@@ -24,24 +24,27 @@ void PrintScenario(const Scenario& scenario, const SymbolTable& symbols, const s
                    std::ostream& out) {
   out << indent << "scenario {\n" << indent << "  until " << FormatNumber(scenario.until) << ";\n";
   for (const InputSignal& s : scenario.inputs) {
-    out << indent << "  " << symbols[s.slot].name << " = ";
-    if (s.shape == InputSignal::Shape::kStep && s.points.size() == 1 && s.points[0].first == 0.0 &&
-        !std::signbit(s.points[0].first)) {
-      out << FormatNumber(s.points[0].second);
-    } else {
-      out << (s.shape == InputSignal::Shape::kStep ? "step(" : "linear(");
-      for (size_t i = 0; i < s.points.size(); ++i) {
-        out << (i > 0 ? ", " : "") << FormatNumber(s.points[i].first) << ": "
-            << FormatNumber(s.points[i].second);
-      }
-      out << ")";
-    }
-    out << ";\n";
+    out << indent << "  " << symbols[s.slot].name << " = " << SignalText(s) << ";\n";
   }
   out << indent << "}\n";
 }
 
 }  // namespace
+
+std::string SignalText(const InputSignal& s) {
+  if (s.shape == InputSignal::Shape::kStep && s.points.size() == 1 && s.points[0].first == 0.0 &&
+      !std::signbit(s.points[0].first)) {
+    return FormatNumber(s.points[0].second);
+  }
+  std::string text = s.shape == InputSignal::Shape::kStep ? "step(" : "linear(";
+  for (size_t i = 0; i < s.points.size(); ++i) {
+    text += i > 0 ? ", " : "";
+    text += FormatNumber(s.points[i].first);
+    text += ": ";
+    text += FormatNumber(s.points[i].second);
+  }
+  return text + ")";
+}
 
 std::string FlowText(const Expression& flow) {
   std::string text = " = ";

@@ -18,6 +18,11 @@ std::string PrintAutomaton(const Automaton& automaton);
 /// (AsRectangularFlow), " = EXPRESSION" otherwise.
 std::string FlowText(const Expression& flow);
 
+/// An input signal as the language writes it (a scenario's right-hand side, and what `hybrid
+/// simulate --input NAME=SIGNAL` and ParseSignal read back): a number for a constant, else
+/// "step(t0: v0, t1: v1, ...)" or "linear(...)", numbers in shortest round-trip form.
+std::string SignalText(const InputSignal& signal);
+
 /// Writes `system`: each distinct automaton it instantiates (as declared, before renaming), then
 /// the `system` block. For a system made by System::Of, writes the automaton alone. Parsing the
 /// result (ParseModel) gives an equal System.

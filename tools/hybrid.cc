@@ -132,8 +132,9 @@ struct Commands {
 // `hybrid info` and `hybrid dot`.
 void AddModelCommands(CLI::App& app, Commands& c) {
   c.info = app.add_subcommand("info",
-                              "Summarise a model: variables, modes, transitions, "
-                              "reachable modes, cycles, warnings");
+                              "Show a model: every declaration in the model language (units, "
+                              "ranges, horizons, scenario), then its reachable modes, cycles and "
+                              "warnings as comments; --json for the JSON report");
   c.info->add_option("MODEL", c.model, kModelHelp)->required();
   c.info->add_flag("--json", c.as_json, "Machine-readable output");
 
@@ -390,7 +391,7 @@ int RunModelCommand(const Commands& c) {
     }
     // The file name may be any bytes: replace invalid UTF-8 rather than throw.
     WriteOutput("-", c.as_json ? report.dump(2, ' ', false, json::error_handler_t::replace) + "\n"
-                               : hybrid::cli::InfoText(report));
+                               : hybrid::cli::InfoText(report, system));
     return 0;
   }
   std::string text;

@@ -3,6 +3,7 @@
 #include <sstream>
 #include <vector>
 
+#include "automaton/expression.h"
 #include "automaton/mode_graph.h"
 #include "automaton/printer.h"
 #include "automaton/rectangular_rate.h"
@@ -36,7 +37,8 @@ json ScenarioJson(const hybrid::Scenario& sc, const hybrid::SymbolTable& symbols
     for (const auto& [t, v] : sig.points) points.push_back({t, v});
     inputs.push_back({{"input", symbols[sig.slot].name},
                       {"shape", sig.shape == hybrid::InputSignal::Shape::kStep ? "step" : "linear"},
-                      {"points", points}});
+                      {"points", points},
+                      {"signal", hybrid::SignalText(sig)}});
   }
   return {{"until", sc.until}, {"inputs", inputs}};
 }
@@ -205,89 +207,55 @@ std::string Join(const json& array, const std::string& sep = ", ") {
   return out;
 }
 
-// One component of InfoText.
-void ComponentText(const json& c, std::ostringstream& out) {
+// The analysis of one component, as comments: its modes, which of them the transition graph
+// reaches, which cannot be left, and its cycles.
+void ComponentAnalysisText(const json& c, std::ostringstream& out) {
   const std::string instance = c["instance"].get<std::string>();
-  out << "\n"
-      << (instance.empty() ? "automaton " : "instance " + instance + " = automaton ")
-      << c["automaton"].get<std::string>() << "\n";
-  if (!c["binds"].empty()) {
-    out << "  binds:";
-    for (const auto& [from, to] : c["binds"].items())
-      out << " " << from << " = " << to.get<std::string>() << ";";
-    out << "\n";
-  }
-  out << "  variables (" << c["variables"].size() << "):";
-  for (const auto& v : c["variables"]) {
-    out << " " << v["name"].get<std::string>();
-    if (!v["unit"].get<std::string>().empty()) out << " [" << v["unit"].get<std::string>() << "]";
-    if (v.contains("domain")) out << " in " << v["domain"].dump();
-    out << ";";
-  }
-  out << "\n";
-  if (!c["discrete_variables"].empty()) {
-    out << "  discrete variables (" << c["discrete_variables"].size()
-        << "): " << Join(c["discrete_variables"]) << "\n";
-  }
-  for (const auto& in : c["inputs"]) {
-    out << "  input " << in["name"].get<std::string>() << " in " << in["bounds"].dump() << "\n";
-  }
-  out << "  parameters (" << c["parameters"].size() << "):";
-  for (const auto& p : c["parameters"]) {
-    out << " " << p["name"].get<std::string>() << " = " << p["value"].dump() << ";";
-  }
-  out << "\n  modes (" << c["modes"].size() << "): ";
+  const std::string automaton = c["automaton"].get<std::string>();
+  out << "# " << (instance.empty() ? "automaton " + automaton : instance + " (" + automaton + ")")
+      << "\n";
   json names = json::array();
   for (const auto& m : c["modes"]) names.push_back(m["name"]);
-  out << Join(names) << "\n";
-  out << "  transitions (" << c["transitions"].size() << "):\n";
-  for (const auto& t : c["transitions"]) {
-    out << "    " << t["name"].get<std::string>() << ": " << t["source"].get<std::string>()
-        << " -> " << t["target"].get<std::string>();
-    if (!t["label"].get<std::string>().empty()) out << " [" << t["label"].get<std::string>() << "]";
-    out << " when " << t["guard"].get<std::string>();
-    if (t["urgency"] == "lazy") out << " (lazy)";
-    out << "\n";
-  }
-  for (const auto& init : c["initial_states"]) {
-    out << "  initial: " << init["mode"].get<std::string>() << " " << init["values"].dump() << "\n";
-  }
-  out << "  reachable modes (" << c["reachable_modes"].size() << " of " << c["modes"].size()
+  out << "#   modes (" << names.size() << "): " << Join(names) << "\n";
+  out << "#   reachable modes (" << c["reachable_modes"].size() << " of " << names.size()
       << "): " << Join(c["reachable_modes"]) << "\n";
-  out << "  terminal modes: " << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"]))
-      << "\n";
-  out << "  cycles (strongly connected components with more than one mode): " << c["cycles"].size()
-      << "\n";
-  for (const auto& p : c["properties"]) {
-    out << "  property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
-        << " " << p["predicate"].get<std::string>() << "\n";
+  if (!c["unreachable_modes"].empty()) {
+    out << "#   unreachable modes: " << Join(c["unreachable_modes"]) << "\n";
   }
+  out << "#   terminal modes: "
+      << (c["terminal_modes"].empty() ? "none" : Join(c["terminal_modes"])) << "\n";
+  out << "#   cycles (strongly connected components with more than one mode): "
+      << c["cycles"].size() << "\n";
+}
+
+// The scenario as options of `hybrid simulate` (--until and one --input per signal).
+std::string ScenarioOptions(const json& scenario) {
+  std::string text = "--until " + FormatNumber(scenario["until"].get<double>());
+  for (const auto& in : scenario["inputs"]) {
+    text +=
+        " --input '" + in["input"].get<std::string>() + "=" + in["signal"].get<std::string>() + "'";
+  }
+  return text;
 }
 
 }  // namespace
 
-std::string InfoText(const json& info) {
+std::string InfoText(const json& info, const System& system) {
   std::ostringstream out;
-  out << "model " << info["name"].get<std::string>() << " (" << info["file"].get<std::string>()
-      << ")\n";
-  if (!info["shared"].empty()) out << "shared: " << Join(info["shared"]) << "\n";
-  for (const auto& c : info["components"]) ComponentText(c, out);
-  for (const auto& p : info["properties"]) {
-    if (info["components"].size() == 1) break;  // single automaton: already listed
-    out << "property " << p["name"].get<std::string>() << ": " << p["kind"].get<std::string>()
-        << " " << p["predicate"].get<std::string>() << "\n";
-  }
+  out << "# model " << info["name"].get<std::string>() << " (" << info["file"].get<std::string>()
+      << ")\n"
+      << "# Below: the model as the language writes it (it parses back to the same model), then\n"
+      << "# what the analysis of its mode graphs found, as comments.\n\n"
+      << PrintSystem(system) << "\n# analysis\n";
+  if (!info["shared"].empty()) out << "# shared variables: " << Join(info["shared"]) << "\n";
+  for (const auto& c : info["components"]) ComponentAnalysisText(c, out);
   if (!info["scenario"].is_null()) {
-    out << "\nscenario: until " << info["scenario"]["until"].dump();
-    for (const auto& in : info["scenario"]["inputs"]) {
-      out << "; " << in["input"].get<std::string>() << " = " << in["shape"].get<std::string>()
-          << in["points"].dump();
-    }
-    out << "\n";
+    out << "# the scenario on the command line: hybrid simulate MODEL "
+        << ScenarioOptions(info["scenario"]) << "\n";
   }
-  out << "\nwarnings: "
+  out << "# warnings: "
       << (info["warnings"].empty() ? "none" : std::to_string(info["warnings"].size())) << "\n";
-  for (const auto& w : info["warnings"]) out << "  warning: " << w.get<std::string>() << "\n";
+  for (const auto& w : info["warnings"]) out << "#   warning: " << w.get<std::string>() << "\n";
   return out.str();
 }
 

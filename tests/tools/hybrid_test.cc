@@ -199,10 +199,11 @@ TEST(HybridCli, InfoJsonOfTheFinger) {
 TEST(HybridCli, InfoTextOfTheFinger) {
   const Result r = RunHybrid("info " + Quote(kFinger));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(r.out.starts_with("model finger (" + kFinger.string() + ")\n")) << r.out;
-  EXPECT_NE(r.out.find("modes (31): c000_l000, "), std::string::npos);
-  EXPECT_NE(r.out.find("reachable modes (31 of 31)"), std::string::npos);
-  EXPECT_NE(r.out.find("\nwarnings: none\n"), std::string::npos);
+  EXPECT_TRUE(r.out.starts_with("# model finger (" + kFinger.string() + ")\n")) << r.out;
+  EXPECT_NE(r.out.find("\nautomaton finger {\n"), std::string::npos);
+  EXPECT_NE(r.out.find("#   modes (31): c000_l000, "), std::string::npos);
+  EXPECT_NE(r.out.find("#   reachable modes (31 of 31)"), std::string::npos);
+  EXPECT_NE(r.out.find("\n# warnings: none\n"), std::string::npos);
 }
 
 TEST(HybridCli, InfoOfAComposedSystemWithWarnings) {
