@@ -14,6 +14,7 @@
 #include "solvers/verification/property_prover.h"
 #include "solvers/verification/property_sampler.h"
 #include "tools/output.h"
+#include "tools/progress.h"
 
 namespace hybrid::cli {
 namespace {
@@ -164,11 +165,26 @@ struct Findings {
   double seconds = 0.0;
 };
 
+// "12.3 s".
+std::string Seconds(double s) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(1);
+  out << s << " s";
+  return out.str();
+}
+
 // The bounds of polyhedral reachability: its deterministic state bound, and --budget as the
-// seconds of its CPU-time safety net.
-PolyhedralReachability::Options ReachOptions(const CheckArgs& args) {
+// seconds of its CPU-time safety net; its state count goes to `progress`.
+PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine& progress) {
   PolyhedralReachability::Options options;
   options.cpu_seconds = args.budget;
+  if (progress.enabled()) {
+    options.progress = [&progress](int states, int queued) {
+      progress.Report("reachability: " + std::to_string(states) + " symbolic states, " +
+                      std::to_string(queued) + " queued, " + Seconds(progress.Elapsed()));
+    };
+  }
   return options;
 }
 
@@ -207,18 +223,26 @@ std::vector<CheckResult> CheckAuto(const PolyhedralReachability::Options& reach,
 // --seed), one result per property in order.
 std::vector<CheckResult> CheckProperties(const CheckArgs& args,
                                          const PropertyProver::Options& prove, const System& system,
-                                         const std::vector<Property>& chosen,
-                                         SolverBudget& budget) {
+                                         const std::vector<Property>& chosen, SolverBudget& budget,
+                                         ProgressLine& progress) {
   if (args.method == "reach")
-    return PolyhedralReachability(ReachOptions(args)).Check(system, chosen);
+    return PolyhedralReachability(ReachOptions(args, progress)).Check(system, chosen);
   if (args.method == "prove") return PropertyProver(prove).Check(system, chosen, budget);
-  if (args.method == "auto") return CheckAuto(ReachOptions(args), prove, system, chosen, budget);
+  if (args.method == "auto") {
+    return CheckAuto(ReachOptions(args, progress), prove, system, chosen, budget);
+  }
   std::vector<CheckResult> results;
   PropertySampler::Options options;
   options.runs = args.runs;
   options.seed = args.seed;
   const PropertySampler sampler(options);
-  for (const Property& p : chosen) results.push_back(sampler.Check(system, p));
+  for (const Property& p : chosen) {
+    progress.Report("sample: property " + std::to_string(results.size() + 1) + " of " +
+                        std::to_string(chosen.size()) + " (" + p.name + "), " +
+                        Seconds(progress.Elapsed()),
+                    true);
+    results.push_back(sampler.Check(system, p));
+  }
   return results;
 }
 
@@ -325,10 +349,20 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   found.chosen = ChosenProperties(args, DeclaredProperties(system));
   // One solver budget for the whole command: the properties, then --modes, draw from it.
   SolverBudget budget(args.budget);
+  ProgressLine progress("check", args.progress);
+  std::string stage = "prove";
+  if (progress.enabled()) {
+    budget.SetObserver([&progress, &stage](const SolverBudget& b) {
+      progress.Report(stage + ": " +
+                      std::to_string(b.used() * 100 / std::max<std::uint64_t>(b.total(), 1)) +
+                      "% of the solver budget used, " + Seconds(progress.Elapsed()));
+    });
+  }
   PropertyProver::Options prove;
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
-  found.results = CheckProperties(args, prove, system, found.chosen, budget);
+  found.results = CheckProperties(args, prove, system, found.chosen, budget, progress);
+  stage = "modes";
   if (args.modes) {
     for (std::size_t c = 0; c < system.components().size(); ++c) {
       found.modes.push_back(

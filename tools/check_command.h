@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "automaton/system.h"
+#include "tools/progress.h"
 
 namespace hybrid::cli {
 
@@ -21,6 +22,8 @@ struct CheckArgs {
   int induction = 1;       ///< prove: largest k of k-induction
   int runs = 200;          ///< sample: random runs per property
   std::uint64_t seed = 1;  ///< sample: seed
+  /// Progress on standard error (the command line: kAuto, --quiet, --progress).
+  ProgressMode progress = ProgressMode::kOff;
 };
 
 /// Runs `hybrid check`; returns the exit code: 0 when no property is violated or unknown, 6 when

@@ -18,6 +18,7 @@
 #include "tools/gripper_command.h"
 #include "tools/options.h"
 #include "tools/output.h"
+#include "tools/progress.h"
 
 namespace hybrid::cli {
 namespace {
@@ -206,6 +207,17 @@ Diagnosis Diagnosed(const DiagnoseArgs& args, const FingerPredictor& predictor, 
   FingerDiagnosisOptions options;
   options.significance = args.significance;
   options.threads = args.threads;
+  ProgressLine progress("diagnose", args.progress);
+  if (progress.enabled()) {
+    options.progress = [&progress](const std::string& stage, int done, int total) {
+      std::ostringstream text;
+      text.setf(std::ios::fixed);
+      text.precision(1);
+      text << stage << ": candidate " << done + 1 << " of " << total << ", " << progress.Elapsed()
+           << " s";
+      progress.Report(text.str(), true);
+    };
+  }
   Diagnosis d = Diagnose(predictor, std::move(data), options);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return d;

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "tools/progress.h"
+
 namespace hybrid::cli {
 
 /// Options of `hybrid diagnose` (see docs/cli.md and docs/diagnosis.md).
@@ -16,6 +18,8 @@ struct DiagnoseArgs {
   std::string report;     ///< write diagnosis.json and SVG plots into this directory
   double significance = 25.0;
   int threads = 2;
+  /// Progress on standard error (the command line: kAuto, --quiet, --progress).
+  ProgressMode progress = ProgressMode::kOff;
 };
 
 /// Runs `hybrid diagnose`; returns 0. Before any work: UsageError (tools/options.h, exit 2) for

@@ -193,6 +193,22 @@ void AddSimulate(CLI::App& app, Commands& c) {
 }
 
 // `hybrid check`.
+// --quiet and --progress of a long-running command: its progress report on standard error, by
+// default while it runs when standard error is a terminal.
+void AddProgressOptions(CLI::App* command, hybrid::cli::ProgressMode* mode) {
+  using hybrid::cli::ProgressMode;
+  *mode = ProgressMode::kAuto;
+  CLI::Option* quiet = command->add_flag_callback(
+      "--quiet", [mode] { *mode = ProgressMode::kOff; },
+      "No progress report on standard error (default: one line while running, when standard "
+      "error is a terminal)");
+  command
+      ->add_flag_callback(
+          "--progress", [mode] { *mode = ProgressMode::kOn; },
+          "Progress reports on standard error even when it is not a terminal (one line each)")
+      ->excludes(quiet);
+}
+
 void AddCheck(CLI::App& app, Commands& c) {
   hybrid::cli::CheckArgs& a = c.check_args;
   CLI::App* check = c.check = app.add_subcommand(
@@ -213,6 +229,7 @@ void AddCheck(CLI::App& app, Commands& c) {
       ->capture_default_str();
   check->add_flag("--json", a.json, "Machine-readable output");
   check->add_flag("--modes", a.modes, "Also report which modes (discrete states) some run reaches");
+  AddProgressOptions(check, &a.progress);
   AddNumberOption(check, "--depth", &a.depth,
                   "prove: longest counterexample or witness searched, in steps (flow segments "
                   "and jumps)");
@@ -318,6 +335,7 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
   AddNumberOption(diagnose, "--significance", &d.significance,
                   "Held-out gain (chi-square units) needed to name a cause");
   AddNumberOption(diagnose, "--threads", &d.threads, "Worker threads");
+  AddProgressOptions(diagnose, &d.progress);
 
   hybrid::cli::SynthesizeArgs& s = c.synthesize_args;
   CLI::App* synthesize = c.synthesize = app.add_subcommand(

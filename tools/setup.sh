@@ -25,6 +25,7 @@ packages=(
   python3-scipy python3-numpy  # tools/compare_scipy.py: the finger simulated by solve_ivp
   pybind11-dev python3-dev     # the Python module (python/, docs/python.md)
   python3-pytest               # its test suite (tests/python/)
+  python3-jsonschema           # the JSON Schemas of the --json outputs (tests/python/test_json_schemas.py)
 )
 
 sudo_cmd=()

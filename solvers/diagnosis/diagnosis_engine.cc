@@ -495,7 +495,9 @@ Selection SelectCauses(const Engine& e, const Reference& base,
                        std::vector<ParameterFit>& candidates) {
   const int count = static_cast<int>(e.model().Parameters().size());
   std::vector<Evaluated> singles;
+  const auto& progress = e.options().progress;
   for (int p = 0; p < count; ++p) {
+    if (progress) progress("single causes", p, count);
     singles.push_back(CandidateEvaluation(e, p, base).Run());
     candidates.push_back(singles.back().fit);
   }
@@ -514,6 +516,8 @@ Selection SelectCauses(const Engine& e, const Reference& base,
   std::vector<Evaluated> pairs;
   for (int p = 0; p < count; ++p) {
     if (p == first) continue;
+    if (progress)
+      progress("pairs with the best single cause", static_cast<int>(pairs.size()), count - 1);
     pairs.push_back(CandidateEvaluation(e, p, ref).Run());
     candidates.push_back(pairs.back().fit);
   }

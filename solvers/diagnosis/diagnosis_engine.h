@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct DiagnosisOptions {
   bool refine = true;
   /// Worker threads for the simulations (>= 1).
   int threads = 2;
+  /// If set, called on the calling thread before each candidate is fitted: the stage ("single
+  /// causes", "pairs"), the candidates done and their number (for a progress report).
+  std::function<void(const std::string& stage, int done, int total)> progress;
 };
 
 /// The noise floor of each channel: variance (unit^2) and the degrees of freedom it was

@@ -209,6 +209,9 @@ class Explorer {
       const int n = queue_.front();
       queue_.pop_front();
       if (!nodes_[n].subsumed) Expand(n);
+      if (options_.progress && ++expanded_ % 64 == 0) {
+        options_.progress(static_cast<int>(nodes_.size()), static_cast<int>(queue_.size()));
+      }
     }
     Finish(stopped);
   }
@@ -349,7 +352,8 @@ class Explorer {
   LinearHybridSystem lhs_;
   std::vector<Goal> goals_;
   PolyhedralReachability::Options options_;
-  double start_ = 0.0;  // thread CPU time at the start of Run
+  double start_ = 0.0;      // thread CPU time at the start of Run
+  long long expanded_ = 0;  // states expanded (for the progress callback)
   std::vector<LinearHybridSystem::Initial> initial_;
   Conjunction horizon_;
   ConvexPolyhedron horizon_set_;

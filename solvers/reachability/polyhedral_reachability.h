@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ class PolyhedralReachability {
     int max_states = 50000;
     /// Safety net: the exploration stops after this much CPU time of the process.
     double cpu_seconds = 120.0;
+    /// If set, called every 64 expanded states with the symbolic states found so far and those
+    /// still queued (for a progress report; it must not throw).
+    std::function<void(int states, int queued)> progress;
   };
 
   PolyhedralReachability() = default;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -45,7 +46,14 @@ class SolverBudget {
   std::uint64_t used() const { return used_; }
   std::uint64_t remaining() const { return used_ < total_ ? total_ - used_ : 0; }
   /// Records `units` spent (the budget may be overdrawn by the last query's overshoot).
-  void Charge(std::uint64_t units) { used_ += units; }
+  void Charge(std::uint64_t units) {
+    used_ += units;
+    if (observer_) observer_(*this);
+  }
+  /// Called after every Charge (for a progress report; it must not throw or charge).
+  void SetObserver(std::function<void(const SolverBudget&)> observer) {
+    observer_ = std::move(observer);
+  }
 
   /// The safety net's deadline, in seconds of the process's CPU time from the budget's
   /// creation: max(60, 10 * seconds()).
@@ -65,6 +73,7 @@ class SolverBudget {
   std::uint64_t used_ = 0;
   double start_cpu_ = 0.0;  // the process's CPU time at creation, in seconds
   bool safety_stopped_ = false;
+  std::function<void(const SolverBudget&)> observer_;
 };
 
 /// The `prove` method of `hybrid check`: bounded model checking and k-induction with the Z3 SMT
