@@ -268,11 +268,12 @@ json PropertiesJson(const System& system, const Simulator& sim, const Findings& 
     const CheckResult& r = found.results[i];
     json j = {{"name", r.property},
               {"kind", std::string(KindKeyword(r.kind))},
-              {"predicate", found.chosen[i].predicate.ToString()},
-              {"verdict", std::string(VerdictName(r.verdict))},
-              {"method", r.method},
-              {"seconds", r.seconds},
-              {"reason", r.reason}};
+              {"predicate", found.chosen[i].predicate.ToString()}};
+    if (found.chosen[i].horizon) j["within"] = *found.chosen[i].horizon;  // as info has it
+    j["verdict"] = std::string(VerdictName(r.verdict));
+    j["method"] = r.method;
+    j["seconds"] = r.seconds;
+    j["reason"] = r.reason;
     if (r.trace) j["trace"] = TraceJson(system, sim, *r.trace);
     props.push_back(j);
   }

@@ -268,6 +268,8 @@ def test_check_of_the_probe_with_modes(probe):
     report = run("check", probe, "--modes", "--budget", "4", "--json", codes=(0, 6, 7))
     assert_valid("check.schema.json", report)
     assert [m["mode"] for m in report["modes"]] == ["a", "b", "lost"]
+    # The bounded reach keeps its horizon, as info reports it.
+    assert report["properties"][0]["within"] == 10.0 and "within" not in report["properties"][1]
 
 
 @pytest.mark.parametrize("args", [
@@ -392,7 +394,7 @@ MUTATIONS = {
     "check: a never property proved reachable": (
         "check", "check.schema.json", lambda d: d["properties"][0].update(verdict="reachable")),
     "check: an extra member in a property": (
-        "check", "check.schema.json", lambda d: d["properties"][0].update(within=3.0)),
+        "check", "check.schema.json", lambda d: d["properties"][0].update(horizon=3.0)),
     # info
     "info: an extra member in a mode": (
         "info", "info.schema.json", lambda d: d["components"][0]["modes"][0].update(initial=True)),
