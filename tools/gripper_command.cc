@@ -593,8 +593,9 @@ Comparison SimulateHand(const HandArgs& args, const gripper::Hand& hand,
 std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spread,
                      const std::vector<Obstacle>& objects, const json& report) {
   std::ostringstream out;
-  out << "hand, " << args.mode << " mode (spread s = " << FormatNumber(spread) << ", angle "
-      << Fixed(hand.spread_angle(), 3) << " deg)";
+  out << "hand, " << (args.spread ? "spread set by --spread" : args.mode + " mode")
+      << " (spread s = " << FormatNumber(spread) << ", angle " << Fixed(hand.spread_angle(), 3)
+      << " deg)";
   for (const Obstacle& o : objects) out << ", object " << o.ToString();
   out << "\n";
   for (const auto& j : report.at("fingers")) {
@@ -666,7 +667,8 @@ namespace {
 // The report of `hybrid hand` before any simulation (the spread, each finger, their touches).
 json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread,
               const std::array<double, 3>& commands) {
-  return {{"mode", args.mode},
+  // With --spread the spread is set directly: no operating mode applies.
+  return {{"mode", args.spread ? json(nullptr) : json(args.mode)},
           {"spread", spread},
           {"spread_angle_deg", hand.spread_angle()},
           {"fingers", HandFingersJson(hand, commands)},

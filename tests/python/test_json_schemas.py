@@ -296,6 +296,7 @@ def test_finger_batch(tmp_path):
     ["--object", "circle:0,0.06,0.02", "--mode", "pinch"],
     ["--simulate"],
     ["--object", "circle:0,0.06,0.02", "--mode", "pinch", "--simulate"],
+    ["--spread", "50"],  # the spread set directly: mode null
 ])
 def test_hand(args):
     report = run("hand", *args, "--json")
@@ -493,7 +494,8 @@ def schema_paths(name):
     def type_text(info):
         types = list(info["types"])
         for value in info["literals"]:
-            kind = {str: "string", bool: "boolean", int: "integer", float: "number"}[type(value)]
+            kind = {str: "string", bool: "boolean", int: "integer", float: "number",
+                    type(None): "null"}[type(value)]
             if kind not in types and not (kind == "integer" and "number" in types):
                 types.append(json.dumps(value))
         return " | ".join(types)

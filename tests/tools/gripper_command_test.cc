@@ -591,6 +591,12 @@ TEST(HybridHand, BadInputIsRejected) {
   ExpectRejected("hand --g-b 400", 2, {"--g-b", "400"});
   ExpectRejected("hand --g nan", 2, {"--g"});
   ExpectRejected("hand --spread 300", 2, {"--spread"});
+  // --spread overrides the operating mode: the report names none.
+  const Result spread = RunHybrid("hand --spread 50 --json");
+  ASSERT_EQ(spread.exit_code, 0) << spread.err;
+  EXPECT_TRUE(Field(json::parse(spread.out), "mode").is_null()) << spread.out;
+  EXPECT_EQ(Field(json::parse(spread.out), "spread"), 50.0);
+  EXPECT_EQ(Field(json::parse(RunHybrid("hand --mode pinch --json").out), "mode"), "pinch");
   ExpectRejected("hand --object circle:0,-0.01,0.02", 1, {"overlaps the palm"});
   ExpectRejected("hand --object circle:0,0.06,abc", 2, {"--object", "column 15"});
   ExpectRejected("hand --object circle:0.3,0.5,0.01", 1, {"no finger reaches"});
