@@ -263,11 +263,6 @@ void FingerClosedForm::PackEnds() {
 
 namespace {
 
-// The fraction of phase 3's way done, (1 - f) / f (g - g_s) / (255 - g) clamped to [0, 1], from
-// moved = g - g_s >= 0 and rest = 255 - g >= 0, without branches (At is called with random g).
-// rest is 0 only at g = 255, where the fraction is 1 once anything moved and 0 otherwise: the
-// division by the smallest normal double gives a huge (or infinite) ratio or 0 there; any
-// positive rest (at least an ulp of 255) is itself.
 // std::max and std::min on values, the same expressions: on references (std::) GCC keeps a
 // branch, which random g mispredicts; on values it emits maxsd/minsd.
 inline double Max(double a, double b) { return a < b ? b : a; }
@@ -282,6 +277,11 @@ inline size_t PieceIndex(const std::array<double, 8>& ends, double g) {
   return k;
 }
 
+// The fraction of phase 3's way done, (1 - f) / f (g - g_s) / (255 - g) clamped to [0, 1], from
+// moved = g - g_s >= 0 and rest = 255 - g >= 0, without branches (At is called with random g).
+// rest is 0 only at g = 255, where the fraction is 1 once anything moved and 0 otherwise: the
+// division by the smallest normal double gives a huge (or infinite) ratio or 0 there; any
+// positive rest (at least an ulp of 255) is itself.
 inline double Phase3Fraction(double moved, double rest, double m3_scale) {
   const double ratio = (m3_scale * moved) / Max(rest, std::numeric_limits<double>::min());
   return Min(Max(ratio, 0.0), 1.0);

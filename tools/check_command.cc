@@ -165,15 +165,6 @@ struct Findings {
   double seconds = 0.0;
 };
 
-// "12.3 s".
-std::string Seconds(double s) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(1);
-  out << s << " s";
-  return out.str();
-}
-
 // The bounds of polyhedral reachability: its deterministic state bound, and --budget as the
 // seconds of its CPU-time safety net; its state count goes to `progress`.
 PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine& progress) {
@@ -182,7 +173,7 @@ PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine
   if (progress.enabled()) {
     options.progress = [&progress](int states, int queued) {
       progress.Report("reachability: " + std::to_string(states) + " symbolic states, " +
-                      std::to_string(queued) + " queued, " + Seconds(progress.Elapsed()));
+                      std::to_string(queued) + " queued");
     };
   }
   return options;
@@ -238,8 +229,7 @@ std::vector<CheckResult> CheckProperties(const CheckArgs& args,
   const PropertySampler sampler(options);
   for (const Property& p : chosen) {
     progress.Report("sample: property " + std::to_string(results.size() + 1) + " of " +
-                        std::to_string(chosen.size()) + " (" + p.name + "), " +
-                        Seconds(progress.Elapsed()),
+                        std::to_string(chosen.size()) + " (" + p.name + ")",
                     true);
     results.push_back(sampler.Check(system, p));
   }
@@ -356,15 +346,15 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
     budget.SetObserver([&progress, &stage](const SolverBudget& b) {
       progress.Report(stage + ": " +
                       std::to_string(b.used() * 100 / std::max<std::uint64_t>(b.total(), 1)) +
-                      "% of the solver budget used, " + Seconds(progress.Elapsed()));
+                      "% of the solver budget used");
     });
   }
   PropertyProver::Options prove;
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
   found.results = CheckProperties(args, prove, system, found.chosen, budget, progress);
-  stage = "modes";
   if (args.modes) {
+    stage = "modes";
     for (std::size_t c = 0; c < system.components().size(); ++c) {
       found.modes.push_back(
           PropertyProver(prove).ReachableModes(system, static_cast<int>(c), budget));

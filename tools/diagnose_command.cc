@@ -210,12 +210,8 @@ Diagnosis Diagnosed(const DiagnoseArgs& args, const FingerPredictor& predictor, 
   ProgressLine progress("diagnose", args.progress);
   if (progress.enabled()) {
     options.progress = [&progress](const std::string& stage, int done, int total) {
-      std::ostringstream text;
-      text.setf(std::ios::fixed);
-      text.precision(1);
-      text << stage << ": candidate " << done + 1 << " of " << total << ", " << progress.Elapsed()
-           << " s";
-      progress.Report(text.str(), true);
+      progress.Report(
+          stage + ": candidate " + std::to_string(done + 1) + " of " + std::to_string(total), true);
     };
   }
   Diagnosis d = Diagnose(predictor, std::move(data), options);

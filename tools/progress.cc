@@ -20,10 +20,6 @@ ProgressLine::~ProgressLine() {
   }
 }
 
-double ProgressLine::Elapsed() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
-
 void ProgressLine::Report(const std::string& text, bool force) {
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
@@ -31,7 +27,10 @@ void ProgressLine::Report(const std::string& text, bool force) {
   if (reported_ && !force && now - last_ < gap) return;
   reported_ = true;
   last_ = now;
-  const std::string line = "hybrid " + command_ + ": " + text;
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, ", %.1f s",
+                std::chrono::duration<double>(now - start_).count());
+  const std::string line = "hybrid " + command_ + ": " + text + seconds;
   if (terminal_) {
     std::fprintf(stream_, "\r\033[K%s", line.c_str());
     shown_ = true;

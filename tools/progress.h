@@ -13,7 +13,8 @@ enum class ProgressMode {
   kOff,   ///< never (--quiet; the Python module)
 };
 
-/// A progress report of a long run on standard error, "hybrid COMMAND: TEXT". On a terminal it
+/// A progress report of a long run on standard error, "hybrid COMMAND: TEXT, 12.3 s" (the time
+/// since the report began). On a terminal it
 /// rewrites one line (carriage return, erase to the end) at most every 0.1 s and erases it when
 /// the run ends; elsewhere (forced with kOn) it writes whole lines, the first report and then at
 /// most one per second. Only what is printed depends on the clock: the run itself does not.
@@ -26,10 +27,9 @@ class ProgressLine {
   ProgressLine& operator=(const ProgressLine&) = delete;
 
   bool enabled() const { return enabled_; }
-  /// Reports `text` (dropped if the last report was too recent; `force` prints it anyway).
+  /// Reports `text` and the seconds elapsed (dropped if the last report was too recent; `force`
+  /// prints it anyway).
   void Report(const std::string& text, bool force = false);
-  /// Seconds since the report began.
-  double Elapsed() const;
 
  private:
   std::string command_;

@@ -10,7 +10,6 @@ import math
 import os
 import subprocess
 import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -20,7 +19,9 @@ import hybrid
 SOURCE = os.environ.get("HYBRID_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "tools", "hybrid"))
 sys.path.insert(0, os.path.join(SOURCE, "tools"))
+sys.path.insert(0, os.path.join(SOURCE, "tests", "test_utilities"))
 import report_finger  # noqa: E402
+from tank_model import TANK  # noqa: E402
 
 CONTACTS = [{}, {"gob1": 80.0}, {"gob1": 80.0, "gob2": 150.0}, {"gob2": 50.0},
             {"gob1": 60.0, "gob3": 200.0}, {"gob1": 140.0}, {"gob3": 30.0}]
@@ -126,19 +127,6 @@ def test_simulate_has_the_command_lines_members():
                          "30", "--input", "u=10", "--json").stdout)
     assert len(cli["events"]) >= 2
     assert {k: v for k, v in r.items() if k not in ("time", "states", "modes")} == cli
-
-
-TANK = textwrap.dedent("""\
-    automaton tank {
-      var h in [0, 10];
-      input d in [-0.2, 0];
-      mode fill { h' = 0.5 + d; inv h <= 8; }
-      init fill { h = 5; }
-      property stays_below_6: always h <= 6;
-      property reaches_7: reach h >= 7;
-      property below_8: always h <= 8;
-    }
-    """)
 
 
 def test_tank_inputs_and_parameters(tmp_path):

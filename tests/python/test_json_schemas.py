@@ -14,6 +14,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 import textwrap
 from urllib.parse import urldefrag, urljoin
 
@@ -31,6 +32,8 @@ SOURCE = os.environ.get("HYBRID_SOURCE_DIR", os.path.join(os.path.dirname(__file
 BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "tools", "hybrid"))
 SCHEMA_DIR = os.path.join(SOURCE, "docs", "schemas")
 SPEC = os.path.join(SOURCE, "spec")
+sys.path.insert(0, os.path.join(SOURCE, "tests", "test_utilities"))
+from tank_model import TANK  # noqa: E402
 BENCH = os.path.join(SOURCE, "spec", "benchmarks")
 
 
@@ -238,19 +241,6 @@ def test_check_of_the_finger_with_modes():
     assert len(report["modes"]) == 31
     assert any("trace" in m for m in report["modes"])
     assert set(report["modes"][0]["discrete"]) == {"c1", "c2", "c3", "l1", "l2", "l3"}
-
-
-TANK = textwrap.dedent("""\
-    automaton tank {
-      var h in [0, 10];
-      input d in [-0.2, 0];
-      mode fill { h' = 0.5 + d; inv h <= 8; }
-      init fill { h = 5; }
-      property stays_below_6: always h <= 6;
-      property reaches_7: reach h >= 7;
-      property below_8: always h <= 8;
-    }
-    """)
 
 
 def test_check_of_the_tank(tmp_path):
