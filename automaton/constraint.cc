@@ -1,5 +1,6 @@
 #include "automaton/constraint.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hybrid {
@@ -20,21 +21,56 @@ std::string_view RelationSpelling(Relation r) {
   return "?";
 }
 
-bool Comparison::Holds(std::span<const double> env, double tol) const {
-  const double r = lhs.Evaluate(env) - rhs.Evaluate(env);
+ResidualBand ResidualBand::Of(Relation relation, double tol, Boundary boundary) {
+  const bool closure = boundary == Boundary::kClosure;
+  ResidualBand band;
   switch (relation) {
     case Relation::kLess:
-      return r < 0.0;
+      band.upper = closure ? tol : std::min(tol, 0.0);
+      band.upper_strict = !closure;
+      break;
     case Relation::kLessEqual:
-      return r <= tol;
+      band.upper = tol;
+      break;
     case Relation::kGreater:
-      return r > 0.0;
+      band.lower = closure ? -tol : std::max(-tol, 0.0);
+      band.lower_strict = !closure;
+      break;
     case Relation::kGreaterEqual:
-      return r >= -tol;
+      band.lower = -tol;
+      break;
     case Relation::kEqual:
-      return std::abs(r) <= tol;
+      band.lower = -std::max(tol, 0.0);
+      band.upper = std::max(tol, 0.0);
+      break;
   }
-  return false;
+  return band;
+}
+
+bool ResidualBand::Contains(double r) const {
+  if (std::isnan(r)) return false;
+  if (lower && (lower_strict ? !(r > *lower) : !(r >= *lower))) return false;
+  if (upper && (upper_strict ? !(r < *upper) : !(r <= *upper))) return false;
+  return true;
+}
+
+ResidualBand LenientBand(Relation relation, double tol) {
+  return ResidualBand::Of(relation, tol, tol == 0.0 ? Boundary::kExact : Boundary::kClosure);
+}
+
+bool ResidualHolds(Relation relation, double r, double tol, Boundary boundary) {
+  return ResidualBand::Of(relation, tol, boundary).Contains(r);
+}
+
+bool Comparison::Holds(std::span<const double> env, double tol, Boundary boundary) const {
+  return ResidualHolds(relation, lhs.Evaluate(env) - rhs.Evaluate(env), tol, boundary);
+}
+
+Comparison Comparison::Closure() const {
+  Comparison c = *this;
+  if (c.relation == Relation::kLess) c.relation = Relation::kLessEqual;
+  if (c.relation == Relation::kGreater) c.relation = Relation::kGreaterEqual;
+  return c;
 }
 
 std::string Comparison::ToString() const {

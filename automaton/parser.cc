@@ -14,20 +14,23 @@
 #include <tao/pegtl.hpp>
 #include <tao/pegtl/contrib/limit_depth.hpp>
 #include <tao/pegtl/contrib/parse_tree.hpp>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
+#include "automaton/quoted_text.h"
 #include "automaton/rectangular_rate.h"
 #include "automaton/stack_thread.h"
 
 namespace hybrid {
 
 ParseError::ParseError(std::string file, int line, int column, const std::string& message)
-    : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                         message),
+    : std::runtime_error(EscapedForMessage(file) + ":" + std::to_string(line) + ":" +
+                         std::to_string(column) + ": " + EscapedForMessage(message)),
       file_(std::move(file)),
       line_(line),
       column_(column),
-      message_(message) {}
+      message_(EscapedForMessage(message)) {}
 
 namespace {
 namespace pegtl = tao::pegtl;
@@ -447,6 +450,32 @@ struct Imports {
   std::size_t bytes = 0;
 };
 
+// The transition names of one automaton, and the default names of its unnamed transitions:
+// `SRC_to_DST` for the first, then the first of `SRC_to_DST_2`, `SRC_to_DST_3`, ... that no
+// earlier transition has (named or not). Names are only ever added, so the first free number
+// of a base never decreases: each base keeps where its search stopped, and every name is passed
+// over at most twice (as a base, and as a base with a number), so naming N transitions takes
+// O(N) look-ups in all.
+class TransitionNames {
+ public:
+  // The default name of the next unnamed transition from `base` (SRC_to_DST).
+  std::string Default(const std::string& base) {
+    int& k = next_number_[base];  // 0 the first time: try `base` itself
+    std::string name = k < 2 ? base : base + "_" + std::to_string(k);
+    while (taken_.count(name) != 0) {
+      k = std::max(k, 1) + 1;
+      name = base + "_" + std::to_string(k);
+    }
+    return name;
+  }
+  // Records the name of a transition added to the automaton.
+  void Taken(const std::string& name) { taken_.insert(name); }
+
+ private:
+  std::unordered_set<std::string> taken_;
+  std::unordered_map<std::string, int> next_number_;  // base -> the number its search is at
+};
+
 class Builder {
  public:
   Builder(std::string file, Imports* imports) : file_(std::move(file)), imports_(imports) {}
@@ -791,6 +820,7 @@ class Builder {
                       const std::function<std::pair<double, double>(int)>& bounds) const {
     Scenario s;
     bool has_until = false;
+    std::unordered_set<int> driven;
     for (const auto& item : n.children) {
       if (item->is_type<grammar::until_item>()) {
         if (has_until) Fail(*item, "'until' given twice");
@@ -807,10 +837,7 @@ class Builder {
         Fail(input, "'" + Text(input) + "' is " + WithArticle(KindName(symbols[*slot].kind)) +
                         ", not an input");
       }
-      if (std::any_of(s.inputs.begin(), s.inputs.end(),
-                      [&](const InputSignal& x) { return x.slot == *slot; })) {
-        Fail(input, "input '" + Text(input) + "' driven twice");
-      }
+      if (!driven.insert(*slot).second) Fail(input, "input '" + Text(input) + "' driven twice");
       sig.slot = *slot;
       // Plain variables, not a structured binding: clang before 16 cannot capture structured
       // bindings in a lambda (a C++20 feature).
@@ -841,6 +868,7 @@ class Builder {
     bool has_scenario = false;
     std::vector<const Node*> inits;  // the mode name of each init declaration, in order
     const std::set<std::string> rated = RatedVariables(n);
+    TransitionNames transition_names;
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
       if (item.is_type<var_decl>()) {
@@ -872,20 +900,14 @@ class Builder {
       } else if (item.is_type<mode_decl>()) {
         ModeDecl(item, &a);
       } else if (item.is_type<transition_decl>()) {
-        TransitionDecl(item, &a);
+        TransitionDecl(item, &a, &transition_names);
       } else if (item.is_type<init_decl>()) {
         InitDecl(item, &a);
         inits.push_back(item.children.at(0).get());
       } else if (item.is_type<scenario_decl>()) {
         if (has_scenario) Fail(item, "scenario declared twice");
         has_scenario = true;
-        Scenario s = ScenarioOf(item, a.symbols(), [&](int slot) {
-          const InputInfo& in = *std::find_if(a.inputs().begin(), a.inputs().end(),
-                                              [&](const InputInfo& x) { return x.slot == slot; });
-          return std::make_pair(a.EvaluateConstant(in.bounds.lo, "input bounds"),
-                                a.EvaluateConstant(in.bounds.hi, "input bounds"));
-        });
-        At(item, [&] { a.SetScenario(std::move(s)); });
+        AutomatonScenario(item, &a);
       } else if (item.is_type<property_decl>()) {
         Property p = PropertyOf(item, PropertyScope(a.symbols()),
                                 [&](const std::string& m) { return a.FindMode(m).has_value(); });
@@ -902,12 +924,26 @@ class Builder {
     local_positions_.push_back(Where(name_node));
   }
 
+  // The scenario `n` of automaton `a`.
+  void AutomatonScenario(const Node& n, Automaton* a) {
+    std::vector<double> parameters;  // evaluated once, at the first input driven
+    Scenario s = ScenarioOf(n, a->symbols(), [&](int slot) {
+      if (parameters.empty()) parameters = a->ParameterEnvironment();
+      // The inputs are in slot order; their bounds were checked finite when declared.
+      const auto in = std::lower_bound(a->inputs().begin(), a->inputs().end(), slot,
+                                       [](const InputInfo& x, int s) { return x.slot < s; });
+      return std::make_pair(in->bounds.lo.Evaluate(parameters), in->bounds.hi.Evaluate(parameters));
+    });
+    At(n, [&] { a->SetScenario(std::move(s)); });
+  }
+
   void ModeDecl(const Node& n, Automaton* a) {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
     const Scope scope{&a->symbols()};
     const Node& name_node = *n.children.at(0);
     Mode m;
     m.name = Text(name_node);
+    std::unordered_set<int> given;  // slots with a flow or a discrete value so far
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
       if (item.is_type<discrete_value>()) {
@@ -917,12 +953,14 @@ class Builder {
         if (v != std::nearbyint(v) || std::abs(v) > 1e9) {
           Fail(*item.children.at(1), "discrete values must be integers");
         }
-        if (m.DiscreteValueOf(slot)) Fail(id, "discrete variable '" + Text(id) + "' set twice");
+        if (!given.insert(slot).second) Fail(id, "discrete variable '" + Text(id) + "' set twice");
         m.discrete_values.emplace_back(slot, static_cast<int>(v));
       } else if (item.is_type<flow>()) {
         const Node& id = *item.children.at(0);
         const int slot = Slot(id, *a, SymbolKind::kVariable, "continuous variable");
-        if (m.FlowOf(slot)) Fail(id, "second flow for '" + Text(id) + "' in mode '" + m.name + "'");
+        if (!given.insert(slot).second) {
+          Fail(id, "second flow for '" + Text(id) + "' in mode '" + m.name + "'");
+        }
         m.flows.emplace_back(slot, FlowOf(item, *a, scope));
       } else if (item.is_type<invariant>()) {
         for (Comparison& c : Conjunction(*item.children.at(0), scope).comparisons) {
@@ -936,7 +974,7 @@ class Builder {
     At(name_node, [&] { return a->AddMode(std::move(m)); });
   }
 
-  void TransitionDecl(const Node& n, Automaton* a) {
+  void TransitionDecl(const Node& n, Automaton* a, TransitionNames* names) {
     using namespace grammar;  // NOLINT(google-build-using-namespace)
     const Scope scope{&a->symbols()};
     Transition t;
@@ -944,24 +982,16 @@ class Builder {
     const Node* name_node = nullptr;
     if (n.children.at(0)->is_type<transition_name>()) {
       name_node = n.children.at(0)->children.at(0).get();
-      t.name = Text(*name_node);
       ++i;
     }
     const Node& source = *n.children.at(i)->children.at(0);
     const Node& target = *n.children.at(i + 1)->children.at(0);
     t.source = ModeOf(source, *a);
     t.target = ModeOf(target, *a);
-    if (!name_node) {
-      // Default name: source_to_target, numbered when repeated.
-      const std::string base = Text(source) + "_to_" + Text(target);
-      t.name = base;
-      for (int k = 2; std::any_of(a->transitions().begin(), a->transitions().end(),
-                                  [&](const Transition& x) { return x.name == t.name; });
-           ++k) {
-        t.name = base + "_" + std::to_string(k);
-      }
-    }
+    // Default name: source_to_target, numbered when repeated.
+    t.name = name_node ? Text(*name_node) : names->Default(Text(source) + "_to_" + Text(target));
     bool has_guard = false, has_label = false, has_urgency = false;
+    std::unordered_set<int> reset_slots;
     for (size_t j = i + 2; j < n.children.size(); ++j) {
       const Node& item = *n.children[j];
       if (item.is_type<guard>()) {
@@ -972,10 +1002,7 @@ class Builder {
         for (const auto& as : item.children) {
           const Node& id = *as->children.at(0);
           const int slot = Slot(id, *a, SymbolKind::kVariable, "continuous variable");
-          if (std::any_of(t.resets.begin(), t.resets.end(),
-                          [slot](const Reset& r) { return r.slot == slot; })) {
-            Fail(id, "'" + Text(id) + "' reset twice");
-          }
+          if (!reset_slots.insert(slot).second) Fail(id, "'" + Text(id) + "' reset twice");
           t.resets.push_back({slot, Expr(*as->children.at(1), scope)});
         }
       } else if (item.is_type<label>()) {
@@ -990,7 +1017,9 @@ class Builder {
     }
     std::sort(t.resets.begin(), t.resets.end(),
               [](const Reset& x, const Reset& y) { return x.slot < y.slot; });
+    const std::string name = t.name;
     At(name_node ? *name_node : source, [&] { return a->AddTransition(std::move(t)); });
+    names->Taken(name);
   }
 
   // Every initial state gives every continuous variable a value, also those declared after it
@@ -1000,8 +1029,11 @@ class Builder {
     const auto states = a.initial_states();
     for (size_t k = 0; k < states.size() && k < inits.size(); ++k) {
       for (const VariableInfo& var : a.variables()) {
-        const bool given = std::any_of(states[k].values.begin(), states[k].values.end(),
-                                       [&](const InitialValue& v) { return v.slot == var.slot; });
+        // The values are sorted by slot (InitDecl).
+        const auto it =
+            std::lower_bound(states[k].values.begin(), states[k].values.end(), var.slot,
+                             [](const InitialValue& v, int slot) { return v.slot < slot; });
+        const bool given = it != states[k].values.end() && it->slot == var.slot;
         if (!given) {
           Fail(*inits[k], "initial state in '" + Text(*inits[k]) + "' gives no value for '" +
                               a.symbols()[var.slot].name + "', declared after it");
@@ -1015,14 +1047,12 @@ class Builder {
     const Node& mode_node = *n.children.at(0);
     InitialState s;
     s.mode = ModeOf(mode_node, *a);
+    std::unordered_set<int> given;
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
       const Node& id = *item.children.at(0);
       const int slot = Slot(id, *a, SymbolKind::kVariable, "continuous variable");
-      if (std::any_of(s.values.begin(), s.values.end(),
-                      [slot](const InitialValue& v) { return v.slot == slot; })) {
-        Fail(id, "initial value of '" + Text(id) + "' given twice");
-      }
+      if (!given.insert(slot).second) Fail(id, "initial value of '" + Text(id) + "' given twice");
       const Node& value = *item.children.at(1);
       InitialValue v;
       v.slot = slot;

@@ -11,14 +11,20 @@
 namespace hybrid {
 
 /// A malformed or invalid model file. what() is "FILE:LINE:COL: MESSAGE" (lines and columns count
-/// from 1, columns in bytes), the format compilers and editors understand.
+/// from 1, columns in bytes), the format compilers and editors understand. Messages quote text of
+/// the input (names, values, file names), so the message and the file name in what() are
+/// escaped with EscapedForMessage (quoted_text.h): a control character read from a file reaches
+/// the user as `\x1b`, `\n`, ..., never as itself.
 class ParseError : public std::runtime_error {
  public:
+  /// `message` is escaped here (escaping is idempotent, so a message built from escaped parts
+  /// is unchanged); `file` is kept as given for file() and escaped in what().
   ParseError(std::string file, int line, int column, const std::string& message);
+  /// The file as given (not escaped), to be compared with or opened.
   const std::string& file() const { return file_; }
   int line() const { return line_; }
   int column() const { return column_; }
-  /// The message without the location prefix.
+  /// The message without the location prefix, escaped.
   const std::string& message() const { return message_; }
 
  private:

@@ -127,6 +127,42 @@ int Level(Predicate::Kind k) {
 
 }  // namespace
 
+namespace {
+
+// Predicate::Lenient at polarity `positive` (a recursion no deeper than the predicate's depth).
+bool LenientAt(const Predicate& p, std::span<const double> env, std::span<const std::string> modes,
+               double tol, bool positive) {
+  switch (p.kind()) {
+    case Predicate::Kind::kTrue:
+      return true;
+    case Predicate::Kind::kFalse:
+      return false;
+    case Predicate::Kind::kComparison: {
+      const Comparison& c = p.comparison();
+      return LenientBand(c.relation, positive ? tol : -tol)
+          .Contains(c.lhs.Evaluate(env) - c.rhs.Evaluate(env));
+    }
+    case Predicate::Kind::kInMode:
+      return std::find(modes.begin(), modes.end(), p.mode()) != modes.end();
+    case Predicate::Kind::kNot:
+      return !LenientAt(p.operands()[0], env, modes, tol, !positive);
+    case Predicate::Kind::kAnd:
+      return LenientAt(p.operands()[0], env, modes, tol, positive) &&
+             LenientAt(p.operands()[1], env, modes, tol, positive);
+    case Predicate::Kind::kOr:
+      return LenientAt(p.operands()[0], env, modes, tol, positive) ||
+             LenientAt(p.operands()[1], env, modes, tol, positive);
+  }
+  return false;
+}
+
+}  // namespace
+
+bool Predicate::Lenient(std::span<const double> env, std::span<const std::string> modes,
+                        double tol) const {
+  return LenientAt(*this, env, modes, tol, true);
+}
+
 bool Predicate::Evaluate(std::span<const double> env, std::span<const std::string> modes,
                          double tol) const {
   // Truth values as int: std::vector<bool> has no contiguous storage for the walk's spans.

@@ -47,6 +47,13 @@ class Predicate {
   /// use Comparison::Holds with tolerance `tol`.
   bool Evaluate(std::span<const double> env, std::span<const std::string> modes,
                 double tol = 0.0) const;
+  /// Truth value evaluated as leniently as `tol` >= 0 allows: a comparison in positive position
+  /// holds when its residual lies in LenientBand(relation, tol), one under an odd number of
+  /// `not`s when it lies in LenientBand(relation, -tol) (it must hold with margin tol). So
+  /// !Lenient(...) means the predicate fails clearly, and a state where Lenient(Not(p), ...) is
+  /// false satisfies p clearly. With tol = 0 this is Evaluate(env, modes). Replays of traces and
+  /// the SMT encoding's counterexample search read predicates this way.
+  bool Lenient(std::span<const double> env, std::span<const std::string> modes, double tol) const;
   /// Calls `f` on every comparison.
   void ForEachComparison(const std::function<void(const Comparison&)>& f) const;
   /// Calls `f` on every mode name of an `in` atom.

@@ -243,6 +243,139 @@ void CheckSharedFlows(const Component& c, std::span<const Component> components)
   }
 }
 
+// How component `c` is named in messages: "instance 'A'", or the automaton's name.
+std::string Named(const Component& c) {
+  return c.instance.empty() ? "'" + c.source.name() + "'" : "instance '" + c.instance + "'";
+}
+
+// The evaluated ranges "lo" or "[lo, hi]" that the initial states of `c` give System slot `g`.
+std::set<std::string> InitialTexts(const Component& c, int g) {
+  std::set<std::string> out;
+  const int local = LocalSlot(c, g);
+  if (local < 0) return out;
+  const std::vector<double> env = c.automaton.ParameterEnvironment();
+  for (const InitialState& init : c.automaton.initial_states()) {
+    for (const InitialValue& v : init.values) {
+      if (v.slot != local) continue;
+      const double lo = v.range.lo.Evaluate(env), hi = v.range.hi.Evaluate(env);
+      out.insert(lo == hi ? FormatNumber(lo)
+                          : "[" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+    }
+  }
+  return out;
+}
+
+// "0" or "0 or 5".
+std::string Alternatives(const std::set<std::string>& texts) {
+  std::string out;
+  for (const std::string& t : texts) out += (out.empty() ? "" : " or ") + t;
+  return out;
+}
+
+// The values the modes of `c` give discrete System slot `g`.
+std::set<int> DiscreteValues(const Component& c, int g) {
+  std::set<int> out;
+  const int local = LocalSlot(c, g);
+  if (local < 0) return out;
+  for (const Mode& m : c.automaton.modes()) {
+    for (const auto& [slot, value] : m.discrete_values) {
+      if (slot == local) out.insert(value);
+    }
+  }
+  return out;
+}
+
+// The evaluated bounds of input System slot `g` in `c`, or nullopt if `c` has no such input.
+std::optional<std::pair<double, double>> InputBoundsIn(const Component& c, int g) {
+  const int local = LocalSlot(c, g);
+  const std::vector<double> env = c.automaton.ParameterEnvironment();
+  for (const InputInfo& in : c.automaton.inputs()) {
+    if (in.slot == local)
+      return std::make_pair(in.bounds.lo.Evaluate(env), in.bounds.hi.Evaluate(env));
+  }
+  return std::nullopt;
+}
+
+// Throws ConflictError unless the new component `c` and every earlier one agree on the initial
+// values, input bounds and discrete values of the System symbols they both have.
+void CheckSharedMeaning(const Component& c, std::span<const Component> components,
+                        const SymbolTable& symbols) {
+  for (int s = 0; s < c.automaton.symbols().size(); ++s) {
+    const int g = c.global_slot[s];
+    const std::string& name = symbols[g].name;
+    for (int o = 0; o < static_cast<int>(components.size()); ++o) {
+      const Component& other = components[o];
+      if (LocalSlot(other, g) < 0) continue;
+      switch (symbols[g].kind) {
+        case SymbolKind::kVariable: {
+          std::set<std::string> ours = InitialTexts(c, g), theirs = InitialTexts(other, g);
+          std::set<std::string> both = ours;
+          both.insert(theirs.begin(), theirs.end());
+          if (!ours.empty() && !theirs.empty() && both.size() > 1) {
+            throw ConflictError("shared variable '" + name + "' starts at " + Alternatives(ours) +
+                                    " in " + Named(c) + " but at " + Alternatives(theirs) + " in " +
+                                    Named(other) + ": give every instance one start",
+                                o);
+          }
+          break;
+        }
+        case SymbolKind::kInput: {
+          const auto ours = InputBoundsIn(c, g), theirs = InputBoundsIn(other, g);
+          if (ours && theirs && *ours != *theirs) {
+            throw ConflictError("shared input '" + name + "' is in [" + FormatNumber(ours->first) +
+                                    ", " + FormatNumber(ours->second) + "] in " + Named(c) +
+                                    " but in [" + FormatNumber(theirs->first) + ", " +
+                                    FormatNumber(theirs->second) + "] in " + Named(other) +
+                                    ": declare the same bounds",
+                                o);
+          }
+          break;
+        }
+        case SymbolKind::kDiscrete: {
+          std::set<int> ours = DiscreteValues(c, g), theirs = DiscreteValues(other, g);
+          std::set<int> both = ours;
+          both.insert(theirs.begin(), theirs.end());
+          if (!ours.empty() && !theirs.empty() && both.size() > 1) {
+            throw ConflictError("shared discrete variable '" + name +
+                                    "' is given values by the modes of both " + Named(c) + " and " +
+                                    Named(other) + ": one instance must own it",
+                                o);
+          }
+          break;
+        }
+        case SymbolKind::kParameter:
+          break;  // CheckSharedParameter
+      }
+      break;  // the first earlier component that has it stands for all
+    }
+  }
+}
+
+// Throws ConflictError if a transition of the new component `c` and one of an earlier component
+// carry one label and both reset one variable: they would fire together and write it twice.
+void CheckSynchronisedResets(const Component& c, std::span<const Component> components,
+                             const SymbolTable& symbols) {
+  for (const Transition& t : c.automaton.transitions()) {
+    if (t.label.empty() || t.resets.empty()) continue;
+    for (int o = 0; o < static_cast<int>(components.size()); ++o) {
+      for (const Transition& u : components[o].automaton.transitions()) {
+        if (u.label != t.label) continue;
+        for (const Reset& r : t.resets) {
+          const int g = c.global_slot[r.slot];
+          for (const Reset& q : u.resets) {
+            if (components[o].global_slot[q.slot] != g) continue;
+            throw ConflictError("transition '" + t.name + "' of " + Named(c) + " and '" + u.name +
+                                    "' of " + Named(components[o]) + " synchronise on '" + t.label +
+                                    "' and both reset '" + symbols[g].name +
+                                    "': only one of them may write it",
+                                o);
+          }
+        }
+      }
+    }
+  }
+}
+
 // Expression `e` of component `c` over System slots.
 Expression Global(const Component& c, const Expression& e, const SymbolTable& symbols) {
   return Remap(e, c.global_slot, symbols);
@@ -617,6 +750,8 @@ void System::AddComponent(std::string instance, const Automaton& automaton,
     }
   }
   CheckSharedFlows(c, components_);
+  CheckSharedMeaning(c, components_, symbols_);
+  CheckSynchronisedResets(c, components_, symbols_);
   components_.push_back(std::move(c));
 }
 
@@ -628,6 +763,38 @@ std::vector<System::Step> System::StepsFrom(std::span<const int> tuple) const {
 Mode System::ProductModeOf(std::span<const int> tuple) const {
   if (tuple.size() != components_.size()) Fail("a mode tuple needs one mode per component");
   return ProductMode(Tuple(tuple.begin(), tuple.end()), components_, symbols_);
+}
+
+Expression System::ResolvedParameter(int slot) const {
+  if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kParameter) {
+    Fail("ResolvedParameter: slot " + std::to_string(slot) + " is not a parameter");
+  }
+  for (const Component& c : components_) {
+    const int local = LocalSlot(c, slot);
+    if (local < 0) continue;
+    if (c.automaton.ParameterRange(local)) return Expression::Symbol(symbols_[slot].name, slot);
+    for (const auto& [s, value] : c.automaton.parameters()) {
+      if (s != local) continue;
+      // Parameters are defined from earlier ones only, so this recursion ends.
+      const Expression resolved =
+          Global(c, value, symbols_)
+              .Substitute([&](const std::string&, int g) -> std::optional<Expression> {
+                if (symbols_[g].kind != SymbolKind::kParameter) return std::nullopt;
+                return ResolvedParameter(g);
+              })
+              .FoldConstants();
+      if (resolved.Slots().empty()) {
+        return Expression::Constant(c.automaton.ParameterEnvironment()[local]);
+      }
+      return resolved;
+    }
+  }
+  Fail("ResolvedParameter: no component declares '" + symbols_[slot].name + "'");
+}
+
+std::set<std::string> System::Alphabet(int c) const {
+  return Alphabets(std::span<const Component>(&components_.at(static_cast<std::size_t>(c)), 1))
+      .front();
 }
 
 std::optional<std::pair<int, ModeId>> System::FindMode(std::string_view qualified) const {

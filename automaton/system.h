@@ -3,6 +3,7 @@
 #include <map>
 #include <set>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,6 +11,20 @@
 #include "automaton/automaton.h"
 
 namespace hybrid {
+
+/// A declaration of a component being added to a System that contradicts a declaration of an
+/// earlier component (System::AddComponent): a parser reports it at both declarations.
+class ConflictError : public std::invalid_argument {
+ public:
+  /// `other`: the index of the earlier component in System::components().
+  ConflictError(const std::string& message, int other)
+      : std::invalid_argument(message), other_(other) {}
+  /// The index of the earlier component whose declaration this one contradicts.
+  int other_component() const { return other_; }
+
+ private:
+  int other_;
+};
 
 /// One automaton inside a System.
 struct Component {
@@ -59,7 +74,12 @@ class System {
   /// flow by two components, a shared parameter whose value or declared range (evaluated; both
   /// absent counts as equal) differs from the one it already has, a bind of a name `automaton`
   /// does not declare or of a shared name, or binds that give two symbols of `automaton` one
-  /// name.
+  /// name. Throws ConflictError (naming the earlier component) where the new component and an
+  /// earlier one would give one System symbol two meanings: a shared (or bound) variable
+  /// started at different values, an input with different bounds, a discrete variable given
+  /// different values by the modes of both, or synchronised transitions (one label) that both
+  /// reset one variable. So every engine reads one initial condition, one bound and one owner per
+  /// shared symbol.
   void AddComponent(std::string instance, const Automaton& automaton,
                     std::map<std::string, std::string> binds = {});
   /// A system-level property over System slots; `in` atoms name component modes qualified by the
@@ -92,6 +112,18 @@ class System {
   std::span<const Property> properties() const { return properties_; }
   const std::optional<Scenario>& scenario() const { return scenario_; }
   const std::set<std::string>& shared() const { return shared_; }
+  /// The value of parameter `slot` (a System slot) as the function of the uncertain parameters
+  /// (those declared with a range) that it is: an uncertain parameter is its own symbol; any
+  /// other is its definition with every parameter it reads resolved in turn, constants folded,
+  /// so that one that reads no uncertain parameter is its nominal value as a constant
+  /// (`param q = 2 * p;` with `p` uncertain gives `2 * p`). Every engine that covers the
+  /// uncertain parameters reads derived ones through this. Throws std::invalid_argument if
+  /// `slot` is not a parameter.
+  Expression ResolvedParameter(int slot) const;
+  /// The labels component `c` synchronises on (System names): those of its transitions. A
+  /// transition labelled `l` fires only together with an `l`-transition of every other
+  /// component whose alphabet has `l`. Throws std::out_of_range for a bad index.
+  std::set<std::string> Alphabet(int c) const;
   /// Component index and mode of a qualified mode name, or nullopt.
   std::optional<std::pair<int, ModeId>> FindMode(std::string_view qualified) const;
   /// The name of mode `m` of component `c` as written at system level ("A.open" or "open").

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "automaton/number_syntax.h"
+#include "automaton/quoted_text.h"
 
 namespace hybrid {
 
@@ -61,15 +62,8 @@ std::vector<std::string_view> SplitCells(std::string_view line) {
   return cells;
 }
 
-// `cell` in single quotes, for messages.
-std::string Quoted(std::string_view cell) {
-  std::string out;
-  out.reserve(cell.size() + 2);
-  out += '\'';
-  out += cell;
-  out += '\'';
-  return out;
-}
+// `cell` in single quotes for messages, its control characters escaped.
+std::string Quoted(std::string_view cell) { return QuotedForMessage(cell); }
 
 // The shortest text that reads back as `x`.
 std::string FormatNumber(double x) {
@@ -153,12 +147,12 @@ class Reader {
           expected += (expected.empty() ? "" : ", ") + std::string(known);
         }
         Fail(line_, c + 1,
-             "unknown column '" + std::string(name) + "' (the columns are " + expected + ")");
+             "unknown column " + Quoted(name) + " (the columns are " + expected + ")");
       }
       const Field field = static_cast<Field>(it - kFieldNames.begin());
       if (column_of_[field] >= 0) {
         Fail(line_, c + 1,
-             "duplicate column '" + std::string(name) + "' (also column " +
+             "duplicate column " + Quoted(name) + " (also column " +
                  std::to_string(ColumnOf(field)) + ")");
       }
       column_of_[field] = c;
@@ -280,9 +274,9 @@ class Reader {
       if (!data_.runs.empty()) CloseRun();
       if (const auto it = first_line_of_run_.find(row.run); it != first_line_of_run_.end()) {
         FailCell(ColumnOf(kRun), kRun,
-                 "run '" + row.run + "' (from line " + std::to_string(it->second) +
-                     ") reappears after run '" + data_.runs.back().label +
-                     "'; the rows of a run must be contiguous");
+                 "run " + Quoted(row.run) + " (from line " + std::to_string(it->second) +
+                     ") reappears after run " + Quoted(data_.runs.back().label) +
+                     "; the rows of a run must be contiguous");
       }
       first_line_of_run_.emplace(row.run, line_);
       MeasuredRun run;
@@ -324,7 +318,7 @@ class Reader {
     const MeasuredRun& run = data_.runs.back();
     if (static_cast<int>(run.g.size()) < kMinRunSamples) {
       Fail(run.lines.front(), ColumnOf(kRun),
-           "run '" + run.label + "' has " + std::to_string(run.g.size()) + " sample" +
+           "run " + Quoted(run.label) + " has " + std::to_string(run.g.size()) + " sample" +
                (run.g.size() == 1 ? "" : "s") + "; a run needs at least " +
                std::to_string(kMinRunSamples));
     }
@@ -367,13 +361,15 @@ int MeasuredData::samples() const {
   return n;
 }
 
+// Messages quote cells, column names and run labels of the file: escaped (quoted_text.h), like
+// the file name in what(), so that no control character of the input reaches a terminal.
 DataError::DataError(std::string source, int line, int column, std::string message)
-    : std::runtime_error(source + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                         message),
+    : std::runtime_error(EscapedForMessage(source) + ":" + std::to_string(line) + ":" +
+                         std::to_string(column) + ": " + EscapedForMessage(message)),
       source_(std::move(source)),
       line_(line),
       column_(column),
-      message_(std::move(message)) {}
+      message_(EscapedForMessage(message)) {}
 
 MeasuredData ReadMeasuredData(std::istream& in, const std::string& source) {
   return Reader(in, source).Read();

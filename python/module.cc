@@ -2,19 +2,43 @@
 // docs/python.md): the finger's closed form, vectorised, and models read, drawn, simulated and
 // checked in-process. JSON-shaped results travel as JSON text (the same documents as the command
 // line's --json); python/hybrid/__init__.py turns them into Python values.
+//
+// Ctrl-C. Long calls (Model.check, Model.simulate, diagnose) run in a child process (fork) while
+// the calling thread, without the GIL, waits for its answer and checks for Python signals every
+// 50 ms: on an exception from a signal handler (KeyboardInterrupt) the child is killed and the
+// exception raised, so the engines stop at once although they have no way to be cancelled
+// (docs/python.md). finger_angles checks for signals between blocks of positions.
 
+#include <fcntl.h>
+#include <poll.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#if defined(__linux__)
+#include <sys/prctl.h>
+#endif
 
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
 #include <map>
+#include <new>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <unordered_map>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -68,8 +92,34 @@ FingerParameters ParametersOfModel(const std::string& path) {
   }
 }
 
-// finger_angles: theta1..3 (degrees) at every g, shape (n, 3), computed without the GIL, in two
-// halves on two threads for large batches (the closed form is read-only, so they share it).
+// The closed form's angles at the positions `g` into `theta` (3 per position), in two halves on
+// two threads for large blocks (the closed form is read-only, so they share it); false if a
+// position is outside [0, 255] (the kernel checks the range in the same pass).
+bool AnglesOfBlock(const FingerClosedForm& closed, std::span<const double> g,
+                   std::span<double> theta) {
+  const auto angles = [&closed](std::span<const double> part, std::span<double> to, bool* failed) {
+    try {
+      closed.AnglesAt(part, to);
+    } catch (const std::out_of_range&) {
+      *failed = true;
+    }
+  };
+  constexpr size_t kThreadBatch = 1 << 16;  // below this a thread costs more than it saves
+  bool failed = false;
+  if (g.size() < kThreadBatch) {
+    angles(g, theta, &failed);
+    return !failed;
+  }
+  const size_t half = g.size() / 2;
+  bool first_failed = false;
+  std::thread first(angles, g.first(half), theta.first(3 * half), &first_failed);
+  angles(g.subspan(half), theta.subspan(3 * half), &failed);
+  first.join();
+  return !failed && !first_failed;
+}
+
+// finger_angles: theta1..3 (degrees) at every g, shape (n, 3), computed without the GIL in blocks
+// of 2^22 positions (a few milliseconds each), checking for Python signals (Ctrl-C) after each.
 py::array_t<double> FingerAngles(
     const py::array_t<double, py::array::c_style | py::array::forcecast>& g,
     std::optional<double> gob1, std::optional<double> gob2, std::optional<double> gob3,
@@ -84,31 +134,19 @@ py::array_t<double> FingerAngles(
   const std::span<const double> in(g.data(), n);
   py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
   const std::span<double> theta(out.mutable_data(), 3 * n);
-  bool out_of_range = false;  // the kernel checks the range in the same pass
-  {
-    py::gil_scoped_release release;
-    const auto angles = [&closed](std::span<const double> part, std::span<double> to,
-                                  bool* failed) {
-      try {
-        closed.AnglesAt(part, to);
-      } catch (const std::out_of_range&) {
-        *failed = true;
-      }
-    };
-    constexpr size_t kThreadBatch = 1 << 16;  // below this a thread costs more than it saves
-    if (n < kThreadBatch) {
-      angles(in, theta, &out_of_range);
-    } else {
-      const size_t half = n / 2;
-      bool first_failed = false;
-      std::thread first(angles, in.first(half), theta.first(3 * half), &first_failed);
-      angles(in.subspan(half), theta.subspan(3 * half), &out_of_range);
-      first.join();
-      out_of_range = out_of_range || first_failed;
+  constexpr size_t kBlock = size_t{1} << 22;
+  for (size_t start = 0; start < n; start += kBlock) {
+    const size_t count = std::min(kBlock, n - start);
+    bool in_range = true;
+    {
+      py::gil_scoped_release release;
+      in_range =
+          AnglesOfBlock(closed, in.subspan(start, count), theta.subspan(3 * start, 3 * count));
     }
-  }
-  if (out_of_range) {
-    for (const double x : in) MotorPosition("g", x);  // throws, naming the first one outside
+    if (!in_range) {
+      for (const double x : in) MotorPosition("g", x);  // throws, naming the first one outside
+    }
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
   return out;
 }
@@ -128,6 +166,288 @@ InputSignal SignalOf(const std::string& name, const SignalValue& value) {
     s = ParseSignal(std::get<std::string>(value), "inputs['" + name + "']");
   }
   return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bytes a child process sends back: numbers and strings appended to a std::string and read back
+// in the same order.
+
+class Encoder {
+ public:
+  void Number(std::uint64_t v) { Raw(&v, sizeof v); }
+  void Text(std::string_view v) {
+    Number(v.size());
+    out_.append(v);
+  }
+  void Doubles(std::span<const double> v) { Raw(v.data(), v.size() * sizeof(double)); }
+  std::string Take() { return std::move(out_); }
+
+ private:
+  void Raw(const void* p, std::size_t n) { out_.append(static_cast<const char*>(p), n); }
+  std::string out_;
+};
+
+class Decoder {
+ public:
+  explicit Decoder(std::string_view in) : in_(in) {}
+  std::uint64_t Number() {
+    std::uint64_t v = 0;
+    std::memcpy(&v, Take(sizeof v).data(), sizeof v);
+    return v;
+  }
+  std::string Text() { return std::string(Take(Number())); }
+  void Doubles(std::span<double> to) {
+    const std::string_view bytes = Take(to.size() * sizeof(double));
+    if (!to.empty()) std::memcpy(to.data(), bytes.data(), bytes.size());
+  }
+
+ private:
+  std::string_view Take(std::size_t n) {
+    if (n > in_.size() - at_) throw std::runtime_error("truncated answer from the worker process");
+    const std::string_view part = in_.substr(at_, n);
+    at_ += n;
+    return part;
+  }
+  std::string_view in_;
+  std::size_t at_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Long calls in a child process that Ctrl-C stops.
+
+// A job's answer: its result, or the exception it threw (reconstructed by Rethrow).
+enum Outcome : char {
+  kResult = 'R',
+  kModelError = 'M',  // hybrid::ParseError: file, line, column, message
+  kDataError = 'D',   // hybrid::DataError: source, line, column, message
+  kValueError = 'V',  // a bad argument (ValueError): its message
+  kMemoryError = 'N',
+  kOtherError = 'E',  // anything else (RuntimeError): its message
+};
+
+// Runs `job` and encodes what came of it: the Outcome, then the result or the exception's fields.
+std::string RunAndEncode(const std::function<std::string()>& job) {
+  Encoder e;
+  const auto located = [&e](Outcome kind, const std::string& file, int line, int column,
+                            const std::string& message) {
+    e.Number(kind);
+    e.Text(file);
+    e.Number(static_cast<std::uint64_t>(line));
+    e.Number(static_cast<std::uint64_t>(column));
+    e.Text(message);
+  };
+  try {
+    std::string result = job();
+    e.Number(kResult);
+    e.Text(result);
+  } catch (const ParseError& x) {
+    located(kModelError, x.file(), x.line(), x.column(), x.message());
+  } catch (const DataError& x) {
+    located(kDataError, x.source(), x.line(), x.column(), x.message());
+  } catch (const std::bad_alloc&) {
+    e.Number(kMemoryError);
+  } catch (const std::invalid_argument& x) {
+    e.Number(kValueError);
+    e.Text(x.what());
+  } catch (const cli::UsageError& x) {
+    e.Number(kValueError);
+    e.Text(x.what());
+  } catch (const cli::InputError& x) {
+    e.Number(kValueError);
+    e.Text(x.what());
+  } catch (const std::out_of_range& x) {
+    e.Number(kValueError);
+    e.Text(x.what());
+  } catch (const std::exception& x) {
+    e.Number(kOtherError);
+    e.Text(x.what());
+  } catch (...) {
+    e.Number(kOtherError);
+    e.Text("unknown error");
+  }
+  return e.Take();
+}
+
+// The result RunAndEncode encoded in `answer`; throws the exception it encoded instead (as the
+// same C++ type where it matters, so that the module's translator gives the same Python
+// exception as a call in this process).
+std::string DecodeOrRethrow(std::string_view answer) {
+  Decoder d(answer);
+  const auto kind = static_cast<Outcome>(d.Number());
+  if (kind == kResult) return d.Text();
+  if (kind == kModelError || kind == kDataError) {
+    const std::string file = d.Text();
+    const int line = static_cast<int>(d.Number());
+    const int column = static_cast<int>(d.Number());
+    const std::string message = d.Text();
+    if (kind == kModelError) throw ParseError(file, line, column, message);
+    throw DataError(file, line, column, message);
+  }
+  if (kind == kMemoryError) throw std::bad_alloc();
+  if (kind == kValueError) throw std::invalid_argument(d.Text());
+  throw std::runtime_error(d.Text());
+}
+
+// Writes all of `bytes` to `fd`; false if it cannot.
+bool WriteAll(int fd, std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+// The child process: runs `job` and sends its answer (length, then RunAndEncode's bytes) to `fd`,
+// then ends without running any exit handler (the interpreter's are the parent's). It never
+// touches Python. Signals that stop a program stop it (the parent's Python handlers are reset),
+// and on Linux it dies with its parent.
+[[noreturn]] void ChildMain(const std::function<std::string()>& job, int fd, pid_t parent) {
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+    ::signal(s, SIG_DFL);
+    sigaddset(&signals, s);
+  }
+  pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);
+#if defined(__linux__)
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(1);
+  // Only the standard streams and the answer's pipe stay open: a pipe the parent writes stays
+  // its own to close (its reader sees the end when the parent closes it), and a signal's wakeup
+  // byte (signal.set_wakeup_fd) never reaches the parent's event loop.
+  std::vector<int> open_fds;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", ec)) {
+    open_fds.push_back(std::atoi(entry.path().filename().c_str()));
+  }
+  for (const int other : open_fds) {
+    if (other > 2 && other != fd) ::close(other);
+  }
+#endif
+  std::string answer;
+  try {
+    // A thread of its own: the parent's thread-local state (the parser's stack thread) does not
+    // survive fork().
+    std::thread worker([&] { answer = RunAndEncode(job); });
+    worker.join();
+  } catch (const std::system_error&) {
+    answer = RunAndEncode(job);
+  }
+  Encoder header;
+  header.Number(answer.size());
+  ::_exit(WriteAll(fd, header.Take()) && WriteAll(fd, answer) ? 0 : 1);
+}
+
+// A child process running a job, and the reading end of the pipe of its answer. Killed (if it
+// still runs) and reaped when destroyed.
+class Child {
+ public:
+  Child(pid_t pid, int fd) : pid_(pid), fd_(fd) {}
+  ~Child() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      Reap();
+    }
+    ::close(fd_);
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  // The child's answer. Waits without the GIL, checking for Python signals every 50 ms: throws
+  // py::error_already_set when a handler raised (KeyboardInterrupt), KeyboardInterrupt when
+  // SIGINT ended the child, std::runtime_error when it ended otherwise without an answer.
+  std::string Answer() {
+    std::string bytes;
+    for (;;) {
+      bool ended = false;
+      {
+        py::gil_scoped_release release;
+        ended = Read(&bytes);
+      }
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      if (bytes.size() >= sizeof(std::uint64_t)) {
+        const std::uint64_t size = Decoder(bytes).Number();
+        if (bytes.size() - sizeof(std::uint64_t) >= size) {
+          return bytes.substr(sizeof(std::uint64_t), size);
+        }
+      }
+      if (ended) ThrowEnded();
+    }
+  }
+
+ private:
+  // Appends what the pipe holds to `bytes`, waiting at most 50 ms for it; true at its end.
+  bool Read(std::string* bytes) {
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, 50) <= 0) return false;
+    char buffer[1 << 16];
+    for (int reads = 0; reads < 256; ++reads) {  // up to 16 MiB before checking for signals
+      const ssize_t n = ::read(fd_, buffer, sizeof buffer);
+      if (n == 0) return true;
+      if (n < 0) return errno != EINTR && errno != EAGAIN;
+      bytes->append(buffer, static_cast<std::size_t>(n));
+    }
+    return false;
+  }
+
+  // Waits for the child to end; its wait status (0 if another waiter reaped it).
+  int Reap() {
+    int status = 0;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+    return status;
+  }
+
+  [[noreturn]] void ThrowEnded() {
+    const int status = Reap();
+    if (WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+      throw py::error_already_set();
+    }
+    throw std::runtime_error(WIFSIGNALED(status)
+                                 ? "the computation's process was killed by signal " +
+                                       std::to_string(WTERMSIG(status))
+                                 : "the computation's process ended without an answer");
+  }
+
+  pid_t pid_;
+  int fd_;
+};
+
+// Whether this is the interpreter's main thread, the one Python signal handlers run on.
+bool OnMainThread() {
+  const py::module_ threading = py::module_::import("threading");
+  const py::object main_ident = threading.attr("main_thread")().attr("ident");
+  return main_ident.equal(threading.attr("get_ident")());
+}
+
+// `job()` (which must not touch Python objects: it may run in another process), so that Ctrl-C
+// stops it within 50 ms: on the main thread in a child process (fork) while this thread waits
+// without the GIL (see Child::Answer); elsewhere, where no signal handler runs, or when no
+// process can be made, here without the GIL. Throws what the job throws.
+std::string RunStoppable(const std::function<std::string()>& job) {
+  int fds[2] = {-1, -1};
+  if (OnMainThread() && ::pipe2(fds, O_CLOEXEC) == 0) {
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::close(fds[0]);
+      ChildMain(job, fds[1], parent);
+    }
+    ::close(fds[1]);
+    if (pid > 0) {
+      ::fcntl(fds[0], F_SETFL, ::fcntl(fds[0], F_GETFL) | O_NONBLOCK);
+      Child child(pid, fds[0]);
+      const std::string answer = child.Answer();
+      return DecodeOrRethrow(answer);
+    }
+    ::close(fds[0]);
+  }
+  py::gil_scoped_release release;
+  return job();
 }
 
 // A model read from a file (.ha or SpaceEx .xml), with the operations of the command line.
@@ -153,8 +473,7 @@ class Model {
     args.method = method;
     args.budget = budget;
     args.depth = depth;
-    py::gil_scoped_release release;
-    return cli::CheckReport(args, system_, nullptr).dump();
+    return RunStoppable([&] { return cli::CheckReport(args, system_, nullptr).dump(); });
   }
 
   py::dict Simulate(std::optional<double> until, const std::map<std::string, SignalValue>& inputs,
@@ -182,6 +501,72 @@ std::vector<InputSignal> Model::Signals(const std::map<std::string, SignalValue>
   return signals;
 }
 
+// Simulates `system` and encodes what Model.simulate returns (decoded by RunDict): the number of
+// samples n, their times, the number of variables and each one's name and n values, the mode
+// labels (a table of the distinct ones, then one index per sample), the status, the message and
+// the command's JSON report (for `horizon`).
+std::string EncodedRun(const System& system, const SimulationOptions& options,
+                       const std::vector<InputSignal>& signals, double horizon) {
+  const Simulator sim(system);
+  const SimulationResult r = sim.Run(options, signals);
+  const std::size_t n = r.samples.size();
+  Encoder e;
+  e.Number(n);
+  std::vector<double> column(n);
+  for (std::size_t k = 0; k < n; ++k) column[k] = r.samples[k].time;
+  e.Doubles(column);
+  e.Number(sim.variable_names().size());
+  for (std::size_t v = 0; v < sim.variable_names().size(); ++v) {
+    e.Text(sim.variable_names()[v]);
+    for (std::size_t k = 0; k < n; ++k) column[k] = r.samples[k].x[v];
+    e.Doubles(column);
+  }
+  std::vector<std::string> labels;
+  std::unordered_map<std::string, std::uint64_t> label_index;
+  std::vector<std::uint64_t> mode_of(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    std::string label = sim.ModeLabel(r.samples[k].modes);
+    const auto [it, added] = label_index.emplace(label, labels.size());
+    if (added) labels.push_back(std::move(label));
+    mode_of[k] = it->second;
+  }
+  e.Number(labels.size());
+  for (const std::string& label : labels) e.Text(label);
+  for (const std::uint64_t m : mode_of) e.Number(m);
+  e.Text(StatusName(r.status));
+  e.Text(r.message);
+  e.Text(cli::SimulationReport(sim, r, horizon).dump());
+  return e.Take();
+}
+
+// The dict Model.simulate returns, from EncodedRun's bytes.
+py::dict RunDict(std::string_view encoded) {
+  Decoder d(encoded);
+  const auto n = static_cast<py::ssize_t>(d.Number());
+  py::array_t<double> time(n);
+  d.Doubles({time.mutable_data(), static_cast<std::size_t>(n)});
+  py::dict states;
+  for (std::uint64_t v = d.Number(); v > 0; --v) {
+    const std::string name = d.Text();
+    py::array_t<double> column(n);
+    d.Doubles({column.mutable_data(), static_cast<std::size_t>(n)});
+    states[py::str(name)] = column;
+  }
+  std::vector<py::str> labels;
+  for (std::uint64_t m = d.Number(); m > 0; --m) labels.emplace_back(d.Text());
+  py::list modes(n);
+  for (py::ssize_t k = 0; k < n; ++k) modes[k] = labels.at(d.Number());
+  py::dict out;
+  out["status"] = d.Text();
+  out["message"] = d.Text();
+  out["time"] = time;
+  out["states"] = states;
+  out["modes"] = modes;
+  // final, events, steps, until (and zeno): the command's JSON, parsed by the package.
+  out["report_json"] = d.Text();
+  return out;
+}
+
 py::dict Model::Simulate(std::optional<double> until,
                          const std::map<std::string, SignalValue>& inputs,
                          std::optional<double> sample,
@@ -191,35 +576,8 @@ py::dict Model::Simulate(std::optional<double> until,
   if (sample) options.sample_step = *sample;
   for (const auto& [name, value] : parameters) options.parameters.emplace_back(name, value);
   const std::vector<InputSignal> signals = Signals(inputs);
-  const Simulator sim(system_);
-  SimulationResult r;
-  {
-    py::gil_scoped_release release;
-    r = sim.Run(options, signals);
-  }
-  const py::ssize_t n = static_cast<py::ssize_t>(r.samples.size());
-  py::array_t<double> time(n);
-  std::vector<py::array_t<double>> columns;
-  for (size_t v = 0; v < sim.variable_names().size(); ++v) columns.emplace_back(n);
-  py::list modes;
-  for (py::ssize_t k = 0; k < n; ++k) {
-    const StateSample& s = r.samples[static_cast<size_t>(k)];
-    time.mutable_at(k) = s.time;
-    for (size_t v = 0; v < columns.size(); ++v) columns[v].mutable_at(k) = s.x[v];
-    modes.append(sim.ModeLabel(s.modes));
-  }
-  py::dict states;
-  for (size_t v = 0; v < columns.size(); ++v) states[py::str(sim.variable_names()[v])] = columns[v];
-  py::dict out;
-  out["status"] = std::string(StatusName(r.status));
-  out["message"] = r.message;
-  out["time"] = time;
-  out["states"] = states;
-  out["modes"] = modes;
-  // final, events, steps, until (and zeno): the command's JSON, parsed by the package.
   const double horizon = until ? *until : system_.scenario() ? system_.scenario()->until : 0.0;
-  out["report_json"] = cli::SimulationReport(sim, r, horizon).dump();
-  return out;
+  return RunDict(RunStoppable([&] { return EncodedRun(system_, options, signals, horizon); }));
 }
 
 // `hybrid hand --json` (without --simulate): the report as JSON text.
@@ -246,8 +604,7 @@ std::string DiagnoseJsonText(const std::string& data, const std::optional<std::s
   args.model = model ? *model : cli::BundledFile("spec/finger.ha").string();
   args.significance = significance;
   args.threads = threads;
-  py::gil_scoped_release release;
-  return cli::DiagnoseReport(args).dump();
+  return RunStoppable([&] { return cli::DiagnoseReport(args).dump(); });
 }
 
 }  // namespace

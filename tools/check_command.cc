@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -53,6 +54,11 @@ json StateJson(const Simulator& sim, const Eigen::VectorXd& x) {
   return j;
 }
 
+// A component as traces name it: its instance name, or its automaton's for an unnamed one.
+std::string ComponentName(const Component& c) {
+  return c.instance.empty() ? c.source.name() : c.instance;
+}
+
 json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
   json params = json::object(), inits = json::object(), inputs = json::object();
   for (const auto& [n, v] : t.parameters) params[n] = v;
@@ -70,12 +76,27 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
                       {"mode_before", sim.ModeLabel(e.modes_before)},
                       {"mode_after", sim.ModeLabel(e.modes_after)}});
   }
+  json starts = json::array();
+  for (const auto& [c, index] : t.initial_states) {
+    const Component& component = system.components()[static_cast<std::size_t>(c)];
+    const InitialState& init =
+        component.automaton.initial_states()[static_cast<std::size_t>(index)];
+    starts.push_back({{"component", ComponentName(component)},
+                      {"init", index},
+                      {"mode", system.QualifiedModeName(c, init.mode)}});
+  }
   json out = {{"parameters", params},
+              {"initial_states", starts},
               {"initial_values", inits},
               {"until", t.inputs.until},
               {"inputs", inputs},
               {"replay_status", std::string(StatusName(t.run.status))},
               {"events", events}};
+  if (!t.run.samples.empty()) {
+    const StateSample& s = t.run.samples.front();
+    out["start"] = {
+        {"time", s.time}, {"mode", sim.ModeLabel(s.modes)}, {"values", StateJson(sim, s.x)}};
+  }
   if (t.state_index >= 0) {
     const StateSample& s = t.run.samples[t.state_index];
     out["state"] = {
@@ -84,12 +105,33 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
   return out;
 }
 
+// " x = 1; y = 2;" (10 significant digits).
+std::string ValuesText(const Simulator& sim, const Eigen::VectorXd& x) {
+  std::ostringstream out;
+  out.precision(10);
+  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
+    out << " " << sim.variable_names()[i] << " = " << x[static_cast<int>(i)] << ";";
+  }
+  return out.str();
+}
+
 std::string TraceText(const System& system, const Simulator& sim, const Trace& t) {
   std::ostringstream out;
   out.precision(10);
   if (!t.parameters.empty()) {
     out << "    parameters:";
     for (const auto& [n, v] : t.parameters) out << " " << n << " = " << v << ";";
+    out << "\n";
+  }
+  if (!t.run.samples.empty()) {  // the start, and which init declarations it comes from
+    out << "    start in " << sim.ModeLabel(t.run.samples.front().modes) << ":"
+        << ValuesText(sim, t.run.samples.front().x);
+    for (const auto& [c, index] : t.initial_states) {
+      const Component& component = system.components()[static_cast<std::size_t>(c)];
+      if (component.automaton.initial_states().size() < 2) continue;
+      out << " (init " << index + 1 << " of " << component.automaton.initial_states().size()
+          << " of " << ComponentName(component) << ")";
+    }
     out << "\n";
   }
   for (const InputSignal& s : t.inputs.inputs) {
@@ -108,11 +150,8 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
   }
   if (t.state_index >= 0) {
     const StateSample& s = t.run.samples[t.state_index];
-    out << "    at t = " << s.time << " in " << sim.ModeLabel(s.modes) << ":";
-    for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
-      out << " " << sim.variable_names()[i] << " = " << s.x[static_cast<int>(i)] << ";";
-    }
-    out << "\n";
+    out << "    at t = " << s.time << " in " << sim.ModeLabel(s.modes) << ":"
+        << ValuesText(sim, s.x) << "\n";
   }
   return out.str();
 }
@@ -157,19 +196,22 @@ std::vector<Property> ChosenProperties(const CheckArgs& args,
 }
 
 // What the check found: per chosen property its result, and with --modes per component the
-// reachability of its discrete states; `seconds` is the wall-clock time from parsing on.
+// reachability of its discrete states; `seconds` is the wall-clock time from parsing on; `reach`
+// what polyhedral reachability spent, when it ran.
 struct Findings {
   std::vector<Property> chosen;
   std::vector<CheckResult> results;
   std::vector<std::vector<PropertyProver::ModeReachability>> modes;
   double seconds = 0.0;
+  std::optional<PolyhedralReachability::Usage> reach;
 };
 
-// The bounds of polyhedral reachability: its deterministic state bound, and --budget as the
-// seconds of its CPU-time safety net; its state count goes to `progress`.
+// The bounds of polyhedral reachability: --budget budget seconds of its deterministic reach
+// units, and its default CPU-time safety net (max(60 s, 10 s per budget second), as the
+// prover's); its state count goes to `progress`.
 PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine& progress) {
   PolyhedralReachability::Options options;
-  options.cpu_seconds = args.budget;
+  options.budget = args.budget;
   if (progress.enabled()) {
     options.progress = [&progress](int states, int queued) {
       progress.Report("reachability: " + std::to_string(states) + " symbolic states, " +
@@ -179,17 +221,19 @@ PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine
   return options;
 }
 
-// --method auto: polyhedral reachability when the model is a linear hybrid automaton, then SMT
-// k-induction (with `budget`) on what it leaves unknown; k-induction alone otherwise. Each
-// result names the method that gave it.
+// --method auto: polyhedral reachability when the model is a linear hybrid automaton (what it
+// spends in `usage`), then SMT k-induction (with `budget`) on what it leaves unknown; k-induction
+// alone otherwise. Each result names the method that gave it.
 std::vector<CheckResult> CheckAuto(const PolyhedralReachability::Options& reach,
                                    const PropertyProver::Options& prove, const System& system,
-                                   const std::vector<Property>& chosen, SolverBudget& budget) {
+                                   const std::vector<Property>& chosen, SolverBudget& budget,
+                                   std::optional<PolyhedralReachability::Usage>& usage) {
   std::string why;
   if (!PolyhedralReachability::Handles(system, chosen, &why)) {
     return PropertyProver(prove).Check(system, chosen, budget);
   }
-  std::vector<CheckResult> results = PolyhedralReachability(reach).Check(system, chosen);
+  std::vector<CheckResult> results =
+      PolyhedralReachability(reach).Check(system, chosen, &usage.emplace());
   std::vector<Property> left;
   for (std::size_t i = 0; i < chosen.size(); ++i) {
     if (results[i].verdict == Verdict::kUnknown) left.push_back(chosen[i]);
@@ -210,17 +254,20 @@ std::vector<CheckResult> CheckAuto(const PolyhedralReachability::Options& reach,
   return results;
 }
 
-// Checks `chosen` on `system` by --method (prove: with `budget`; sample: --runs runs from
-// --seed), one result per property in order.
+// Checks `chosen` on `system` by --method (prove: with `budget`; reach: what it spends in
+// `usage`; sample: --runs runs from --seed), one result per property in order.
 std::vector<CheckResult> CheckProperties(const CheckArgs& args,
                                          const PropertyProver::Options& prove, const System& system,
                                          const std::vector<Property>& chosen, SolverBudget& budget,
-                                         ProgressLine& progress) {
-  if (args.method == "reach")
-    return PolyhedralReachability(ReachOptions(args, progress)).Check(system, chosen);
+                                         ProgressLine& progress,
+                                         std::optional<PolyhedralReachability::Usage>& usage) {
+  if (args.method == "reach") {
+    return PolyhedralReachability(ReachOptions(args, progress))
+        .Check(system, chosen, &usage.emplace());
+  }
   if (args.method == "prove") return PropertyProver(prove).Check(system, chosen, budget);
   if (args.method == "auto") {
-    return CheckAuto(ReachOptions(args, progress), prove, system, chosen, budget);
+    return CheckAuto(ReachOptions(args, progress), prove, system, chosen, budget, usage);
   }
   std::vector<CheckResult> results;
   PropertySampler::Options options;
@@ -288,6 +335,23 @@ json ModesJson(const System& system, const Simulator& sim, const Findings& found
   return ms;
 }
 
+// The "budget" member of the JSON report: --budget, and what polyhedral reachability spent of
+// its deterministic units (only when it ran).
+json BudgetJson(const CheckArgs& args, const PolyhedralReachability::Usage& reach) {
+  using Stop = PolyhedralReachability::Usage::Stop;
+  const char* stop = reach.stop == Stop::kBudget       ? "budget"
+                     : reach.stop == Stop::kStateBound ? "state_bound"
+                     : reach.stop == Stop::kSafetyNet  ? "cpu_safety_net"
+                                                       : "none";
+  return {{"budget_seconds", args.budget},
+          {"reach",
+           {{"units_used", reach.units_used},
+            {"units_total", reach.units_total},
+            {"units_per_budget_second", kReachUnitsPerBudgetSecond},
+            {"symbolic_states", reach.states},
+            {"stopped_by", stop}}}};
+}
+
 // The report of `hybrid check --json`.
 json ReportJson(const CheckArgs& args, const System& system, const Simulator& sim,
                 const Findings& found) {
@@ -296,6 +360,7 @@ json ReportJson(const CheckArgs& args, const System& system, const Simulator& si
               {"seconds", found.seconds},
               {"properties", PropertiesJson(system, sim, found)}};
   if (args.modes) out["modes"] = ModesJson(system, sim, found);
+  if (found.reach) out["budget"] = BudgetJson(args, *found.reach);
   return out;
 }
 
@@ -352,7 +417,8 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   PropertyProver::Options prove;
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
-  found.results = CheckProperties(args, prove, system, found.chosen, budget, progress);
+  found.results =
+      CheckProperties(args, prove, system, found.chosen, budget, progress, found.reach);
   if (args.modes) {
     stage = "modes";
     for (std::size_t c = 0; c < system.components().size(); ++c) {

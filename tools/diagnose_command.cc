@@ -231,7 +231,8 @@ nlohmann::ordered_json DiagnoseReport(const DiagnoseArgs& args) {
 
 int RunDiagnose(const DiagnoseArgs& args) {
   CheckDiagnoseOptions(args);
-  const std::vector<NamedFile> inputs = {{"DATA", args.data}, {"--model", args.model}};
+  std::vector<NamedFile> inputs = {{"DATA", args.data}};
+  for (NamedFile& f : ModelInputs("--model", args.model)) inputs.push_back(std::move(f));
   const auto outputs = [&](const std::vector<std::pair<std::string, std::string>>& report) {
     std::vector<NamedFile> out = {{"--out-model", args.out_model}};
     for (const auto& [path, text] : report) out.push_back({"--report", path});
@@ -311,7 +312,7 @@ void CheckSyntheticSize(const SynthesizeArgs& args) {
 
 int RunSynthesize(const SynthesizeArgs& args) {
   CheckSyntheticSize(args);
-  CheckDistinctFiles({{"--model", args.model}}, {{"--out", args.out}});
+  CheckDistinctFiles(ModelInputs("--model", args.model), {{"--out", args.out}});
   CheckOutputPlaces({{"--out", args.out}});
   HiddenEffects hidden;
   const FingerPredictor predictor = LoadPredictor(args.model, FingerPredictor::Options{});

@@ -249,7 +249,7 @@ FingerContacts CheckFingerArgs(FingerArgs& args) {
   const std::vector<NamedFile> outputs = {
       {"--draw", args.draw}, {"--plot", args.plot}, {"-o/--output", args.output}};
   std::vector<NamedFile> inputs;
-  if (!args.model.empty()) inputs.push_back({"--model", args.model});
+  if (!args.model.empty()) inputs = ModelInputs("--model", args.model);
   if (!args.data.empty()) inputs.push_back({"--data", args.data});
   if (!args.queries.empty()) inputs.push_back({"--queries", args.queries});
   CheckDistinctFiles(inputs, outputs);
@@ -686,9 +686,8 @@ nlohmann::ordered_json HandReport(const HandArgs& args) {
 }
 
 int RunHand(const HandArgs& args) {
-  CheckDistinctFiles(
-      args.simulate ? std::vector<NamedFile>{{"--model", args.model}} : std::vector<NamedFile>{},
-      {{"--draw", args.draw}});
+  CheckDistinctFiles(args.simulate ? ModelInputs("--model", args.model) : std::vector<NamedFile>{},
+                     {{"--draw", args.draw}});
   CheckOutputPlaces({{"--draw", args.draw}});
   CheckMotor("--g", args.g);
   const std::array<double, 3> commands = HandCommands(args);

@@ -397,7 +397,7 @@ int RunImport(const Commands& c) {
 int RunModelCommand(const Commands& c) {
   if (c.import->parsed()) return RunImport(c);
   if (c.dot->parsed()) {
-    hybrid::cli::CheckDistinctFiles({{"MODEL", c.model}}, {{"-o", c.output}});
+    hybrid::cli::CheckDistinctFiles(hybrid::cli::ModelInputs("MODEL", c.model), {{"-o", c.output}});
     hybrid::cli::CheckOutputPlaces({{"-o", c.output}});
   }
   const System system = hybrid::spaceex::ReadModelFile(c.model);
@@ -497,6 +497,9 @@ void SetExitCodeFooters(Commands& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A signal that stops the program (Ctrl-C, kill) removes the temporary files of an output
+  // being written.
+  hybrid::cli::RemoveTemporaryFilesOnSignals();
   CLI::App app{"hybrid: declare, inspect and draw hybrid automata (see docs/cli.md)", "hybrid"};
   app.footer(
       "Exit codes: 0 success; 1 invalid model or data (FILE:LINE:COL: message on stderr); 2 usage "

@@ -1,17 +1,25 @@
 #include "tools/output.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
+#include <string_view>
 #include <unordered_map>
 
+#include "automaton/parser.h"
+#include "automaton/spaceex/spaceex_import.h"
 #include "tools/options.h"
 
 namespace hybrid::cli {
@@ -41,13 +49,70 @@ void WriteStream(const std::string& path, const std::string& text) {
   if (!out) throw OutputError("cannot write '" + path + "'");
 }
 
-// Writes `text` to a new temporary file next to `target` and returns its path.
-std::string WriteTemporary(const std::string& target, const std::string& text, int index) {
-  const fs::path t(target);
-  const std::string temp =
-      (DirectoryOf(target) / ("." + t.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                              "-" + std::to_string(index)))
-          .string();
+// ---------------------------------------------------------------------------------------------
+// The paths removed when a signal stops the program (RemovedOnSignal): a fixed table, so that the
+// signal handler reads it without allocating or locking. A slot is free, being filled (its path
+// not yet complete: the handler skips it), or holds a file or a directory.
+
+constexpr int kFreeSlot = 0, kFillingSlot = 1, kFileSlot = 2, kDirectorySlot = 3;
+constexpr std::size_t kSlots = 64;
+constexpr std::size_t kMaxRegisteredPath = 4096;  // bytes, with the terminating NUL
+
+struct RegisteredPath {
+  std::atomic<int> state{kFreeSlot};
+  char path[kMaxRegisteredPath] = {};
+};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads the table");
+
+std::array<RegisteredPath, kSlots> registered_paths;
+
+constexpr std::array<int, 3> kCleanedSignals = {SIGINT, SIGTERM, SIGHUP};
+
+// Removes the registered files, then the directories (latest slot first: a directory is
+// registered before what it holds), then ends the program by `signal` (reset to its default
+// action by SA_RESETHAND; raised again, it is delivered when the handler returns). Uses only
+// async-signal-safe calls.
+extern "C" void RemoveRegisteredAndRaise(int signal) {
+  for (const RegisteredPath& r : registered_paths) {
+    if (r.state.load(std::memory_order_acquire) == kFileSlot) ::unlink(r.path);
+  }
+  for (auto r = registered_paths.rbegin(); r != registered_paths.rend(); ++r) {
+    if (r->state.load(std::memory_order_acquire) == kDirectorySlot) ::rmdir(r->path);
+  }
+  ::raise(signal);
+}
+
+// SIGINT, SIGTERM and SIGHUP blocked in the calling thread while it lives (pending ones are
+// delivered when it ends).
+class BlockedSignals {
+ public:
+  BlockedSignals() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int s : kCleanedSignals) sigaddset(&set, s);
+    blocked_ = pthread_sigmask(SIG_BLOCK, &set, &previous_) == 0;
+  }
+  ~BlockedSignals() {
+    if (blocked_) pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
+  }
+  BlockedSignals(const BlockedSignals&) = delete;
+  BlockedSignals& operator=(const BlockedSignals&) = delete;
+
+ private:
+  sigset_t previous_{};
+  bool blocked_ = false;
+};
+
+// The name of the temporary file written for `target` (".NAME.tmp-PID-K" next to it).
+std::string TemporaryName(const std::string& target, int index) {
+  return (DirectoryOf(target) / ("." + fs::path(target).filename().string() + ".tmp-" +
+                                 std::to_string(::getpid()) + "-" + std::to_string(index)))
+      .string();
+}
+
+// Writes `text` to the new temporary file `temp` (registered with RemovedOnSignal by the caller)
+// for `target`. Throws OutputError.
+void WriteTemporary(const std::string& target, const std::string& temp, const std::string& text) {
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw OutputError("cannot write '" + target + "'" + Reason(errno));
   std::size_t written = 0;
@@ -66,12 +131,13 @@ std::string WriteTemporary(const std::string& target, const std::string& text, i
     ::unlink(temp.c_str());
     throw OutputError("cannot write '" + target + "'" + Reason(error));
   }
-  return temp;
 }
 
 // Creates `dir` and its missing parents; appends the directories it created to `created`,
-// outermost first. Throws OutputError.
-void CreateDirectories(const std::string& dir, std::vector<fs::path>* created) {
+// outermost first, and registers each with RemovedOnSignal in `registrations`. Throws
+// OutputError.
+void CreateDirectories(const std::string& dir, std::vector<fs::path>* created,
+                       std::vector<RemovedOnSignal>* registrations) {
   std::vector<fs::path> missing;
   std::error_code ec;
   for (fs::path p = fs::path(dir).lexically_normal(); !p.empty() && !fs::exists(p, ec);
@@ -80,6 +146,7 @@ void CreateDirectories(const std::string& dir, std::vector<fs::path>* created) {
     if (p == p.parent_path()) break;
   }
   for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    registrations->emplace_back(it->string(), RemovedOnSignal::kDirectory);
     if (!fs::create_directory(*it, ec) && ec) {
       throw OutputError("cannot create the directory '" + it->string() + "': " + ec.message());
     }
@@ -121,6 +188,96 @@ std::string FileKey(const std::string& path) {
 
 bool SameFile(const std::string& a, const std::string& b) { return FileKey(a) == FileKey(b); }
 
+namespace {
+
+// The file names `text` imports (`import "FILE";`), in order. Comments run from '#' to the end of
+// the line and strings appear only after `import` (docs/model_language.md, "Lexical rules"); a
+// malformed rest is left to the parser.
+std::vector<std::string> ImportedNames(std::string_view text) {
+  std::vector<std::string> names;
+  bool after_import = false;  // the last token was the keyword `import`
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == '#') {
+      i = text.find('\n', i);
+    } else if (std::isspace(c)) {
+      ++i;
+    } else if (c == '"') {
+      const std::size_t end = text.find_first_of("\"\n\r", i + 1);
+      if (end == std::string_view::npos || text[end] != '"') break;
+      if (after_import) names.emplace_back(text.substr(i + 1, end - i - 1));
+      after_import = false;
+      i = end + 1;
+    } else if (std::isalpha(c) || c == '_') {
+      std::size_t end = i;
+      while (end < text.size() &&
+             (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_')) {
+        ++end;
+      }
+      after_import = text.substr(i, end - i) == "import";
+      i = end;
+    } else {
+      after_import = false;
+      ++i;
+    }
+  }
+  return names;
+}
+
+// The first kMaxModelFileBytes + 1 bytes of the regular file `path` (more are refused by the
+// parser anyway), or nullopt when it is not a regular file or cannot be read.
+std::optional<std::string> RegularFileText(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return std::nullopt;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  std::ifstream in(path, std::ios::binary);
+  if (ec || !in) return std::nullopt;
+  std::string text(std::min<std::uintmax_t>(size, kMaxModelFileBytes + 1), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
+}
+
+// Appends to `inputs` the files `file` imports and theirs, each once (`seen`: canonical paths),
+// as the parser resolves them (relative to the importing file's directory); `by` describes the
+// importer of the top-level file's imports.
+void CollectImports(const fs::path& file, const std::string& by, int depth,
+                    std::set<fs::path>* seen, std::vector<NamedFile>* inputs) {
+  if (depth > kMaxImportDepth) return;
+  const std::optional<std::string> text = RegularFileText(file);
+  if (!text) return;
+  for (const std::string& name : ImportedNames(*text)) {
+    const fs::path imported = file.parent_path() / name;
+    std::error_code ec;
+    const fs::path canonical = fs::weakly_canonical(imported, ec);
+    if (ec || !seen->insert(canonical).second) continue;
+    inputs->push_back({"", imported.string(), "imported by " + by});
+    CollectImports(imported, "'" + imported.string() + "'", depth + 1, seen, inputs);
+  }
+}
+
+}  // namespace
+
+std::vector<NamedFile> ModelInputs(const std::string& option, const std::string& path,
+                                   const std::optional<std::string>& config) {
+  std::vector<NamedFile> inputs = {{option, path}};
+  if (path.empty()) return inputs;
+  const std::string named = option + " '" + path + "'";
+  if (spaceex::IsSpaceExFile(path)) {
+    std::optional<std::string> cfg = config;
+    if (!cfg) {
+      if (const auto beside = spaceex::DefaultConfigFile(path)) cfg = beside->string();
+    }
+    if (cfg) inputs.push_back({"", *cfg, "the SpaceEx configuration of " + named});
+    return inputs;
+  }
+  std::error_code ec;
+  std::set<fs::path> seen = {fs::weakly_canonical(path, ec)};
+  CollectImports(path, named, 1, &seen, &inputs);
+  return inputs;
+}
+
 void CheckDistinctFiles(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs) {
   std::unordered_map<std::string, const NamedFile*> inputs_by_key, outputs_by_key;
@@ -137,8 +294,11 @@ void CheckDistinctFiles(const std::vector<NamedFile>& inputs,
                        "', '" + out.path + "'); give each output its own file");
     }
     if (const auto in = inputs_by_key.find(key); in != inputs_by_key.end()) {
-      throw UsageError(out.option + " '" + out.path + "' names the input " + in->second->option +
-                       " '" + in->second->path + "'; an output may not overwrite an input");
+      const NamedFile& input = *in->second;
+      const std::string named = input.role.empty() ? input.option + " '" + input.path + "'"
+                                                   : "'" + input.path + "' (" + input.role + ")";
+      throw UsageError(out.option + " '" + out.path + "' names the input " + named +
+                       "; an output may not overwrite an input");
     }
   }
 }
@@ -173,45 +333,116 @@ void CheckOutputPlaces(const std::vector<NamedFile>& files,
 
 void WriteOutput(const std::string& path, const std::string& text) { WriteOutputs({{path, text}}); }
 
+namespace {
+
+// The temporary files of one WriteOutputs call and the directories it created, registered with
+// RemovedOnSignal while they exist.
+struct PendingOutputs {
+  std::vector<fs::path> created;                             // directories, outermost first
+  std::vector<std::pair<std::string, std::string>> renames;  // (temporary, target)
+  std::vector<RemovedOnSignal> registrations;
+
+  // Removes the temporary files and the created directories.
+  void Discard() {
+    std::error_code ignored;
+    for (const auto& r : renames) fs::remove(r.first, ignored);
+    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
+  }
+};
+
+// Creates the `directories`, writes each regular (or new) file's text to a temporary file and the
+// stream outputs directly. Throws OutputError (what was made stays in `pending`).
+void WriteTemporaries(const std::vector<std::pair<std::string, std::string>>& files,
+                      const std::vector<std::string>& directories, PendingOutputs* pending) {
+  for (const std::string& dir : directories) {
+    CreateDirectories(dir, &pending->created, &pending->registrations);
+  }
+  int index = 0;
+  for (const auto& [path, text] : files) {
+    if (IsStreamOutput(path)) continue;
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+      throw OutputError("cannot write '" + path + "': it is a directory");
+    }
+    const std::string temp = TemporaryName(path, index++);
+    pending->registrations.emplace_back(temp);  // before the file exists
+    WriteTemporary(path, temp, text);
+    pending->renames.emplace_back(temp, path);
+  }
+  for (const auto& [path, text] : files) {
+    if (IsStreamOutput(path)) WriteStream(path, text);
+  }
+}
+
+// Renames the temporary files over their targets, with the cleaned signals blocked, and ends the
+// registrations before they are delivered. Throws OutputError.
+void RenameTemporaries(PendingOutputs* pending) {
+  const BlockedSignals blocked;
+  for (std::size_t i = 0; i < pending->renames.size(); ++i) {
+    std::error_code ec;
+    fs::rename(pending->renames[i].first, pending->renames[i].second, ec);
+    if (ec) {
+      // Not expected (same directory, target not a directory): the files renamed so far stay.
+      std::error_code ignored;
+      for (std::size_t k = i; k < pending->renames.size(); ++k) {
+        fs::remove(pending->renames[k].first, ignored);
+      }
+      pending->registrations.clear();
+      throw OutputError("cannot write '" + pending->renames[i].second + "': " + ec.message());
+    }
+  }
+  pending->registrations.clear();
+}
+
+}  // namespace
+
 void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files,
                   const std::vector<std::string>& directories) {
   std::vector<NamedFile> named;
   for (const auto& [path, text] : files) named.push_back({"'" + path + "'", path});
   CheckDistinctFiles({}, named);
-  std::vector<fs::path> created;                             // directories, outermost first
-  std::vector<std::pair<std::string, std::string>> renames;  // (temporary, target)
-  auto discard = [&]() {
-    std::error_code ignored;
-    for (const auto& r : renames) fs::remove(r.first, ignored);
-    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
-  };
+  PendingOutputs pending;
   try {
-    for (const std::string& dir : directories) CreateDirectories(dir, &created);
-    int index = 0;
-    for (const auto& [path, text] : files) {
-      if (IsStreamOutput(path)) continue;
-      std::error_code ec;
-      if (fs::is_directory(path, ec)) {
-        throw OutputError("cannot write '" + path + "': it is a directory");
-      }
-      renames.emplace_back(WriteTemporary(path, text, index++), path);
-    }
-    for (const auto& [path, text] : files) {
-      if (IsStreamOutput(path)) WriteStream(path, text);
-    }
+    WriteTemporaries(files, directories, &pending);
   } catch (const OutputError&) {
-    discard();
+    pending.Discard();
     throw;
   }
-  for (std::size_t i = 0; i < renames.size(); ++i) {
-    std::error_code ec;
-    fs::rename(renames[i].first, renames[i].second, ec);
-    if (ec) {
-      // Not expected (same directory, target not a directory): the files renamed so far stay.
-      std::error_code ignored;
-      for (std::size_t k = i; k < renames.size(); ++k) fs::remove(renames[k].first, ignored);
-      throw OutputError("cannot write '" + renames[i].second + "': " + ec.message());
+  RenameTemporaries(&pending);
+}
+
+RemovedOnSignal::RemovedOnSignal(const std::string& path, Kind kind) {
+  if (path.empty() || path.size() >= kMaxRegisteredPath) return;
+  for (std::size_t i = 0; i < registered_paths.size(); ++i) {
+    RegisteredPath& r = registered_paths[i];
+    int expected = kFreeSlot;
+    if (!r.state.compare_exchange_strong(expected, kFillingSlot, std::memory_order_acq_rel)) {
+      continue;
     }
+    std::memcpy(r.path, path.c_str(), path.size() + 1);
+    r.state.store(kind == kDirectory ? kDirectorySlot : kFileSlot, std::memory_order_release);
+    slot_ = static_cast<int>(i);
+    return;
+  }
+}
+
+RemovedOnSignal::~RemovedOnSignal() {
+  if (slot_ >= 0) {
+    registered_paths[static_cast<std::size_t>(slot_)].state.store(kFreeSlot,
+                                                                  std::memory_order_release);
+  }
+}
+
+void RemoveTemporaryFilesOnSignals() {
+  for (int s : kCleanedSignals) {
+    struct sigaction current {};
+    if (sigaction(s, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+    struct sigaction action {};
+    action.sa_handler = RemoveRegisteredAndRaise;
+    sigemptyset(&action.sa_mask);
+    for (int other : kCleanedSignals) sigaddset(&action.sa_mask, other);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(s, &action, nullptr);
   }
 }
 

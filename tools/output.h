@@ -2,8 +2,9 @@
 
 // The files a `hybrid` command writes (docs/cli.md, "Output files"): checked before any work
 // (no two outputs naming one file, no output naming an input, every output's directory present),
-// then written all or nothing.
+// then written all or nothing, and no temporary file left behind when a signal stops the program.
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -17,11 +18,26 @@ struct OutputError : std::runtime_error {
 };
 
 /// A file named on the command line: the option that names it ("MODEL" for a positional
-/// argument, "--out", ...) and its path.
+/// argument, "--out", ...) and its path. An input the command reads because another names it (a
+/// model's import) has a `role` saying so ("imported by MODEL 'main.ha'"), which messages give in
+/// place of the option.
 struct NamedFile {
   std::string option;
   std::string path;
+  std::string role = {};
 };
+
+/// The files reading the model file `path` (named by `option`: "MODEL", "--model") reads, as
+/// inputs for CheckDistinctFiles: the model itself; every file it imports, directly or through
+/// other imports, found as the parser finds them (`import "FILE";` outside comments, FILE relative
+/// to the importing file's directory), with the role "imported by ..."; and for a SpaceEx model
+/// (.xml) its configuration: `config` if given, else the .cfg beside it if it exists, with the
+/// role "the SpaceEx configuration of ...". Nothing is read from a model that is not a regular
+/// file (a pipe, /dev/stdin: reading it would consume it); a file that cannot be read, an import
+/// that does not exist and a cycle are skipped (reading the model reports them). Never throws
+/// for a bad model.
+std::vector<NamedFile> ModelInputs(const std::string& option, const std::string& path,
+                                   const std::optional<std::string>& config = std::nullopt);
 
 /// Whether `path` is standard output ("" or "-") or an existing file that is neither a regular
 /// file nor a directory (a device such as /dev/null or /dev/stdout, a FIFO): outputs written
@@ -34,8 +50,9 @@ bool IsStreamOutput(const std::string& path);
 bool SameFile(const std::string& a, const std::string& b);
 
 /// Throws UsageError (tools/options.h; exit 2) naming both options when two `outputs` name one
-/// file (SameFile) or an output names one of the `inputs`. Outputs for which IsStreamOutput holds
-/// are not compared; entries with an empty path are skipped.
+/// file (SameFile) or an output names one of the `inputs` (named by its option, or by its path and
+/// role). Outputs for which IsStreamOutput holds are not compared; entries with an empty path are
+/// skipped.
 void CheckDistinctFiles(const std::vector<NamedFile>& inputs,
                         const std::vector<NamedFile>& outputs);
 
@@ -58,8 +75,41 @@ void WriteOutput(const std::string& path, const std::string& text);
 /// targets. On a failure the temporary files and the directories this call created are removed
 /// and no regular target is touched (existing files keep their content), then OutputError is
 /// thrown. Two entries naming one file (SameFile) are refused with UsageError before anything is
-/// written.
+/// written. While they exist, the temporary files and the created directories are registered with
+/// RemovedOnSignal, and the renames run with SIGINT, SIGTERM and SIGHUP blocked in the calling
+/// thread: a program stopped by one of them (RemoveTemporaryFilesOnSignals) leaves either no
+/// temporary file and no target touched, or (stopped during the renames) every target written.
 void WriteOutputs(const std::vector<std::pair<std::string, std::string>>& files,
                   const std::vector<std::string>& directories = {});
+
+/// Installs handlers of SIGINT, SIGTERM and SIGHUP (those not ignored when it is called) that
+/// remove every path registered with RemovedOnSignal (files with unlink(2), then directories with
+/// rmdir(2), the latest registered first) and then end the program by the same signal with its
+/// default action (so the exit status tells the signal, as without the handlers). The handlers are
+/// async-signal-safe. Call it once, early in main; a library (the Python module) does not.
+void RemoveTemporaryFilesOnSignals();
+
+/// While it lives, `path` (a file, or an empty directory with kDirectory) is removed if one of the
+/// signals of RemoveTemporaryFilesOnSignals stops the program. Register a file before creating it
+/// (removing a path not created yet is harmless) and let the registration go once the file is
+/// renamed or removed. At most 64 paths are registered at once and a path may be at most 4095
+/// bytes long; beyond that nothing is registered (the path is then not removed on a signal).
+/// Relative paths are taken from the working directory at the signal.
+class RemovedOnSignal {
+ public:
+  enum Kind { kFile, kDirectory };
+  RemovedOnSignal(const std::string& path, Kind kind = kFile);
+  ~RemovedOnSignal();
+  RemovedOnSignal(RemovedOnSignal&& other) noexcept : slot_(other.slot_) { other.slot_ = -1; }
+  RemovedOnSignal& operator=(RemovedOnSignal&&) = delete;
+  RemovedOnSignal(const RemovedOnSignal&) = delete;
+  RemovedOnSignal& operator=(const RemovedOnSignal&) = delete;
+
+  /// Whether the path is registered (false when the table was full or the path too long).
+  bool registered() const { return slot_ >= 0; }
+
+ private:
+  int slot_ = -1;  // index in the table of registered paths; -1: none
+};
 
 }  // namespace hybrid::cli

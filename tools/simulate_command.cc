@@ -280,7 +280,9 @@ nlohmann::ordered_json SimulationReport(const Simulator& sim, const SimulationRe
 }
 
 int RunSimulate(const SimulateArgs& args) {
-  CheckDistinctFiles({{"MODEL", args.model}, {"--input-csv", args.input_csv}},
+  std::vector<NamedFile> inputs = ModelInputs("MODEL", args.model);
+  inputs.push_back({"--input-csv", args.input_csv});
+  CheckDistinctFiles(inputs,
                      {{"--out", args.out}, {"--events", args.events}, {"--plot", args.plot}});
   if (args.input_csv.empty() ? false : args.csv_shape != "step" && args.csv_shape != "linear") {
     throw UsageError("--csv-shape must be 'step' or 'linear'");

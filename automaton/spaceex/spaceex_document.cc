@@ -1,6 +1,7 @@
 #include "automaton/spaceex/spaceex_document.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <pugixml.hpp>
 #include <set>
@@ -21,8 +22,10 @@ class Reader {
     const auto offset = static_cast<std::size_t>(std::max<std::ptrdiff_t>(node.offset_debug(), 0));
     return offset > 0 && raw_[offset - 1] == '<' ? offset - 1 : offset;
   }
-  // Offset of attribute `name`'s value in the start tag of `node` (or of the element).
-  std::size_t AttributeAt(const pugi::xml_node& node, const char* name) const {
+  // Offsets of attribute `name` in the start tag of `node`: of its name and of its value's first
+  // character; both the element's when it cannot be found.
+  std::pair<std::size_t, std::size_t> AttributePlace(const pugi::xml_node& node,
+                                                     const char* name) const {
     const std::size_t start = At(node);
     const std::size_t end = raw_.find('>', start);
     std::size_t pos = start;
@@ -34,10 +37,46 @@ class Reader {
       if ((before == ' ' || before == '\t' || before == '\n' || before == '\r') && q < end &&
           raw_[q] == '=') {
         const std::size_t value = raw_.find_first_of("\"'", q);
-        return value < end ? value + 1 : pos;
+        return {pos, value < end ? value + 1 : pos};
       }
     }
-    return start;
+    return {start, start};
+  }
+  // Offset of attribute `name`'s value in the start tag of `node` (or of the element).
+  std::size_t AttributeAt(const pugi::xml_node& node, const char* name) const {
+    return AttributePlace(node, name).second;
+  }
+
+  // Fails at the first attribute of `node` that is not in `known`: SpaceEx gives every
+  // attribute of these elements a meaning or a place in the editor's drawing, so an attribute the
+  // import does not know could change the model unseen. Names starting with `prefix` (when
+  // given) are accepted too.
+  void OnlyAttributes(const pugi::xml_node& node, std::initializer_list<const char*> known,
+                      const char* prefix = nullptr) const {
+    for (const pugi::xml_attribute a : node.attributes()) {
+      bool ok = prefix != nullptr && std::strncmp(a.name(), prefix, std::strlen(prefix)) == 0;
+      for (const char* k : known) ok = ok || std::strcmp(a.name(), k) == 0;
+      if (ok) continue;
+      std::string list;
+      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      doc_.Fail(AttributePlace(node, a.name()).first,
+                std::string("unknown attribute '") + a.name() + "' of <" + node.name() + ">" +
+                    (list.empty() ? " (it takes none)" : " (known: " + list + ")"));
+    }
+  }
+
+  // The boolean attribute `name` of `node`: true or false, also written 1 or 0, in any case;
+  // `absent` when it is not given. Fails at the value otherwise.
+  bool Boolean(const pugi::xml_node& node, const char* name, bool absent) const {
+    const pugi::xml_attribute a = node.attribute(name);
+    if (!a) return absent;
+    std::string value = a.value();
+    for (char& c : value) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (value == "true" || value == "1") return true;
+    if (value == "false" || value == "0") return false;
+    doc_.Fail(AttributeAt(node, name), std::string("attribute '") + name + "' of <" + node.name() +
+                                           "> must be true or false (or 1 or 0), not '" +
+                                           a.value() + "'");
   }
 
   std::string Required(const pugi::xml_node& node, const char* name) const {
@@ -64,6 +103,11 @@ class Reader {
     }
     return {"", At(node), false};
   }
+  // Text(node) of an element that takes no attributes (a flow, a guard, ...).
+  SxText Content(const pugi::xml_node& node) const {
+    OnlyAttributes(node, {});
+    return Text(node);
+  }
 
   // Fails on any child element of `node` but those named in `known` (and notes).
   void OnlyChildren(const pugi::xml_node& node, std::initializer_list<const char*> known) const {
@@ -79,11 +123,18 @@ class Reader {
   }
 
   SxParam Param(const pugi::xml_node& node) const {
+    OnlyAttributes(node, {"name", "type", "local", "d1", "d2", "dynamics", "controlled"});
     SxParam p;
     p.name = Required(node, "name");
     p.offset = At(node);
     const std::string type = Required(node, "type");
-    p.local = std::strcmp(node.attribute("local").as_string("false"), "true") == 0;
+    p.local = Boolean(node, "local", false);
+    // An uncontrolled variable may change arbitrarily at the component's jumps: not supported.
+    if (!Boolean(node, "controlled", true)) {
+      doc_.Fail(AttributeAt(node, "controlled"),
+                "controlled=\"false\" is not supported: parameters are controlled by their "
+                "component");
+    }
     if (type == "label") {
       p.type = SxParam::Type::kLabel;
       return p;
@@ -111,17 +162,19 @@ class Reader {
 
   SxLocation Location(const pugi::xml_node& node) const {
     OnlyChildren(node, {"invariant", "flow"});
+    OnlyAttributes(node, {"id", "name", "x", "y", "width", "height"});
     SxLocation l;
     l.id = Required(node, "id");
     l.name = node.attribute("name").as_string(l.id.c_str());
     l.offset = At(node);
-    if (const pugi::xml_node inv = node.child("invariant")) l.invariant = Text(inv);
-    if (const pugi::xml_node flow = node.child("flow")) l.flow = Text(flow);
+    if (const pugi::xml_node inv = node.child("invariant")) l.invariant = Content(inv);
+    if (const pugi::xml_node flow = node.child("flow")) l.flow = Content(flow);
     return l;
   }
 
   SxTransition Transition(const pugi::xml_node& node) const {
     OnlyChildren(node, {"label", "guard", "assignment", "labelposition", "middlepoint"});
+    OnlyAttributes(node, {"source", "target", "asap", "timedriven", "priority", "bezier"});
     for (const char* unsupported : {"timedriven", "priority"}) {
       if (node.attribute(unsupported)) {
         doc_.Fail(AttributeAt(node, unsupported),
@@ -132,21 +185,23 @@ class Reader {
     t.source = Required(node, "source");
     t.target = Required(node, "target");
     t.offset = At(node);
-    t.asap = std::strcmp(node.attribute("asap").as_string("false"), "true") == 0;
-    if (const pugi::xml_node n = node.child("label")) t.label = Text(n);
-    if (const pugi::xml_node n = node.child("guard")) t.guard = Text(n);
-    if (const pugi::xml_node n = node.child("assignment")) t.assignment = Text(n);
+    t.asap = Boolean(node, "asap", false);
+    if (const pugi::xml_node n = node.child("label")) t.label = Content(n);
+    if (const pugi::xml_node n = node.child("guard")) t.guard = Content(n);
+    if (const pugi::xml_node n = node.child("assignment")) t.assignment = Content(n);
     return t;
   }
 
   SxBind Bind(const pugi::xml_node& node) const {
     OnlyChildren(node, {"map"});
+    OnlyAttributes(node, {"component", "as", "x", "y", "width", "height"});
     SxBind b;
     b.component = Required(node, "component");
     b.as = Required(node, "as");
     b.offset = At(node);
     std::set<std::string> keys;
     for (const pugi::xml_node m : node.children("map")) {
+      OnlyAttributes(m, {"key"});
       SxMap map{Required(m, "key"), Text(m), At(m)};
       if (!keys.insert(map.key).second) {
         doc_.Fail(AttributeAt(m, "key"), "'" + map.key + "' is mapped twice");
@@ -158,6 +213,7 @@ class Reader {
 
   SxComponent Component(const pugi::xml_node& node) const {
     OnlyChildren(node, {"param", "location", "transition", "bind"});
+    OnlyAttributes(node, {"id"});
     SxComponent c;
     c.id = Required(node, "id");
     c.offset = At(node);
@@ -212,8 +268,8 @@ SpaceExDocument::SpaceExDocument(std::string_view xml, std::string file)
       doc.load_buffer(raw_.data(), raw_.size(), pugi::parse_default, pugi::encoding_utf8);
   if (!result) {
     // pugixml may report the offset just past the end of a truncated document.
-    const auto offset = std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(result.offset, 0)),
-                                 raw_.size());
+    const auto offset =
+        std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(result.offset, 0)), raw_.size());
     Fail(offset, std::string("malformed XML: ") + result.description());
   }
   const Reader reader(*this, raw_);
@@ -223,6 +279,7 @@ SpaceExDocument::SpaceExDocument(std::string_view xml, std::string file)
                               ">, expected <sspaceex>");
   }
   reader.OnlyChildren(root, {"component"});
+  reader.OnlyAttributes(root, {"xmlns", "version", "math"}, "xmlns:");
   for (const pugi::xml_node c : root.children("component")) {
     components_.push_back(reader.Component(c));
     if (Find(components_.back().id) != &components_.back()) {

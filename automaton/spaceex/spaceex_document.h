@@ -42,7 +42,7 @@ struct SxTransition {
   std::optional<SxText> label;
   std::optional<SxText> guard;
   std::optional<SxText> assignment;
-  bool asap = false;  ///< `asap="true"`: taken as soon as the guard holds
+  bool asap = false;  ///< `asap="true"` (or "1", any case): taken as soon as the guard holds
 };
 
 struct SxMap {
@@ -79,8 +79,11 @@ class SpaceExDocument {
  public:
   /// Parses `xml` (named `file` in messages) with pugixml. Throws ParseError at the line and
   /// column of malformed XML, a root that is not `<sspaceex>`, a missing or malformed required
-  /// attribute, an element the import does not support (named in the message), or a duplicate
-  /// component, parameter or location id.
+  /// attribute, an element the import does not support (named in the message), an attribute
+  /// not among those SpaceEx gives the element (layout attributes such as x, y, width, height
+  /// and bezier are known; `<note>`, `<labelposition>` and `<middlepoint>` are not read), a
+  /// boolean attribute (`asap`, `local`, `controlled`) other than true, false, 1 or 0 in any
+  /// case, `controlled="false"`, or a duplicate component, parameter or location id.
   SpaceExDocument(std::string_view xml, std::string file);
 
   const std::string& file() const { return file_; }

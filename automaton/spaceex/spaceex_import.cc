@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "automaton/parser.h"
+#include "automaton/quoted_text.h"
 #include "automaton/spaceex/spaceex_config.h"
 #include "automaton/spaceex/spaceex_document.h"
 #include "automaton/spaceex/sx_formula.h"
@@ -166,6 +167,7 @@ class Translator {
   void CheckNames(const Template& t, const Located& f, bool allow_primes) const;
   void BuildInstances(const SxComponent& system);
   Target MapParam(const Instance& inst, const SxParam& p, const SxMap* map) const;
+  void ReadForbidden();
   void AssignFlows();
   void ReadInitially();
   std::string InitialBoundSide(const Located& f, const SxFormula& side) const;
@@ -180,8 +182,8 @@ class Translator {
   std::string ParamLine(const Instance& inst, const SxParam& p) const;
   const Bound& InitialBound(const Instance& inst, const std::string& param) const;
   std::string Forbidden(const Located& f, const SxFormula& node) const;
-  Lines SystemLines(const SxComponent& system, const std::vector<std::string>& automaton_of,
-                    const std::optional<Located>& forbidden) const;
+  std::string ForbiddenName(const Located& f, const SxFormula& n) const;
+  Lines SystemLines(const SxComponent& system, const std::vector<std::string>& automaton_of) const;
   Translation Emit(const SxComponent& system);
 
   const SpaceExDocument& doc_;
@@ -195,6 +197,8 @@ class Translator {
   std::map<std::string, Bound> initial_;                 // SpaceEx system name -> bound
   std::map<std::string, std::string> initial_location_;  // instance `as` -> location name
   std::optional<Origin> initially_at_;
+  std::optional<Located> forbidden_;  // the option `forbidden`, if given
+  std::set<std::string> declared_;    // SpaceEx system names some instance declares
   std::vector<std::string> notes_;
 };
 
@@ -456,6 +460,29 @@ Target Translator::MapParam(const Instance& inst, const SxParam& p, const SxMap*
   return {target->name, *network_.Find(target->name), ""};
 }
 
+// Reads the option `forbidden`. The names it reads count as used by every instance whose
+// parameter they name, so that a constant or variable read only there is declared (and then
+// needs a value, or a flow, like any other); declared_ collects the names declared.
+void Translator::ReadForbidden() {
+  std::set<std::string> read;
+  if (const auto value = cfg_ ? cfg_->Find("forbidden") : std::nullopt) {
+    forbidden_ = ParseOption(*value);
+    forbidden_->formula.ForEachName([&](const SxFormula& n) { read.insert(n.text); });
+  }
+  for (const Instance& inst : instances_) {
+    Template& t = templates_.at(inst.tmpl->sx->id);
+    for (const SxParam& p : t.sx->params) {
+      const std::string& sx_name = inst.targets.at(p.name).sx_name;
+      if (p.type != SxParam::Type::kLabel && read.count(sx_name)) t.used.insert(p.name);
+    }
+  }
+  for (const Instance& inst : instances_) {
+    for (const auto& [param, target] : inst.targets) {
+      if (inst.tmpl->used.count(param) && !target.sx_name.empty()) declared_.insert(target.sx_name);
+    }
+  }
+}
+
 // Decides which instance gives each variable its flow. SpaceEx leaves a variable that no flow
 // constrains free to change arbitrarily, the model language keeps it constant: so a component
 // that gives a variable a flow must give it one in every location, and some component must.
@@ -704,15 +731,33 @@ Lines Translator::AutomatonBody(const Instance& inst) const {
   return out;
 }
 
+// A name read by `forbidden`, written in the model language: the system's name for it, or, for a
+// parameter of the network that no instance declares, its value when `initially` gives it one.
+std::string Translator::ForbiddenName(const Located& f, const SxFormula& n) const {
+  const auto it = our_system_names_.find(n.text);
+  if (it == our_system_names_.end())
+    Fail(f.At(n), "undefined name '" + n.text + "' in 'forbidden'");
+  if (n.primed) Fail(f.At(n), "'" + n.text + "'' (primed) is not allowed in 'forbidden'");
+  if (declared_.count(n.text)) return it->second;
+  const SxParam* p = instance_network_ ? instance_network_->FindParam(n.text) : nullptr;
+  if (p && p->type == SxParam::Type::kVariable) {
+    Fail(f.At(n), "no component gives '" + n.text +
+                      "' a flow: SpaceEx lets it change arbitrarily, which the import does not "
+                      "support (map it into a component that gives it a flow)");
+  }
+  const auto b = initial_.find(n.text);
+  if (b == initial_.end() || !b->second.point) {
+    Fail(f.At(n), "constant '" + n.text + "' read in 'forbidden' is declared by no component: " +
+                      "give it one value in 'initially' (" + n.text +
+                      " == 2), or map it into "
+                      "a component");
+  }
+  return "(" + b->second.lo + ")";
+}
+
 // The predicate of `forbidden` over system names.
 std::string Translator::Forbidden(const Located& f, const SxFormula& node) const {
-  auto name = [&](const SxFormula& n) {
-    const auto it = our_system_names_.find(n.text);
-    if (it == our_system_names_.end())
-      Fail(f.At(n), "undefined name '" + n.text + "' in 'forbidden'");
-    if (n.primed) Fail(f.At(n), "'" + n.text + "'' (primed) is not allowed in 'forbidden'");
-    return it->second;
-  };
+  auto name = [&](const SxFormula& n) { return ForbiddenName(f, n); };
   switch (node.kind) {
     case Kind::kTrue:
       return "true";
@@ -758,8 +803,7 @@ std::string Join(const std::vector<std::string>& lines) {
 
 // The `system` block of a network: one instance per bind, then the property.
 Lines Translator::SystemLines(const SxComponent& system,
-                              const std::vector<std::string>& automaton_of,
-                              const std::optional<Located>& forbidden) const {
+                              const std::vector<std::string>& automaton_of) const {
   Lines out;
   out.Add("", {doc_.file(), 1, 1});
   out.Add("system " + Names().Add(system.id, At(system.offset), "component") + " {",
@@ -780,9 +824,9 @@ Lines Translator::SystemLines(const SxComponent& system,
                 (binds.empty() ? ";" : " {" + binds + " }"),
             inst.at);
   }
-  if (forbidden) {
-    out.Add("  property forbidden: never " + Forbidden(*forbidden, forbidden->formula) + ";",
-            forbidden->where(0));
+  if (forbidden_) {
+    out.Add("  property forbidden: never " + Forbidden(*forbidden_, forbidden_->formula) + ";",
+            forbidden_->where(0));
   }
   out.Add("}", At(system.offset));
   return out;
@@ -791,18 +835,17 @@ Lines Translator::SystemLines(const SxComponent& system,
 Translation Translator::Emit(const SxComponent& system) {
   Lines out;
   const Origin top{doc_.file(), 1, 1};
-  out.Add("# Translated from the SpaceEx model " + doc_.file() +
-              (cfg_ ? " with the configuration " + cfg_->file() : std::string()) +
-              " (docs/spaceex.md).",
-          top);
+  // File names may hold any byte: escaped, so that none ends the comment line.
+  out.Add(
+      "# Translated from the SpaceEx model " + EscapedForMessage(doc_.file()) +
+          (cfg_ ? " with the configuration " + EscapedForMessage(cfg_->file()) : std::string()) +
+          " (docs/spaceex.md).",
+      top);
   for (const std::string& note : notes_) out.Add("# " + note, top);
   // One automaton per template, or per instance where the bodies differ.
   Names automata;
   std::vector<std::string> automaton_of(instances_.size());
   std::map<std::string, std::string> name_of_body;  // template id + body -> automaton name
-  std::optional<Located> forbidden;
-  if (const auto value = cfg_ ? cfg_->Find("forbidden") : std::nullopt)
-    forbidden = ParseOption(*value);
   std::vector<Lines> body_of;
   std::map<const Template*, std::set<std::string>> bodies;  // distinct bodies per template
   for (const Instance& inst : instances_) {
@@ -824,19 +867,20 @@ Translation Translator::Emit(const SxComponent& system) {
     out.Add("", top);
     out.Add("automaton " + name + " {", At(inst.tmpl->sx->offset));
     out.Append(body);
-    if (!system.IsNetwork() && forbidden) {
-      out.Add("  property forbidden: never " + Forbidden(*forbidden, forbidden->formula) + ";",
-              forbidden->where(0));
+    if (!system.IsNetwork() && forbidden_) {
+      out.Add("  property forbidden: never " + Forbidden(*forbidden_, forbidden_->formula) + ";",
+              forbidden_->where(0));
     }
     out.Add("}", At(inst.tmpl->sx->offset));
   }
-  if (system.IsNetwork()) out.Append(SystemLines(system, automaton_of, forbidden));
+  if (system.IsNetwork()) out.Append(SystemLines(system, automaton_of));
   return {Join(out.text), out.origins, notes_};
 }
 
 Translation Translator::Run() {
   const SxComponent& system = ChooseSystem();
   BuildInstances(system);
+  ReadForbidden();
   AssignFlows();
   ReadInitially();
   if (!cfg_) {
@@ -845,7 +889,7 @@ Translation Translator::Run() {
     if (!initially_at_)
       notes_.push_back("The configuration has no 'initially': the model has no initial states.");
     if (const auto horizon = cfg_->Find("time-horizon")) {
-      notes_.push_back("time-horizon = " + horizon->text +
+      notes_.push_back("time-horizon = " + EscapedForMessage(horizon->text) +
                        " is not imported: properties hold over unbounded time here.");
     }
   }
@@ -892,7 +936,18 @@ Translation ImportSpaceExFile(const std::filesystem::path& xml,
   const std::optional<std::filesystem::path> cfg_path = cfg ? cfg : DefaultConfigFile(xml);
   const std::string xml_text = ReadModelText(xml);
   const std::string cfg_text = cfg_path ? ReadModelText(*cfg_path) : std::string();
-  return TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path ? cfg_path->string() : "");
+  Translation translation =
+      TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path ? cfg_path->string() : "");
+  if (!cfg_path) {
+    // Without a configuration the model has no initial states, which no model may lack: say
+    // which file was looked for (once the model itself has been read without error).
+    std::filesystem::path beside = xml;
+    beside.replace_extension(".cfg");
+    throw ParseError(beside.string(), 0, 0,
+                     "missing: the SpaceEx model " + xml.string() +
+                         " needs its configuration (initial states, forbidden set) in this file");
+  }
+  return translation;
 }
 
 bool IsSpaceExFile(const std::filesystem::path& path) {

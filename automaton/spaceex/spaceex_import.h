@@ -38,13 +38,19 @@ struct Translation {
 /// states); `initially` gives initial states, `forbidden` the property `never` of that set.
 /// Throws ParseError naming the file, line and column of malformed XML or configuration, of a
 /// construct the translation does not support (nested networks, disjunctive initial sets, flows
-/// that leave a variable unconstrained, ...), or of a name that is not declared.
+/// that leave a variable unconstrained, ...), of an attribute the import does not know or a
+/// boolean attribute that is not true, false, 1 or 0 (in any case), or of a name that is not
+/// declared. Names that `forbidden` reads are declared by the components they belong to, also
+/// when nothing else reads them. Messages and notes escape the control characters they quote
+/// (EscapedForMessage, automaton/quoted_text.h).
 Translation TranslateSpaceEx(std::string_view xml, const std::string& xml_file,
                              std::string_view cfg, const std::string& cfg_file);
 
 /// Reads `xml` and its configuration (`cfg`, or else the file next to `xml` with the extension
-/// `.cfg` if there is one) and translates them. Throws ParseError (line 0) for a file that cannot
-/// be read, as TranslateSpaceEx otherwise.
+/// `.cfg`) and translates them. Throws ParseError (line 0) for a file that cannot be read, as
+/// TranslateSpaceEx for errors in them, and, when `cfg` is not given and there is no `.cfg` next
+/// to `xml`, a ParseError naming the file looked for (line 0, after any error of `xml`): without
+/// a configuration the model has no initial states.
 Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg = std::nullopt);
 

@@ -12,6 +12,10 @@ The C++ library behind the ``hybrid`` command line, in-process:
 
 Errors in a model raise :class:`ModelError` (a ``ValueError``) whose message names the file, line
 and column, as the command line does; bad arguments raise ``ValueError`` or ``KeyError``.
+
+Ctrl-C stops a long call (:meth:`Model.check`, :meth:`Model.simulate`, :func:`diagnose`,
+:func:`finger_angles` on large arrays) at once with ``KeyboardInterrupt``: called from the main
+thread, the first three compute in a child process that is killed (docs/python.md).
 """
 
 import json as _json

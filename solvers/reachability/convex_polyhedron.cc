@@ -441,6 +441,10 @@ int ConvexPolyhedron::NumConstraints() const {
   return count;
 }
 
+std::size_t ConvexPolyhedron::RepresentationBytes() const {
+  return static_cast<std::size_t>(impl_->p.external_memory_in_bytes());
+}
+
 std::optional<std::vector<double>> MaximizeLinear(int dims,
                                                   std::span<const LinearConstraint> constraints,
                                                   std::span<const double> objective) {

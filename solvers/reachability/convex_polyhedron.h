@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <optional>
 #include <span>
@@ -105,6 +106,14 @@ class ConvexPolyhedron {
   std::vector<LinearConstraint> Constraints() const;
   /// Number of minimised constraints (a size measure).
   int NumConstraints() const;
+  /// The bytes its representation in PPL holds beyond the object itself, as it stands
+  /// (constraints and generators as far as computed, their coefficients' digits, saturation
+  /// matrices): what operations on it read, so a measure of their cost that grows with the
+  /// number of constraints and generators, the dimension and the coefficients' length. It
+  /// depends only on the operations that made this polyhedron (and the PPL and GMP builds), not
+  /// on the machine's load or speed: reachability's deterministic budget charges it. Cheap
+  /// (linear in the representation), and it neither minimises nor converts anything.
+  std::size_t RepresentationBytes() const;
 
  private:
   struct Impl;

@@ -58,6 +58,14 @@ Disjunction Cross(const Disjunction& a, const Disjunction& b) {
   return out;
 }
 
+// Every comparison of `comparisons` in its closure (Comparison::Closure).
+std::vector<Comparison> Closed(const std::vector<Comparison>& comparisons) {
+  std::vector<Comparison> out;
+  out.reserve(comparisons.size());
+  for (const Comparison& c : comparisons) out.push_back(c.Closure());
+  return out;
+}
+
 }  // namespace
 
 // Expressions over System slots turned into affine maps over the dimensions.
@@ -75,7 +83,9 @@ struct LinearHybridSystem::Forms {
     const SymbolTable& symbols = system.symbols();
     return e.Substitute([&](const std::string&, int slot) -> std::optional<Expression> {
       if (symbols[slot].kind == SymbolKind::kParameter && dim_of_slot[slot] < 0) {
-        return Expression::Constant(nominal[slot]);
+        // A parameter derived from uncertain ones is that function of them (a dimension each).
+        const Expression resolved = system.ResolvedParameter(slot);
+        return resolved.is_constant() ? Expression::Constant(nominal[slot]) : resolved;
       }
       if (symbols[slot].kind == SymbolKind::kDiscrete) {
         for (const auto& [s, v] : discrete) {
@@ -271,6 +281,11 @@ LinearHybridSystem::LinearHybridSystem(const System& system, bool clock,
     names_.push_back(p.name);
     slots_.push_back(s);
   }
+  for (int s = 0; s < n; ++s) {  // derived parameters: their range over the uncertain ones
+    if (symbols[s].kind != SymbolKind::kParameter || f.dim_of_slot[s] >= 0) continue;
+    const Expression resolved = system.ResolvedParameter(s);
+    if (!resolved.is_constant()) f.box[s] = resolved.EvaluateInterval(f.box);
+  }
   for (int s = 0; s < n; ++s) {
     if (symbols[s].kind != SymbolKind::kInput) continue;
     const auto [lo, hi] = system.InputBounds(s);
@@ -309,8 +324,9 @@ LinearLocation LinearHybridSystem::Build(const std::vector<int>& tuple) const {
     loc.name += (c > 0 ? ", " : "") + system_.QualifiedModeName(c, ModeId(tuple[c]));
   }
   loc.discrete_values = mode.discrete_values;
+  // Invariants in their closure: the boundary belongs to the mode (docs/model_language.md).
   const auto invariant =
-      f.Conjunction(mode.invariant.comparisons, mode.discrete_values, "mode " + loc.name);
+      f.Conjunction(Closed(mode.invariant.comparisons), mode.discrete_values, "mode " + loc.name);
   // A constant-false invariant: no state; an empty conjunction with a false part stands for it.
   loc.invariant =
       invariant
@@ -321,14 +337,12 @@ LinearLocation LinearHybridSystem::Build(const std::vector<int>& tuple) const {
   loc.rates = f.Rates(mode, num_variables_, clock_, loc.input_rates, loc.exact_rates);
   for (System::Step& step : system_.StepsFrom(tuple)) {
     const std::string what = "transition " + step.transition.name;
-    const auto guard = f.Conjunction(step.transition.guard.comparisons, mode.discrete_values, what);
-    if (!guard) continue;  // never enabled
     // Guards in their closure: the simulator takes a jump where its guard holds in its closure
     // (a strict guard crossed at its boundary), so runs may jump there.
-    std::vector<LinearConstraint> closed = *guard;
-    for (LinearConstraint& c : closed) {
-      if (c.kind == Kind::kLess) c.kind = Kind::kLessEqual;
-    }
+    const auto guard =
+        f.Conjunction(Closed(step.transition.guard.comparisons), mode.discrete_values, what);
+    if (!guard) continue;  // never enabled
+    const std::vector<LinearConstraint>& closed = *guard;
     LinearEdge edge{std::move(step.target),
                     closed,
                     Polyhedron(closed),

@@ -5,10 +5,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <map>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <cstdio>
+#include <cstdlib>
 
 #include "solvers/reachability/linear_hybrid_system.h"
 
@@ -23,6 +28,58 @@ double ThreadCpuSeconds() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
+
+// The deterministic cost count of one Check, in reach units (kReachUnitsPerBudgetSecond), and its
+// CPU-time safety net, shared by its explorations: each may use units up to its share.
+class Meter {
+ public:
+  Meter(std::uint64_t total, double cpu_seconds)
+      : total_(total), limit_(total), cpu_seconds_(cpu_seconds), start_(ThreadCpuSeconds()) {}
+
+  // Charges `count` operations that read a polyhedron of the size of `p` (and one of `q`'s).
+  void Op(const ConvexPolyhedron& p, std::uint64_t count = 1) {
+    used_ += count * (kReachUnitsPerOperation + p.RepresentationBytes() / kReachBytesPerUnit);
+    const double b = p.RepresentationBytes() / 64.0;
+    cal_ops += count; cal_bytes += count * (p.RepresentationBytes() / kReachBytesPerUnit);
+    cal_sq += count * b * std::sqrt(b);
+  }
+  void Op(const ConvexPolyhedron& p, const ConvexPolyhedron& q) {
+    used_ += kReachUnitsPerOperation +
+             (p.RepresentationBytes() + q.RepresentationBytes()) / kReachBytesPerUnit;
+    cal_ops += 1; cal_bytes += (p.RepresentationBytes() + q.RepresentationBytes()) / kReachBytesPerUnit;
+    const double b = p.RepresentationBytes() / 64.0, c = q.RepresentationBytes() / 64.0;
+    cal_sq += (b + c) * std::sqrt(b + c);
+  }
+  double cal_sq = 0; std::uint64_t cal_locs = 0;
+  // Charges `count` comparisons of bounding boxes.
+  void Boxes(std::uint64_t count) { used_ += count * kReachUnitsPerBoxComparison; cal_boxes += count; }
+  // Charges the construction of a location.
+  void Location() { used_ += kReachUnitsPerLocation; cal_locs += 1; }
+  // Charges the replay of a run along a path of `steps` symbolic states.
+  void Replay(std::size_t steps) { used_ += steps * kReachUnitsPerReplayedStep; cal_replay += steps; }
+  std::uint64_t cal_ops = 0, cal_bytes = 0, cal_boxes = 0, cal_replay = 0;
+  double cal_cpu() const { return ThreadCpuSeconds() - start_; }
+
+  // The next exploration's share: what is left split equally among the `parts` still to run.
+  void ShareAmong(int parts) {
+    limit_ = used_ + (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
+  }
+  // Whether the current exploration has used its share.
+  bool Exhausted() const { return used_ >= limit_; }
+  // Whether the CPU-time safety net has passed (the thread's time since the Check began).
+  bool OutOfTime() const { return ThreadCpuSeconds() - start_ > cpu_seconds_; }
+
+  std::uint64_t used() const { return used_; }
+  std::uint64_t total() const { return total_; }
+  double cpu_seconds() const { return cpu_seconds_; }
+
+ private:
+  std::uint64_t total_;
+  std::uint64_t limit_;
+  std::uint64_t used_ = 0;
+  double cpu_seconds_;
+  double start_;  // thread CPU time at the start of the Check
+};
 
 // The bounding box of a symbolic state, each bound (ConvexPolyhedron::Bounds, within one ulp of
 // the true one) widened by one ulp either way: the true infimum of dimension i lies in
@@ -83,24 +140,30 @@ constexpr int kMaxConcretizations = 32;
 // the invariant (no urgent guard stops time), `set` lies inside it and inside its own time
 // elapse, so neither is tested.
 ConvexPolyhedron Flow(const LinearLocation& loc, ConvexPolyhedron set,
-                      const ConvexPolyhedron* extra) {
+                      const ConvexPolyhedron* extra, Meter& meter) {
   if (extra) {
     set.Intersect(*extra);
+    meter.Op(set, 2);
     if (set.IsEmpty()) return set;
   }
   if (loc.elapse_invariant.size() == loc.invariant.size()) {
     set.TimeElapse(loc.rates);
     if (!loc.invariant.empty()) set.Intersect(loc.invariant_set);
     if (extra) set.Intersect(*extra);
+    meter.Op(set, 3);
     return set;
   }
   ConvexPolyhedron flowing = set;
   flowing.Intersect(loc.elapse_set);
+  meter.Op(flowing, 3);
   if (flowing.IsEmpty()) return set;
   flowing.TimeElapse(loc.rates);
   flowing.Intersect(loc.elapse_set);
   if (extra) flowing.Intersect(*extra);
+  meter.Op(flowing, 3);
   if (!flowing.Contains(set)) flowing.Hull(set);
+  meter.Op(flowing, set);
+  meter.Op(flowing);
   return flowing;
 }
 
@@ -147,8 +210,9 @@ std::vector<const Property*> PropertiesOf(const std::vector<Goal>& goals) {
 }
 
 // `set` (entry states of `loc`) with the values of the variables dead at `loc` forgotten.
-ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set) {
+ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set, Meter& meter) {
   for (const int d : loc.dead) set.Unconstrain(d);
+  if (!loc.dead.empty()) meter.Op(set, loc.dead.size());
   return set;
 }
 
@@ -169,11 +233,12 @@ struct BadPart {
 class Explorer {
  public:
   Explorer(const System& system, std::vector<Goal> goals, std::optional<double> horizon,
-           const PolyhedralReachability::Options& options)
+           const PolyhedralReachability::Options& options, Meter& meter)
       : system_(system),
         lhs_(system, horizon.has_value(), PropertiesOf(goals)),
         goals_(std::move(goals)),
         options_(options),
+        meter_(meter),
         initial_(lhs_.InitialSets()),
         horizon_set_(ConvexPolyhedron::Universe(lhs_.dims())) {
     if (horizon) {
@@ -182,30 +247,21 @@ class Explorer {
     }
   }
 
-  // Explores until every goal is decided, the reachable set is complete or a bound is hit;
-  // then writes every goal's result.
-  // True once the exploration has used its CPU-time safety net.
-  bool OutOfTime() const { return ThreadCpuSeconds() - start_ > options_.cpu_seconds; }
-
-  void Run() {
-    start_ = ThreadCpuSeconds();
+  // Explores until every goal is decided, the reachable set is complete or a bound is hit
+  // (checked before each expansion: the deterministic budget's share, the state bound, the
+  // CPU-time safety net); then writes every goal's result and returns why it stopped early.
+  PolyhedralReachability::Usage::Stop Run() {
     for (int i = 0; i < static_cast<int>(initial_.size()); ++i) {
-      const LinearLocation& loc = lhs_.At(initial_[i].tuple);
-      ConvexPolyhedron set = Forgetting(loc, initial_[i].set);
+      const LinearLocation& loc = Enter(initial_[i].tuple);
+      ConvexPolyhedron set = Forgetting(loc, initial_[i].set, meter_);
       set.Intersect(loc.invariant_set);
-      Push({initial_[i].tuple, Flow(loc, std::move(set), Horizon()), -1, i});
+      meter_.Op(set);
+      Push({initial_[i].tuple, Flow(loc, std::move(set), Horizon(), meter_), -1, i});
     }
-    std::string stopped;
+    Stop stop = Stop::kNone;
     while (!queue_.empty() && !AllDecided()) {
-      if (static_cast<int>(nodes_.size()) > options_.max_states) {
-        stopped = "stopped after " + std::to_string(options_.max_states) + " symbolic states";
-        break;
-      }
-      if (OutOfTime()) {
-        stopped = "stopped by the CPU-time safety net after " +
-                  std::to_string(static_cast<int>(options_.cpu_seconds)) + " s";
-        break;
-      }
+      stop = Bound();
+      if (stop != Stop::kNone) break;
       const int n = queue_.front();
       queue_.pop_front();
       if (!nodes_[n].subsumed) Expand(n);
@@ -213,10 +269,35 @@ class Explorer {
         options_.progress(static_cast<int>(nodes_.size()), static_cast<int>(queue_.size()));
       }
     }
-    Finish(stopped);
+    Finish(stop);
+    return stop;
   }
 
+  // Symbolic states stored.
+  long long states() const { return static_cast<long long>(nodes_.size()); }
+
  private:
+  using Stop = PolyhedralReachability::Usage::Stop;
+
+  // The bound the exploration has reached, if any (deterministic ones first, so that the safety
+  // net is named only when it alone stops the exploration).
+  Stop Bound() const {
+    if (meter_.Exhausted()) return Stop::kBudget;
+    if (options_.max_states > 0 && static_cast<int>(nodes_.size()) > options_.max_states) {
+      return Stop::kStateBound;
+    }
+    return meter_.OutOfTime() ? Stop::kSafetyNet : Stop::kNone;
+  }
+
+  // The location `tuple`; the first time, its construction is charged.
+  const LinearLocation& Enter(const std::vector<int>& tuple) {
+    const int before = lhs_.num_locations();
+    const LinearLocation& loc = lhs_.At(tuple);
+    if (lhs_.num_locations() == before) return loc;
+    meter_.Location();
+    return loc;
+  }
+
   // The horizon's states, or null without a horizon.
   const ConvexPolyhedron* Horizon() const { return horizon_.empty() ? nullptr : &horizon_set_; }
 
@@ -230,17 +311,22 @@ class Explorer {
     const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
     for (int e = 0; e < static_cast<int>(loc.edges.size()); ++e) {
       const LinearEdge& edge = loc.edges[static_cast<size_t>(e)];
+      meter_.Boxes(1);
       if (CertainlyMisses(nodes_[n].box, edge.guard)) continue;
       ConvexPolyhedron set = nodes_[n].set;
+      meter_.Op(set);
       if (!edge.guard.empty()) {
         set.Intersect(edge.guard_set);
+        meter_.Op(set, 2);
         if (set.IsEmpty()) continue;
       }
       set.Assign(edge.resets);
-      const LinearLocation& target = lhs_.At(edge.target);
-      set = Forgetting(target, std::move(set));
+      if (!edge.resets.empty()) meter_.Op(set);
+      const LinearLocation& target = Enter(edge.target);
+      set = Forgetting(target, std::move(set), meter_);
       if (!target.invariant.empty()) {  // else every state (and `set` is not empty)
         set.Intersect(target.invariant_set);
+        meter_.Op(set, 2);
         if (set.IsEmpty()) continue;
       }
       // Where time elapse is exact (Flow), a state found before contains the flow of every set
@@ -249,7 +335,7 @@ class Explorer {
           Covered(edge.target, set, BoxOf(set))) {
         continue;
       }
-      Push({edge.target, Flow(target, std::move(set), Horizon()), n, e});
+      Push({edge.target, Flow(target, std::move(set), Horizon(), meter_), n, e});
     }
   }
 
@@ -258,12 +344,16 @@ class Explorer {
   // `node` contains no longer count at the location (`node` covers them), and those not yet
   // expanded never will be: `node`'s successors contain theirs.
   void Push(Node node) {
+    meter_.Op(node.set, 2);  // the emptiness test and the bounding box
     if (node.set.IsEmpty()) return;
     node.box = BoxOf(node.set);
     if (Covered(node.tuple, node.set, node.box)) return;
     std::vector<int>& here = passed_[node.tuple];
+    meter_.Boxes(here.size());
     std::erase_if(here, [&](int i) {
-      if (!MayContain(node.box, nodes_[i].box) || !node.set.Contains(nodes_[i].set)) return false;
+      if (!MayContain(node.box, nodes_[i].box)) return false;
+      meter_.Op(node.set, nodes_[i].set);
+      if (!node.set.Contains(nodes_[i].set)) return false;
       nodes_[i].subsumed = true;
       return true;
     });
@@ -278,10 +368,19 @@ class Explorer {
 
   // Whether `set` (with bounding box `box`) lies inside a state found before at `tuple`.
   bool Covered(const std::vector<int>& tuple, const ConvexPolyhedron& set, const Box& box) {
+    std::uint64_t compared = 0;
+    bool covered = false;
     for (const int i : passed_[tuple]) {
-      if (MayContain(nodes_[i].box, box) && nodes_[i].set.Contains(set)) return true;
+      ++compared;
+      if (!MayContain(nodes_[i].box, box)) continue;
+      meter_.Op(nodes_[i].set, set);
+      if (nodes_[i].set.Contains(set)) {
+        covered = true;
+        break;
+      }
     }
-    return false;
+    meter_.Boxes(compared);
+    return covered;
   }
 
   // The bad (target) states of goal g at `loc`: where an `always` predicate fails, where a
@@ -294,6 +393,7 @@ class Explorer {
     for (Conjunction& c : lhs_.States(property.predicate, negated, loc)) {
       c.insert(c.end(), horizon_.begin(), horizon_.end());
       ConvexPolyhedron set = lhs_.Polyhedron(c);
+      meter_.Op(set, 2);
       if (!set.IsEmpty()) it->second.push_back({std::move(c), std::move(set)});
     }
     return it->second;
@@ -303,12 +403,15 @@ class Explorer {
     Goal& g = goals_[index];
     const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
     for (const BadPart& bad : Bad(index, loc)) {
+      meter_.Op(bad.set, nodes_[n].set);
       if (!bad.set.Intersects(nodes_[n].set)) continue;
       g.met = true;
-      if (g.concretizations >= kMaxConcretizations || OutOfTime()) continue;
+      if (g.concretizations >= kMaxConcretizations) continue;
+      if (Bound() != Stop::kNone) continue;  // no run is sought past a bound
       ++g.concretizations;
       std::optional<Trace> trace = Concretize(n, bad.constraints, &g.why_no_trace);
       if (!trace) continue;
+      meter_.Replay(PathOf(n).size());
       CheckResult& r = *g.result;
       r.verdict =
           g.property->kind == Property::Kind::kReach ? Verdict::kReachable : Verdict::kViolated;
@@ -319,6 +422,7 @@ class Explorer {
         r.reason = "a path of " + std::to_string(PathOf(n).size()) +
                    " symbolic states reaches it; the simulator replayed its run";
         g.decided = true;
+        if (std::getenv("HYBRID_REACH_CALIBRATE")) std::fprintf(stderr, "CALGOAL %s units %llu\n", g.property->name.c_str(), (unsigned long long)meter_.used());
         return;
       }
       g.why_no_trace = r.reason;
@@ -346,13 +450,14 @@ class Explorer {
                   const std::vector<ConvexPolyhedron>& ends);
   Trace TraceOf(const PathRun& run, const std::vector<int>& path,
                 const LinearHybridSystem::Initial& init);
-  void Finish(const std::string& stopped);
+  std::string StopText(Stop stop) const;
+  void Finish(Stop stop);
 
   const System& system_;
   LinearHybridSystem lhs_;
   std::vector<Goal> goals_;
   PolyhedralReachability::Options options_;
-  double start_ = 0.0;      // thread CPU time at the start of Run
+  Meter& meter_;
   long long expanded_ = 0;  // states expanded (for the progress callback)
   std::vector<LinearHybridSystem::Initial> initial_;
   Conjunction horizon_;
@@ -382,6 +487,7 @@ std::optional<Trace> Explorer::Concretize(int n, const Conjunction& bad, std::st
   ConvexPolyhedron start = Backward(path, bad, ends);
   const std::vector<double> margin = Unit(lhs_.dims() + 1, lhs_.dims());
   const std::optional<double> best = start.Supremum(margin);
+  meter_.Op(start, 2);
   if (!best || *best < 1e-9) {
     *why = "the states met lie on the boundary of the property (no run violates it with margin)";
     return std::nullopt;
@@ -424,12 +530,15 @@ ConvexPolyhedron Explorer::Backward(const std::vector<int>& path, const Conjunct
     rates.AddConstraint({Unit(d + 1, d), 0.0, Kind::kEqual});
     set.TimeElapseBackward(rates);
     set.Intersect(inside);
+    meter_.Op(set, 6);
     if (k == 0) break;
     const LinearEdge& edge = EdgeAfter(path, k - 1);
     set.AssignPreimage(edge.resets);
     set.Intersect(Lifted(edge.guard_set, 1));
+    meter_.Op(set, 3);
   }
   set.Intersect(Lifted(initial_[static_cast<size_t>(nodes_[path[0]].edge)].set, 1));
+  meter_.Op(set, 2);
   return set;
 }
 
@@ -484,6 +593,7 @@ PathRun Explorer::Forward(const std::vector<int>& path, const ConvexPolyhedron& 
     flow.TimeElapse(LiftedRates(LocationOf(path[k])));
     flow.Intersect(Lifted(ends[static_cast<size_t>(k)], 1 + ni));
     point = flow.CentralPoint();
+    meter_.Op(flow, 6);
     const std::vector<double> x = point.PointCoordinates();
     const double dwell = x[static_cast<size_t>(d + 1)];
     run.dwell.push_back(dwell);
@@ -546,17 +656,46 @@ Trace Explorer::TraceOf(const PathRun& run, const std::vector<int>& path,
   return trace;
 }
 
+// How an exploration that stopped early says why (in "reachability stopped ... before a
+// fixpoint").
+std::string Explorer::StopText(Stop stop) const {
+  switch (stop) {
+    case Stop::kBudget: {
+      std::ostringstream out;
+      out << "by its deterministic budget (" << options_.budget << " budget seconds, "
+          << meter_.total() << " reach units)";
+      return out.str();
+    }
+    case Stop::kStateBound:
+      return "after " + std::to_string(options_.max_states) + " symbolic states (its state bound)";
+    case Stop::kSafetyNet:
+      return "by the CPU-time safety net (" +
+             std::to_string(static_cast<long long>(meter_.cpu_seconds())) +
+             " s of CPU time), not by the deterministic budget: this verdict may differ on "
+             "another machine";
+    case Stop::kNone:
+      break;
+  }
+  return "";
+}
+
 // Writes each goal's verdict and reason.
-void Explorer::Finish(const std::string& stopped) {
-  const bool complete = queue_.empty() && stopped.empty();
+void Explorer::Finish(Stop stop) {
+  const bool complete = queue_.empty();  // else a bound stopped it
   std::ostringstream size;
   size << nodes_.size() << " symbolic states in " << lhs_.num_locations() << " locations";
+  // A goal met but left without a run sought met it after a bound was reached.
+  const std::string stopped =
+      "reachability stopped " + StopText(stop != Stop::kNone ? stop : Bound());
   for (Goal& g : goals_) {
     if (g.decided) continue;
     CheckResult& r = *g.result;
     r.verdict = Verdict::kUnknown;
     r.trace.reset();
-    if (g.met) {
+    if (g.met && g.concretizations == 0) {
+      r.reason = "the reachable set meets the property's states, but " + stopped +
+                 " before a run reaching them was sought (" + size.str() + ")";
+    } else if (g.met) {
       r.reason = "the reachable set meets the property's states, but no run found replays (" +
                  g.why_no_trace +
                  (g.concretizations >= kMaxConcretizations
@@ -565,8 +704,7 @@ void Explorer::Finish(const std::string& stopped) {
                       : std::string()) +
                  ")";
     } else if (!complete) {
-      r.reason = "reachability " + (stopped.empty() ? std::string("stopped") : stopped) +
-                 " before a fixpoint (" + size.str() + ")";
+      r.reason = stopped + " before a fixpoint (" + size.str() + ")";
     } else {
       r.verdict =
           g.property->kind == Property::Kind::kReach ? Verdict::kUnreachable : Verdict::kProved;
@@ -603,8 +741,12 @@ bool PolyhedralReachability::Handles(const System& system, const std::vector<Pro
   }
 }
 
-std::vector<CheckResult> PolyhedralReachability::Check(
-    const System& system, const std::vector<Property>& properties) const {
+std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
+                                                       const std::vector<Property>& properties,
+                                                       Usage* usage) const {
+  if (!(options_.budget > 0) || !(options_.budget <= 1e6)) {
+    throw std::invalid_argument("the reachability budget must be in (0, 1e6] budget seconds");
+  }
   std::vector<CheckResult> results(properties.size());
   const auto started = std::chrono::steady_clock::now();
   std::map<std::optional<double>, std::vector<int>> by_horizon;
@@ -614,11 +756,21 @@ std::vector<CheckResult> PolyhedralReachability::Check(
     results[i].method = "reach";
     by_horizon[properties[i].horizon].push_back(i);
   }
+  Meter meter(static_cast<std::uint64_t>(
+                  std::llround(options_.budget * static_cast<double>(kReachUnitsPerBudgetSecond))),
+              options_.cpu_seconds > 0 ? options_.cpu_seconds
+                                       : std::max(60.0, 10.0 * options_.budget));
+  Usage used;
+  int parts = static_cast<int>(by_horizon.size());
   for (const auto& [horizon, which] : by_horizon) {
     std::vector<Goal> goals;
     for (const int i : which) goals.push_back({&properties[i], &results[i], false, false, ""});
+    meter.ShareAmong(parts--);
     try {
-      Explorer(system, std::move(goals), horizon, options_).Run();
+      Explorer explorer(system, std::move(goals), horizon, options_, meter);
+      const Usage::Stop stop = explorer.Run();
+      used.states += explorer.states();
+      used.stop = std::max(used.stop, stop);  // the enumerators are in that order
     } catch (const std::invalid_argument& e) {
       for (const int i : which) {
         results[i].verdict = Verdict::kUnknown;
@@ -627,6 +779,15 @@ std::vector<CheckResult> PolyhedralReachability::Check(
       }
     }
   }
+  if (std::getenv("HYBRID_REACH_CALIBRATE")) {
+    std::fprintf(stderr, "CAL cpu %.3f ops %llu bytes %llu boxes %llu replay %llu sq %.0f locs %llu units %llu states %lld\n",
+                 meter.cal_cpu(), (unsigned long long)meter.cal_ops, (unsigned long long)meter.cal_bytes,
+                 (unsigned long long)meter.cal_boxes, (unsigned long long)meter.cal_replay, meter.cal_sq, (unsigned long long)meter.cal_locs,
+                 (unsigned long long)meter.used(), used.states);
+  }
+  used.units_total = meter.total();
+  used.units_used = meter.used();
+  if (usage) *usage = used;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   for (CheckResult& r : results) r.seconds = seconds / static_cast<double>(results.size());

@@ -86,21 +86,10 @@ struct CompiledComponent {
   std::vector<std::pair<int, double>> initial_values;  // (index in x, value)
 };
 
-// Residual semantics. `closure`: strict comparisons are taken as non-strict.
+// Residual semantics (automaton/constraint.h's ResidualHolds, the one definition of a comparison
+// within tolerance). `closure`: strict comparisons are taken as non-strict.
 bool Holds(Relation relation, double r, double tol, bool closure) {
-  switch (relation) {
-    case Relation::kLess:
-      return closure ? r <= tol : r < 0.0;
-    case Relation::kLessEqual:
-      return r <= tol;
-    case Relation::kGreater:
-      return closure ? r >= -tol : r > 0.0;
-    case Relation::kGreaterEqual:
-      return r >= -tol;
-    case Relation::kEqual:
-      return std::abs(r) <= tol;
-  }
-  return false;
+  return ResidualHolds(relation, r, tol, closure ? Boundary::kClosure : Boundary::kExact);
 }
 
 // Whether `e` contains an operation whose value may jump as the state moves continuously: sign,

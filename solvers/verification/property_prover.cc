@@ -60,6 +60,10 @@ struct Job {
   const Automaton* automaton = nullptr;
   // Its component's index in the System, or -1 for a product of components.
   int component = -1;
+  // For a product: its components (System indices, in product order). The product's initial
+  // states are the cartesian product of theirs, the first component varying slowest
+  // (System::Product).
+  std::vector<int> product_components;
   // automaton slot -> System slot
   std::vector<int> to_system;
   std::vector<Goal> goals;
@@ -278,6 +282,8 @@ class JobRun {
   // values, input schedule) and replays it for `c` (ReplayPath); false if it does not replay.
   bool TryTrace(const z3::model& model, int depth, Candidate& c);
   // Adds to `trace` the values s0 gives the variables that initial state `start` sets in a box.
+  // Which `init` declaration each component of the job starts from (trace.initial_states).
+  void AddInitialStates(int start, Trace& trace) const;
   void AddInitialValues(int start, const SmtEncoding::PathStep& s0, Trace& trace) const;
   // Adds to `trace` the input schedule of `path`: one step piece per flow segment of positive
   // duration, the values a jump's guard reads from the jump's instant, then a short tail with
@@ -406,10 +412,26 @@ bool JobRun::TryTrace(const z3::model& model, int depth, Candidate& c) {
   // The initial state the path starts from, and its values where that state is a box.
   const int start = enc_.InitialIndex(model);
   if (start < 0) return false;
-  if (job_.component >= 0) trace.initial_states.emplace_back(job_.component, start);
+  AddInitialStates(start, trace);
   AddInitialValues(start, path[0], trace);
   AddInputSchedule(path, depth, trace);
   return ReplayPath(model, depth, c, std::move(trace));
+}
+
+void JobRun::AddInitialStates(int start, Trace& trace) const {
+  if (job_.component >= 0) {
+    trace.initial_states.emplace_back(job_.component, start);
+    return;
+  }
+  // A product's initial state `start`, decomposed (mixed radix, the last component fastest).
+  const auto components = system_.components();
+  std::vector<std::pair<int, int>> states;
+  for (auto c = job_.product_components.rbegin(); c != job_.product_components.rend(); ++c) {
+    const int n = static_cast<int>(components[*c].automaton.initial_states().size());
+    states.emplace_back(*c, start % n);
+    start /= n;
+  }
+  trace.initial_states.assign(states.rbegin(), states.rend());
 }
 
 void JobRun::AddInitialValues(int start, const SmtEncoding::PathStep& s0, Trace& trace) const {
@@ -969,14 +991,23 @@ std::set<int> ComponentsRead(const System& system, const Property& p, const std:
   return comps;
 }
 
-// Whether no other component writes a continuous variable of component c.
+// Whether component c alone over-approximates what it does in the system, so that a property
+// reading only c may be checked on c alone: no other component has a continuous variable of c,
+// and no urgent transition of c synchronises with another component (a partner that is not
+// ready lets time pass beyond the point where c alone would have to jump; lazy synchronised
+// transitions only lose jumps in the system, which is sound).
 bool WritesAlone(const System& system, const std::vector<std::vector<int>>& owners, int c) {
   const Component& comp = system.components()[c];
-  bool alone = true;
   for (const VariableInfo& v : comp.automaton.variables()) {
-    if (owners[comp.global_slot[v.slot]].size() > 1) alone = false;
+    if (owners[comp.global_slot[v.slot]].size() > 1) return false;
   }
-  return alone;
+  for (const Transition& t : comp.automaton.transitions()) {
+    if (t.urgency != Urgency::kUrgent || t.label.empty()) continue;
+    for (int other = 0; other < static_cast<int>(system.components().size()); ++other) {
+      if (other != c && system.Alphabet(other).count(t.label)) return false;
+    }
+  }
+  return true;
 }
 
 // `p` (System slots) over the slots of a job whose slot i is System slot to_system[i], its mode
@@ -1086,6 +1117,7 @@ void MakeProduct(const System& system, const std::vector<int>& which, int max_pr
                  ProductJob& pj) {
   const System restricted = system.Restricted(which);
   pj.components = which;
+  pj.job.product_components = which;
   try {
     pj.automaton = restricted.Product(max_product_modes, &pj.tuples);
   } catch (const std::invalid_argument& e) {

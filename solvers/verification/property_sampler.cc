@@ -297,6 +297,12 @@ Trace ToTrace(const System& system, const Space& space, const Draw& draw, double
                                       Resolve(initial_levels[i], 0.5 * (lo + hi), lo, hi));
   }
 
+  // Runs start from each component's first init declaration (named where there are several).
+  for (std::size_t c = 0; c < system.components().size(); ++c) {
+    if (system.components()[c].automaton.initial_states().size() > 1) {
+      trace.initial_states.emplace_back(static_cast<int>(c), 0);
+    }
+  }
   trace.inputs.until = horizon;
   for (std::size_t i = 0; i < space.inputs.size(); ++i) {
     const auto [lo, hi] = model.InputBounds(space.inputs[i].slot);

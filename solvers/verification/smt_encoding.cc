@@ -614,28 +614,29 @@ z3::expr SmtEncoding::Power(const Expression& base, const Expression& ex,
 }
 
 z3::expr SmtEncoding::Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
-                              double margin) {
-  z3::expr r = Translate(c.lhs, env) - Translate(c.rhs, env);
-  const z3::expr m = Num(ctx_, margin);
-  switch (c.relation) {
-    case Relation::kLess:
-      return r < m;
-    case Relation::kLessEqual:
-      return r <= m;
-    case Relation::kGreater:
-      return r > -m;
-    case Relation::kGreaterEqual:
-      return r >= -m;
-    case Relation::kEqual:
-      return margin > 0 ? (r <= m && r >= -m) : r == 0;
+                              double margin, Boundary boundary) {
+  // The band of residuals that satisfy c (automaton/constraint.h: the one definition of a
+  // comparison within tolerance, which the simulator and the replay evaluate numerically).
+  const ResidualBand band =
+      margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary) : LenientBand(c.relation, margin);
+  const z3::expr r = Translate(c.lhs, env) - Translate(c.rhs, env);
+  z3::expr out = ctx_.bool_val(true);
+  if (band.lower) {
+    const z3::expr lo = Num(ctx_, *band.lower);
+    out = out && (band.lower_strict ? r > lo : r >= lo);
   }
-  return ctx_.bool_val(false);
+  if (band.upper) {
+    const z3::expr hi = Num(ctx_, *band.upper);
+    out = out && (band.upper_strict ? r < hi : r <= hi);
+  }
+  return out;
 }
 
 z3::expr SmtEncoding::Conjunction(const Constraint& c,
-                                  const std::vector<std::optional<z3::expr>>& env) {
+                                  const std::vector<std::optional<z3::expr>>& env,
+                                  Boundary boundary) {
   z3::expr out = ctx_.bool_val(true);
-  for (const Comparison& cmp : c.comparisons) out = out && Compare(cmp, env, 0.0);
+  for (const Comparison& cmp : c.comparisons) out = out && Compare(cmp, env, 0.0, boundary);
   return out;
 }
 
@@ -706,7 +707,10 @@ z3::expr SmtEncoding::State(int k) {
     }
     for (int m = 0; m < automaton_.num_modes(); ++m) {
       const Constraint& inv = automaton_.modes()[m].invariant;
-      if (!inv.empty()) clauses.push_back(z3::implies(v.mode[m], Conjunction(inv, env)));
+      // Invariants in their closure: the boundary belongs to the mode, as in the simulator.
+      if (!inv.empty()) {
+        clauses.push_back(z3::implies(v.mode[m], Conjunction(inv, env, Boundary::kClosure)));
+      }
     }
     for (std::size_t i = 0; i < input_slots_.size(); ++i) {
       clauses.push_back(Num(ctx_, input_lo_[i]) <= v.u[i]);
@@ -1087,12 +1091,10 @@ z3::expr SmtEncoding::Jump(int k, int t) {
   // jumps, where they are evaluated as they are: they stay strict. Every jump the simulator
   // takes meets this guard (more jumps: sound for proofs).
   z3::expr out = a.mode[tr.source.value()] && b.mode[tr.target.value()];
-  for (Comparison c : tr.guard.comparisons) {
-    if (ReadsMovingVariable(c, tr.source.value())) {
-      if (c.relation == Relation::kLess) c.relation = Relation::kLessEqual;
-      if (c.relation == Relation::kGreater) c.relation = Relation::kGreaterEqual;
-    }
-    out = out && Compare(c, env, 0.0);
+  for (const Comparison& c : tr.guard.comparisons) {
+    const Boundary boundary =
+        ReadsMovingVariable(c, tr.source.value()) ? Boundary::kClosure : Boundary::kExact;
+    out = out && Compare(c, env, 0.0, boundary);
   }
   std::vector<bool> reset(var_slots_.size(), false);
   for (const Reset& r : tr.resets) {

@@ -211,9 +211,12 @@ class SmtEncoding {
   // for a negative one), else an unconstrained auxiliary. `translate` translates `base`.
   z3::expr Power(const Expression& base, const Expression& ex,
                  const std::function<z3::expr(const Expression&)>& translate);
+  // c within the signed margin (ResidualBand: LenientBand for a margin, ResidualBand::Of with
+  // `boundary` for 0), encoded over the translated residual.
   z3::expr Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
-                   double margin);
-  z3::expr Conjunction(const Constraint& c, const std::vector<std::optional<z3::expr>>& env);
+                   double margin, Boundary boundary = Boundary::kExact);
+  z3::expr Conjunction(const Constraint& c, const std::vector<std::optional<z3::expr>>& env,
+                       Boundary boundary = Boundary::kExact);
   z3::expr Flow(int k, int mode);
   // The representative constant input u_k has the sign of the input's integral V_k, and V_k lies
   // within the input's bounds times d.

@@ -26,50 +26,6 @@ std::vector<UncertainParameter> UncertainParameters(const System& system) {
 
 namespace {
 
-// Whether `c` holds with margin `margin` (> 0 lenient, < 0 strict) at `env`.
-bool AtomHolds(const Comparison& c, std::span<const double> env, double margin) {
-  const double r = c.lhs.Evaluate(env) - c.rhs.Evaluate(env);
-  switch (c.relation) {
-    case Relation::kLess:
-      return r < margin;
-    case Relation::kLessEqual:
-      return r <= margin;
-    case Relation::kGreater:
-      return r > -margin;
-    case Relation::kGreaterEqual:
-      return r >= -margin;
-    case Relation::kEqual:
-      return std::abs(r) <= std::max(margin, 0.0);
-  }
-  return false;
-}
-
-// `p` evaluated as leniently as `tol` allows: every comparison in positive position holds within
-// tol, every comparison under an odd number of `not`s must hold with margin tol. So
-// !Lenient(p) means p fails clearly.
-bool Lenient(const Predicate& p, std::span<const double> env, std::span<const std::string> modes,
-             double tol, bool positive) {
-  switch (p.kind()) {
-    case Predicate::Kind::kTrue:
-      return true;
-    case Predicate::Kind::kFalse:
-      return false;
-    case Predicate::Kind::kComparison:
-      return AtomHolds(p.comparison(), env, positive ? tol : -tol);
-    case Predicate::Kind::kInMode:
-      return std::find(modes.begin(), modes.end(), p.mode()) != modes.end();
-    case Predicate::Kind::kNot:
-      return !Lenient(p.operands()[0], env, modes, tol, !positive);
-    case Predicate::Kind::kAnd:
-      return Lenient(p.operands()[0], env, modes, tol, positive) &&
-             Lenient(p.operands()[1], env, modes, tol, positive);
-    case Predicate::Kind::kOr:
-      return Lenient(p.operands()[0], env, modes, tol, positive) ||
-             Lenient(p.operands()[1], env, modes, tol, positive);
-  }
-  return false;
-}
-
 // The System environment of a recorded state: parameters, continuous and discrete variables.
 std::vector<double> StateEnvironment(const Simulator& simulator, const StateSample& sample) {
   const System& system = simulator.system();
@@ -111,7 +67,7 @@ bool InsideInvariants(const Simulator& simulator, const StateSample& sample, dou
       if (reads_input) continue;
       const double scale =
           1.0 + std::abs(cmp.lhs.Evaluate(local)) + std::abs(cmp.rhs.Evaluate(local));
-      if (!AtomHolds(cmp, local, tol * scale)) return false;
+      if (!cmp.Holds(local, tol * scale, Boundary::kClosure)) return false;  // invariants: closure
     }
   }
   return true;
@@ -133,11 +89,11 @@ bool IsTarget(const Simulator& simulator, const Property& property, const StateS
   const std::vector<std::string> modes = ModeNames(simulator, sample);
   switch (property.kind) {
     case Property::Kind::kAlways:
-      return !Lenient(property.predicate, env, modes, tolerance, true);
+      return !property.predicate.Lenient(env, modes, tolerance);
     case Property::Kind::kNever:
-      return !Lenient(Predicate::Not(property.predicate), env, modes, tolerance, true);
+      return !Predicate::Not(property.predicate).Lenient(env, modes, tolerance);
     case Property::Kind::kReach:
-      return Lenient(property.predicate, env, modes, tolerance, true);
+      return property.predicate.Lenient(env, modes, tolerance);
   }
   return false;
 }

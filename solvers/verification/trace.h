@@ -53,9 +53,9 @@ struct Trace {
 };
 
 /// Replay settings: a property counts as failing (or, for `reach`, holding) at a recorded state
-/// only when it does so with margin `tolerance` (comparisons are tested with Comparison::Holds
-/// at -tolerance for a failure, +tolerance for a witness), so a replay confirms a violation only
-/// when it is clear of rounding.
+/// only when it does so with margin `tolerance` (the predicate is read with Predicate::Lenient,
+/// the one definition of tolerance that the SMT encoding's counterexample search shares), so a
+/// replay confirms a violation only when it is clear of rounding.
 struct ReplayOptions {
   double tolerance = 1e-6;
   /// Also record the state this often (fraction of the horizon); 0 records only the start,

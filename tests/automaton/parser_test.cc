@@ -1023,6 +1023,112 @@ automaton t {
   EXPECT_TRUE(a.transitions()[3].guard.empty());
 }
 
+// A default name skips every name an earlier transition has, named or not, and whatever base
+// it came from: `m_to_n_2` is the default name of `m -> n_2`, so the next `m -> n` is `m_to_n_3`.
+// A later explicit name equal to an earlier default is a duplicate.
+TEST(Parser, DefaultTransitionNamesSkipEveryEarlierName) {
+  const Automaton a = OnlyAutomaton(R"(
+automaton t {
+  mode m { }
+  mode n { }
+  mode n_2 { }
+  transition m -> n { }
+  transition m -> n_2 { }
+  transition m -> n { }
+  transition m_to_n_5: m -> n { }
+  transition m -> n { }
+  transition m -> n { }
+  transition m -> n_2 { }
+  transition m -> n { }
+  init m { }
+})");
+  std::vector<std::string> names;
+  for (const Transition& t : a.transitions()) names.push_back(t.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"m_to_n", "m_to_n_2", "m_to_n_3", "m_to_n_5",
+                                             "m_to_n_4", "m_to_n_6", "m_to_n_2_2", "m_to_n_7"}));
+  const ParseError e = ParseFailure(R"(automaton t {
+  mode m { }
+  mode n { }
+  transition m -> n { }
+  transition m_to_n: m -> n { }
+  init m { }
+})");
+  EXPECT_EQ(e.line(), 5);
+  EXPECT_EQ(e.message(), "duplicate transition 'm_to_n'");
+}
+
+// `count` unnamed transitions; transition i goes from mode `source(i)` to mode `target(i)`, modes
+// q0 .. q(modes - 1).
+std::string UnnamedTransitions(int modes, int count, const std::function<int(int)>& source,
+                               const std::function<int(int)>& target) {
+  std::string text = "automaton many {\n";
+  for (int i = 0; i < modes; ++i) text += "  mode q" + std::to_string(i) + " { }\n";
+  for (int i = 0; i < count; ++i) {
+    text += "  transition q" + std::to_string(source(i)) + " -> q" + std::to_string(target(i)) +
+            " { }\n";
+  }
+  return text + "  init q0 { }\n}\n";
+}
+
+// 10^5 unnamed transitions between two modes are numbered 2, 3, ... in order (naming them used
+// to scan every earlier transition for every number tried: cubic, hours for 10^5).
+TEST(LargeInputs, HundredThousandUnnamedTransitionsBetweenTwoModes) {
+  constexpr int kCount = 100000;
+  const Automaton a = ParseAutomaton(UnnamedTransitions(
+                                         2, kCount, [](int) { return 0; }, [](int) { return 1; }),
+                                     "many.ha");
+  ASSERT_EQ(a.num_transitions(), kCount);
+  EXPECT_EQ(a.transitions()[0].name, "q0_to_q1");
+  for (int i = 1; i < kCount; ++i) {
+    ASSERT_EQ(a.transitions()[i].name, "q0_to_q1_" + std::to_string(i + 1)) << i;
+  }
+}
+
+// 10^5 unnamed transitions, each between its own pair of 317 modes, keep their plain names
+// (naming them used to scan every earlier transition: quadratic, about 16 s for 10^5).
+TEST(LargeInputs, HundredThousandUnnamedTransitionsOverDistinctModePairs) {
+  constexpr int kCount = 100000, kModes = 317;  // 317^2 > kCount
+  const System s = ParseModel(
+      UnnamedTransitions(
+          kModes, kCount, [](int i) { return i / kModes; }, [](int i) { return i % kModes; }),
+      "many.ha");
+  ASSERT_EQ(s.components().size(), 1u);
+  const Automaton& a = s.components()[0].source;
+  ASSERT_EQ(a.num_transitions(), kCount);
+  for (int i = 0; i < kCount; ++i) {
+    ASSERT_EQ(a.transitions()[i].name,
+              "q" + std::to_string(i / kModes) + "_to_q" + std::to_string(i % kModes))
+        << i;
+  }
+}
+
+// A variable, flow, reset and initial value apiece for 20000 variables: each is checked for
+// repetition against a set, not against every earlier one.
+TEST(LargeInputs, TwentyThousandVariablesWithFlowsResetsAndInitialValues) {
+  constexpr int kCount = 20000;
+  std::string vars, flows, resets, values;
+  for (int i = 0; i < kCount; ++i) {
+    const std::string x = "x" + std::to_string(i);
+    vars += (i == 0 ? "" : ", ") + x;
+    flows += " " + x + "' = 1;";
+    resets += (i == 0 ? "" : ", ") + x + " := 0";
+    values += " " + x + " = 0;";
+  }
+  const Automaton a = ParseAutomaton("automaton wide {\n  var " + vars + ";\n  mode m {" + flows +
+                                         " }\n  transition m -> m { reset " + resets +
+                                         "; }\n  init m {" + values + " }\n}\n",
+                                     "wide.ha");
+  ASSERT_EQ(a.variables().size(), static_cast<size_t>(kCount));
+  EXPECT_EQ(a.modes()[0].flows.size(), static_cast<size_t>(kCount));
+  EXPECT_EQ(a.transitions()[0].resets.size(), static_cast<size_t>(kCount));
+  EXPECT_EQ(a.initial_states()[0].values.size(), static_cast<size_t>(kCount));
+  // A repetition is still found, at the repeated name.
+  const ParseError e = ParseFailure("automaton w {\n  var " + vars + ";\n  mode m {" + flows +
+                                    " x7' = 2; }\n  init m {" + values + " }\n}\n");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.message(), "second flow for 'x7' in mode 'm'");
+}
+
 TEST(Parser, ScenarioSignals) {
   const System s = ParseModel(R"(
 automaton sc {

@@ -433,7 +433,7 @@ TEST(System, SetInitialValueByQualifiedOrSharedName) {
   const Automaton contact = Parse(kContact);
   // Reads the shared g without giving it a flow; g is its slot 0.
   const Automaton watch =
-      Parse("automaton watch { var g; mode w { inv g <= 300; } init w { g = 5; } }");
+      Parse("automaton watch { var g; mode w { inv g <= 300; } init w { g = 0; } }");
   System s("hand");
   s.AddComponent("B", contact);  // before the share: B.g is its own
   s.Share("g");
@@ -644,8 +644,99 @@ automaton b {
   s.Share("x");
   s.Share("go");
   s.AddComponent("A", a);
-  s.AddComponent("B", b);
-  EXPECT_EQ(InvalidArgument([&] { s.Product(); }), "synchronised transitions reset 'x' twice");
+  // Refused when the second writer joins, so that no engine picks one of the writes.
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("B", b); }),
+            "transition 'm_to_n' of instance 'B' and 'm_to_n' of instance 'A' synchronise on 'go' "
+            "and both reset 'x': only one of them may write it");
+  EXPECT_EQ(s.components().size(), 1u);
+}
+
+// The index of the earlier component a ConflictError names, or -1 if `f` throws none.
+template <typename F>
+int ConflictWith(F&& f) {
+  try {
+    f();
+  } catch (const ConflictError& e) {
+    return e.other_component();
+  }
+  return -1;
+}
+
+TEST(System, ASharedVariableStartedAtTwoValuesIsRefused) {
+  const Automaton a =
+      Parse("automaton a { var x, k; mode m { x' = 1; } init m { x = 0; k = 0; } }");
+  const Automaton b =
+      Parse("automaton b { var y, k; mode p { y' = 1; } init p { y = 0; k = 5; } }");
+  const Automaton same = Parse("automaton c { var k; mode q { } init q { k = 0; } }");
+  System s("s");
+  s.Share("k");
+  s.AddComponent("A", a);
+  s.AddComponent("C", same);  // agrees: accepted
+  EXPECT_EQ(InvalidArgument([&] { s.AddComponent("B", b); }),
+            "shared variable 'k' starts at 5 in instance 'B' but at 0 in instance 'A': give every "
+            "instance one start");
+  EXPECT_EQ(ConflictWith([&] { s.AddComponent("B", b); }), 0);
+}
+
+TEST(System, ABoundInputWithOtherBoundsIsRefused) {
+  const Automaton host =
+      Parse("automaton host { input v in [0, 10]; var z; mode h { z' = v; } init h { z = 0; } }");
+  const Automaton proc =
+      Parse("automaton proc { input u in [0, 1]; var x; mode a { x' = u; } init a { x = 0; } }");
+  System s("s");
+  s.AddComponent("H", host);
+  EXPECT_EQ(InvalidArgument([&] {
+              s.AddComponent("B", proc, {{"u", "H.v"}});
+            }),
+            "shared input 'H.v' is in [0, 1] in instance 'B' but in [0, 10] in instance 'H': "
+            "declare the same bounds");
+}
+
+TEST(System, ADiscreteVariableSetByTheModesOfTwoInstancesIsRefused) {
+  const Automaton a = Parse(
+      "automaton a { discrete c; var x; mode m (c = 0) { x' = 1; } mode n (c = 1) { } "
+      "transition m -> n { guard x >= 1; } init m { x = 0; } }");
+  const Automaton b =
+      Parse("automaton b { discrete c; var y; mode p (c = 5) { } init p { y = 0; } }");
+  System s("s");
+  s.Share("c");
+  s.AddComponent("A", a);
+  EXPECT_EQ(ConflictWith([&] { s.AddComponent("B", b); }), 0);
+  System t("t");  // in either order
+  t.Share("c");
+  t.AddComponent("B", b);
+  EXPECT_EQ(InvalidArgument([&] { t.AddComponent("A", a); }),
+            "shared discrete variable 'c' is given values by the modes of both instance 'A' and "
+            "instance 'B': one instance must own it");
+}
+
+TEST(System, ResolvedParameterIsAFunctionOfTheUncertainOnes) {
+  const Automaton a = Parse(
+      "automaton a { param p = 1 in [0, 2]; param k = 3; param q = 2 * p + k; param r = k * k; "
+      "var x; mode m { x' = q; } init m { x = 0; } }");
+  const System s = System::Of(a);
+  const int p = *s.symbols().Find("p"), q = *s.symbols().Find("q"), r = *s.symbols().Find("r");
+  EXPECT_EQ(s.ResolvedParameter(p), Expression::Symbol("p", p));
+  const Expression resolved = s.ResolvedParameter(q);
+  EXPECT_EQ(resolved.Slots(), std::vector<int>{p});
+  for (double value : {0.0, 0.5, 2.0}) {  // 2p + 3, by evaluation at p
+    std::vector<double> env(static_cast<std::size_t>(s.symbols().size()), 0.0);
+    env[static_cast<std::size_t>(p)] = value;
+    EXPECT_DOUBLE_EQ(resolved.Evaluate(env), 2 * value + 3);
+  }
+  EXPECT_EQ(s.ResolvedParameter(r), Expression::Constant(9));
+  EXPECT_THROW(s.ResolvedParameter(*s.symbols().Find("x")), std::invalid_argument);
+}
+
+TEST(System, AlphabetIsTheLabelsOfAComponentsTransitions) {
+  const Automaton a = Parse(R"(
+automaton a { var x; mode m { x' = 1; } mode n { }
+  transition m -> n { guard x >= 1; label go; } transition n -> m { label back; } init m { x = 0; } })");
+  System s("s");
+  s.Share("go");
+  s.AddComponent("A", a);
+  EXPECT_EQ(s.Alphabet(0), (std::set<std::string>{"A.back", "go"}));
+  EXPECT_THROW(s.Alphabet(1), std::out_of_range);
 }
 
 TEST(Product, InitialStatesAreTheCartesianProduct) {

@@ -8,8 +8,11 @@ import csv
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -189,3 +192,90 @@ def test_diagnose_bad_data_names_the_row(tmp_path):
     with pytest.raises(hybrid.DataError) as e:
         hybrid.diagnose(bad)
     assert str(e.value).startswith(str(bad) + ":")
+
+
+# A model whose simulation is long: a fast oscillator (period 2 pi / 1000), recorded every time
+# unit, so that CVODE takes about 10^4 steps per unit (about 25 s to t = 1000).
+OSCILLATOR = """automaton osc {
+  var x;
+  var v;
+  mode m {
+    x' = v;
+    v' = -1000000 * x;
+  }
+  init m { x = 1; v = 0; }
+}
+"""
+
+# Long calls: each runs for tens of seconds when not interrupted (nav4's exact reachability about
+# a minute, docs/benchmarks_lha.md).
+LONG_CALLS = {
+    "check": ("nav4", "model.check(method='reach')"),
+    "simulate": ("oscillator", "model.simulate(until=1000.0, sample=1.0)"),
+}
+
+
+@pytest.mark.parametrize("call", sorted(LONG_CALLS))
+def test_ctrl_c_stops_a_long_call_at_once(tmp_path, call):
+    # SIGINT a second into the call: KeyboardInterrupt within seconds (not when the call would
+    # have returned), and no process left computing (the process group is empty).
+    which, expression = LONG_CALLS[call]
+    if which == "oscillator":
+        path = tmp_path / "osc.ha"
+        path.write_text(OSCILLATOR)
+    else:
+        path = os.path.join(SOURCE, "spec", "benchmarks", "nav4.ha")
+    script = (
+        "import sys, time, hybrid\n"
+        "model = hybrid.load(sys.argv[1])\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    " + expression + "\n"
+        "    print('returned', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n")
+    process = subprocess.Popen([sys.executable, "-c", script, str(path)], stdout=subprocess.PIPE,
+                               text=True, start_new_session=True)
+    try:
+        assert process.stdout.readline() == "started\n"
+        time.sleep(1.0)
+        process.send_signal(signal.SIGINT)
+        sent = time.monotonic()
+        out, _ = process.communicate(timeout=120)
+        elapsed = time.monotonic() - sent
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert out == "interrupted\n"
+    assert elapsed < 5.0, f"KeyboardInterrupt {elapsed:.1f} s after SIGINT"
+    time.sleep(0.2)
+    with pytest.raises(ProcessLookupError):  # nothing of the call still runs
+        os.killpg(process.pid, 0)
+
+
+def test_long_calls_raise_the_same_errors_and_work_off_the_main_thread(tmp_path):
+    # Errors of a call made in another process are the same Python exceptions, and a call from
+    # another thread (which signals never interrupt) gives the same answer.
+    bad = tmp_path / "bad.ha"
+    bad.write_text("automaton a {\n  mode m { x' = 1; }\n}\n")
+    data = os.path.join(SOURCE, "data", "finger_demo.csv")
+    with pytest.raises(hybrid.ModelError) as e:
+        hybrid.diagnose(data, model=bad)
+    assert str(e.value).startswith(str(bad) + ":2:")
+    path = tmp_path / "tank.ha"
+    path.write_text(TANK)
+    model = hybrid.load(path)
+    with pytest.raises(ValueError, match="no_such_property"):
+        model.check(properties=["no_such_property"])
+    results = {}
+    worker = threading.Thread(target=lambda: results.update(
+        check=model.check(), run=model.simulate(until=4.0, sample=0.5)))
+    worker.start()
+    worker.join()
+    verdicts = [(p["name"], p["verdict"]) for p in model.check()["properties"]]
+    assert [(p["name"], p["verdict"]) for p in results["check"]["properties"]] == verdicts
+    here = model.simulate(until=4.0, sample=0.5)
+    assert np.array_equal(results["run"]["time"], here["time"])
+    assert np.array_equal(results["run"]["states"]["h"], here["states"]["h"])
+    assert results["run"]["modes"] == here["modes"] and results["run"]["events"] == here["events"]

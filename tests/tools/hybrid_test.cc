@@ -2,8 +2,14 @@
 // 2 usage error, 3 output error), FILE:LINE:COL: diagnostics for every malformed model, the
 // JSON of `hybrid info`, and the files `hybrid dot -o` writes.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/inotify.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -449,6 +455,142 @@ TEST(HybridCli, DotOutputNamingTheModelIsRefused) {
   EXPECT_EQ(ReadAll(model), text);
 }
 
+// Every file reading the model reads is an input no output may name, however spelled: a file it
+// imports (directly or not) for dot, simulate, diagnose, synthesize and hand; the command refuses
+// before any work, naming the option, the file and its importer, and leaves the file as it was.
+TEST(HybridCli, OutputsNamingAFileTheModelImportsAreRefused) {
+  TempDir dir;
+  const std::string lib_text =
+      "automaton lib {\n  var x;\n  mode m { x' = 1; }\n  init m { x = 0; }\n}\n";
+  const fs::path lib = dir.Write("lib.ha", lib_text);
+  const fs::path main =
+      dir.Write("main.ha", "import \"lib.ha\";\nsystem main { instance A = lib; }\n");
+  fs::create_symlink(lib, dir.path() / "link.ha");
+  fs::create_directory(dir.path() / "x");
+  const std::string importer = "(imported by MODEL '" + main.string() + "')";
+  struct Case {
+    std::string args;
+    std::string option;
+    std::string output;
+  };
+  const std::string m = Quote(main);
+  for (const Case& c : std::vector<Case>{
+           {"dot " + m + " -o", "-o", lib.string()},
+           {"dot " + m + " -o", "-o", dir.File("./lib.ha")},
+           {"dot " + m + " -o", "-o", dir.File("x/../lib.ha")},
+           {"dot " + m + " -o", "-o", dir.File("link.ha")},
+           {"simulate " + m + " --until 1 -o", "--out", lib.string()},
+           {"simulate " + m + " --until 1 --plot", "--plot", dir.File("link.ha")},
+           {"simulate " + m + " --until 1 --events", "--events", dir.File("./lib.ha")},
+       }) {
+    const Result r = RunHybrid(c.args + " " + Quote(c.output));
+    EXPECT_EQ(r.exit_code, 2) << c.args << " " << c.output << "\n" << r.err;
+    EXPECT_EQ(r.err, "hybrid: " + c.option + " '" + c.output + "' names the input '" +
+                         lib.string() + "' " + importer +
+                         "; an output may not overwrite an input\n");
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(ReadAll(lib), lib_text);
+  }
+  // --model of diagnose and synthesize: refused before the model is read (it is no finger).
+  const std::string model = " --model " + m + " ";
+  const std::string data = Quote((kSourceDir / "data" / "finger_demo.csv").string());
+  for (const std::string& args : {"diagnose " + data + model + "--out-model " + Quote(lib),
+                                  "synthesize" + model + "-o " + Quote(dir.File("link.ha"))}) {
+    const Result r = RunHybrid(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("names the input '" + lib.string() + "' (imported by --model"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(ReadAll(lib), lib_text);
+  }
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"lib.ha", "link.ha", "main.ha", "x"}));
+}
+
+// `hand --simulate` reads the hand model and the finger it imports: --draw may name neither.
+TEST(HybridCli, HandDrawingOverTheImportedFingerIsRefused) {
+  TempDir dir;
+  const fs::path hand = dir.Write("hand.ha", ReadAll(kSourceDir / "spec" / "hand.ha"));
+  const fs::path finger = dir.Write("finger.ha", ReadAll(kFinger));
+  const Result r = RunHybrid("hand --simulate --model " + Quote(hand) + " --draw " + Quote(finger));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err, "hybrid: --draw '" + finger.string() + "' names the input '" + finger.string() +
+                       "' (imported by --model '" + hand.string() +
+                       "'); an output may not overwrite an input\n");
+  EXPECT_EQ(ReadAll(finger), ReadAll(kFinger));
+}
+
+// Runs `hybrid ARGS...` (standard streams to /dev/null) and returns its process id.
+pid_t SpawnHybrid(const std::vector<std::string>& args) {
+  std::vector<std::string> words = {HYBRID_BINARY};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  for (int fd : {0, 1, 2}) {
+    posix_spawn_file_actions_addopen(&actions, fd, "/dev/null", fd == 0 ? O_RDONLY : O_WRONLY, 0);
+  }
+  pid_t pid = -1;
+  const int error = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return error == 0 ? pid : -1;
+}
+
+// Waits (at most `seconds`) for a file whose name starts with `prefix` to be created in the
+// directory `inotify` watches; whether one was.
+bool AwaitCreated(int inotify, const std::string& prefix, int seconds) {
+  alignas(inotify_event) char buffer[4096];
+  pollfd p{inotify, POLLIN, 0};
+  while (::poll(&p, 1, seconds * 1000) > 0) {
+    const ssize_t n = ::read(inotify, buffer, sizeof buffer);
+    for (ssize_t at = 0; n > 0 && at < n;) {
+      const auto* e = reinterpret_cast<const inotify_event*>(buffer + at);
+      if (e->len > 0 && std::string(e->name).starts_with(prefix)) return true;
+      at += static_cast<ssize_t>(sizeof(inotify_event) + e->len);
+    }
+  }
+  return false;
+}
+
+// SIGTERM while the outputs are being written (a trajectory of tens of megabytes): the program
+// ends by the signal, no temporary file is left, and the target is either not created or
+// complete. Retried when the writing ends before the signal arrives.
+TEST(HybridCli, SigtermWhileWritingLeavesNoTemporaryFile) {
+  TempDir dir;
+  const std::string out = dir.File("t.csv");
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const int inotify = ::inotify_init1(IN_CLOEXEC);
+    ASSERT_GE(inotify, 0);
+    ASSERT_GE(::inotify_add_watch(inotify, dir.path().c_str(), IN_CREATE), 0);
+    const pid_t pid =
+        SpawnHybrid({"simulate", (kSourceDir / "spec" / "thermostat.ha").string(), "--until",
+                     "40000", "--sample", "0.1", "-o", out, "--plot", dir.File("t.svg")});
+    ASSERT_GT(pid, 0);
+    const bool created = AwaitCreated(inotify, ".t.csv.tmp-", 120);
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ::close(inotify);
+    ASSERT_TRUE(created) << "no temporary file was written";
+    if (!WIFSIGNALED(status)) {  // done before the signal came: again
+      fs::remove(out);
+      fs::remove(dir.File("t.svg"));
+      continue;
+    }
+    EXPECT_EQ(WTERMSIG(status), SIGTERM);
+    for (const std::string& name : dir.Files()) {
+      EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "left behind: " << name;
+    }
+    if (fs::exists(out)) {  // stopped while renaming: complete
+      const std::string text = ReadAll(out);
+      EXPECT_NE(text.find("\n40000,end,"), std::string::npos) << text.substr(text.size() - 200);
+    }
+    return;
+  }
+  GTEST_SKIP() << "every run finished writing before SIGTERM arrived";
+}
+
 TEST(HybridCli, FullStdoutExitsThree) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   const Result dot = RunHybrid("dot " + Quote(kFinger), "/dev/full");
@@ -495,6 +637,25 @@ TEST(HybridCli, ImportWritesAModelThatChecksLikeTheSpaceExFile) {
     const nlohmann::json j = nlohmann::json::parse(check.out);
     EXPECT_EQ(Field(Field(Field(j, "properties"), 0), "verdict"), "proved") << model;
   }
+}
+
+// The configuration read beside a SpaceEx model is an input of every command reading the model.
+TEST(HybridCli, OutputsNamingTheSpaceExConfigurationAreRefused) {
+  TempDir dir;
+  const fs::path xml = dir.Write("m.xml", ReadAll(kFischerXml));
+  const std::string cfg_text = ReadAll(kSourceDir / "spec" / "spaceex" / "fischer_2.cfg");
+  const fs::path cfg = dir.Write("m.cfg", cfg_text);
+  for (const std::string& args :
+       {"simulate " + Quote(xml) + " --until 1 -o ", "dot " + Quote(xml) + " -o "}) {
+    const Result r = RunHybrid(args + Quote(cfg));
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err, "hybrid: " + std::string(args[0] == 's' ? "--out" : "-o") + " '" +
+                         cfg.string() + "' names the input '" + cfg.string() +
+                         "' (the SpaceEx configuration of MODEL '" + xml.string() +
+                         "'); an output may not overwrite an input\n");
+    EXPECT_EQ(ReadAll(cfg), cfg_text);
+  }
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"m.cfg", "m.xml"}));
 }
 
 TEST(HybridCli, ImportRefusesToOverwriteItsInputsAndReportsBadFiles) {
