@@ -613,23 +613,26 @@ z3::expr SmtEncoding::Power(const Expression& base, const Expression& ex,
   return Fresh();
 }
 
+z3::expr SmtEncoding::InBand(const z3::expr& r, const ResidualBand& band) {
+  z3::expr out = r.ctx().bool_val(true);
+  if (band.lower) {
+    const z3::expr lo = Num(r.ctx(), *band.lower);
+    out = out && (band.lower_strict ? r > lo : r >= lo);
+  }
+  if (band.upper) {
+    const z3::expr hi = Num(r.ctx(), *band.upper);
+    out = out && (band.upper_strict ? r < hi : r <= hi);
+  }
+  return out;
+}
+
 z3::expr SmtEncoding::Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
                               double margin, Boundary boundary) {
   // The band of residuals that satisfy c (automaton/constraint.h: the one definition of a
   // comparison within tolerance, which the simulator and the replay evaluate numerically).
-  const ResidualBand band =
-      margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary) : LenientBand(c.relation, margin);
-  const z3::expr r = Translate(c.lhs, env) - Translate(c.rhs, env);
-  z3::expr out = ctx_.bool_val(true);
-  if (band.lower) {
-    const z3::expr lo = Num(ctx_, *band.lower);
-    out = out && (band.lower_strict ? r > lo : r >= lo);
-  }
-  if (band.upper) {
-    const z3::expr hi = Num(ctx_, *band.upper);
-    out = out && (band.upper_strict ? r < hi : r <= hi);
-  }
-  return out;
+  const ResidualBand band = margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary)
+                                          : LenientBand(c.relation, margin);
+  return InBand(Translate(c.lhs, env) - Translate(c.rhs, env), band);
 }
 
 z3::expr SmtEncoding::Conjunction(const Constraint& c,
@@ -1024,45 +1027,23 @@ z3::expr SmtEncoding::GuardMeets(const std::vector<GuardAtom>& atoms, const z3::
 }
 
 z3::expr SmtEncoding::AndHoldsAtStart(const z3::expr& fixed, const GuardAtom& at) {
-  const z3::expr& r = at.alpha;
-  switch (at.rel) {
-    case Relation::kLess:
-      return fixed && r < 0;
-    case Relation::kLessEqual:
-      return fixed && r <= 0;
-    case Relation::kGreater:
-      return fixed && r > 0;
-    case Relation::kGreaterEqual:
-      return fixed && r >= 0;
-    case Relation::kEqual:
-      return fixed && r == 0;
-  }
-  return fixed;
+  return fixed && InBand(at.alpha, ResidualBand::Of(at.rel, 0.0));
 }
 
 void SmtEncoding::AddSigmaBound(const GuardAtom& at, std::vector<std::pair<z3::expr, bool>>& lower,
                                 std::vector<std::pair<z3::expr, bool>>& upper) {
-  // alpha + beta sigma REL 0  <=>  sigma REL' -alpha / beta.
-  // Exact rational arithmetic: -alpha / beta with beta a numeral.
-  const z3::expr bound = -at.alpha / at.beta_q;
-  const bool up = at.beta > 0;  // `<=` gives an upper bound when beta > 0
-  switch (at.rel) {
-    case Relation::kLess:
-      (up ? upper : lower).emplace_back(bound, true);
-      break;
-    case Relation::kLessEqual:
-      (up ? upper : lower).emplace_back(bound, false);
-      break;
-    case Relation::kGreater:
-      (up ? lower : upper).emplace_back(bound, true);
-      break;
-    case Relation::kGreaterEqual:
-      (up ? lower : upper).emplace_back(bound, false);
-      break;
-    case Relation::kEqual:
-      lower.emplace_back(bound, false);
-      upper.emplace_back(bound, false);
-      break;
+  // alpha + beta sigma in the comparison's band  <=>  sigma between (end - alpha) / beta for
+  // each end of the band (ResidualBand, exact), the ends swapping when beta < 0. Exact rational
+  // arithmetic: beta is a numeral.
+  const ResidualBand band = ResidualBand::Of(at.rel, 0.0);
+  const bool up = at.beta > 0;
+  if (band.upper) {
+    const z3::expr bound = (Num(at.alpha.ctx(), *band.upper) - at.alpha) / at.beta_q;
+    (up ? upper : lower).emplace_back(bound, band.upper_strict);
+  }
+  if (band.lower) {
+    const z3::expr bound = (Num(at.alpha.ctx(), *band.lower) - at.alpha) / at.beta_q;
+    (up ? lower : upper).emplace_back(bound, band.lower_strict);
   }
 }
 

@@ -211,6 +211,8 @@ class SmtEncoding {
   // for a negative one), else an unconstrained auxiliary. `translate` translates `base`.
   z3::expr Power(const Expression& base, const Expression& ex,
                  const std::function<z3::expr(const Expression&)>& translate);
+  // r lies in `band` (its ends as z3 comparisons; an absent end is no constraint).
+  static z3::expr InBand(const z3::expr& r, const ResidualBand& band);
   // c within the signed margin (ResidualBand: LenientBand for a margin, ResidualBand::Of with
   // `boundary` for 0), encoded over the translated residual.
   z3::expr Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,

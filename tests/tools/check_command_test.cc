@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -517,6 +518,122 @@ TEST(CheckCommand, BadOptionsExitTwo) {
   EXPECT_NE(none.err.find("none"), std::string::npos) << none.err;
   // Method names are exact.
   EXPECT_EQ(RunHybrid("check " + finger + " --method Prove").exit_code, 2);
+}
+
+// The verdicts of `hybrid check MODEL --method METHOD --json`, by property name (the exit code is
+// the verdicts', not checked here).
+std::map<std::string, std::string> Verdicts(const std::string& model, const std::string& method) {
+  const Result r = RunHybrid("check " + Quote(model) + " --method " + method + " --json");
+  std::map<std::string, std::string> out;
+  try {
+    const json report = json::parse(r.out);
+    for (const json& p : Field(report, "properties")) {
+      out[Field(p, "name").get<std::string>()] = Field(p, "verdict").get<std::string>();
+    }
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << model << " --method " << method << ": " << e.what() << "\n" << r.err;
+  }
+  return out;
+}
+
+// Models of the issue "One meaning of a model for every engine", each of which some engine used
+// to get wrong: the verdict every method that decides gives, and no method contradicts it.
+struct OneMeaningCase {
+  std::string what;
+  std::string text;
+  std::map<std::string, std::string> expected;  // property -> the right definite verdict
+};
+
+std::vector<OneMeaningCase> OneMeaningCases() {
+  return {
+      {"an urgent synchronised transition waits for its partner (B's guard holds at t = 6.93)",
+       R"(automaton compA { var x; mode a { x' = 1; } mode b { x' = 0; }
+  transition go: a -> b { guard x >= 1; label sync; } init a { x = 0; } }
+automaton compB { var y; mode p { y' = 0.1 * y; } mode q { y' = 0; }
+  transition go: p -> q { guard y >= 2; label sync; } init p { y = 1; } }
+system s { share sync; instance A = compA; instance B = compB;
+  property x_small: always A.x <= 1.5; property x_big: reach A.x >= 3; })",
+       {{"x_small", "violated"}, {"x_big", "reachable"}}},
+      {"the same with the label joined by a bind",
+       R"(automaton compA { var x; mode a { x' = 1; } mode b { x' = 0; }
+  transition go: a -> b { guard x >= 1; label tick; } init a { x = 0; } }
+automaton compB { var y; mode p { y' = 0.1 * y; } mode q { y' = 0; }
+  transition go: p -> q { guard y >= 2; label pass; } init p { y = 1; } }
+system s { instance G = compB; instance A = compA { tick = G.pass; }
+  property x_small: always A.x <= 1.5; property x_big: reach A.x >= 3; })",
+       {{"x_small", "violated"}, {"x_big", "reachable"}}},
+      {"a parameter derived from an uncertain one covers its range",
+       R"(automaton a { param p = 1 in [0, 2]; param q = 2 * p; var x;
+  mode m { x' = 1; inv x <= q; } mode n { x' = 0; }
+  transition go: m -> n { guard x >= q; } init m { x = 0; }
+  property small: always x <= 2.5; property big: reach x >= 3; })",
+       {{"small", "violated"}, {"big", "reachable"}}},
+      {"a strict invariant's boundary belongs to its mode",
+       R"(automaton a { var x; mode m { x' = 1; inv x < 1; } mode n { x' = 0; }
+  transition go: m -> n { guard x >= 1; lazy; } init m { x = 0; }
+  property never_n: never in n; property reach_n: reach in n; })",
+       {{"never_n", "violated"}, {"reach_n", "reachable"}}},
+      {"a counterexample from the second init of a composed system",
+       R"(automaton cA { var x; mode m { x' = 1; } mode n { x' = -1; }
+  init m { x = 0; } init n { x = 10; } }
+automaton cB { var y; mode p { y' = 1; } init p { y = 0; } }
+system s { share x; instance A = cA; instance B = cB;
+  property p: always x <= 5 or B.y >= 100; })",
+       {{"p", "violated"}}},
+  };
+}
+
+bool Definite(const std::string& verdict) { return verdict != "unknown"; }
+
+TEST(CheckCommand, EveryMethodGivesTheIssueModelsOneMeaning) {
+  TempDir dir;
+  for (const OneMeaningCase& c : OneMeaningCases()) {
+    const std::string path = dir.Write("m.ha", c.text).string();
+    for (const std::string method : {"auto", "reach", "prove", "sample"}) {
+      const auto verdicts = Verdicts(path, method);
+      for (const auto& [property, right] : c.expected) {
+        const auto it = verdicts.find(property);
+        ASSERT_NE(it, verdicts.end()) << c.what << ": " << method << " has no " << property;
+        // A definite verdict must be the right one; `auto` must decide.
+        if (Definite(it->second) || method == "auto") {
+          EXPECT_EQ(it->second, right) << c.what << ": --method " << method << ", " << property;
+        }
+      }
+    }
+  }
+}
+
+TEST(CheckCommand, ATraceNamesTheInitItStartsFrom) {
+  TempDir dir;
+  const std::string path = dir.Write("m.ha", OneMeaningCases().back().text).string();
+  const json report = RunHybridJson("check " + Quote(path) + " --method prove", 6);
+  const json& trace = Field(report, "properties", 0, "trace");
+  EXPECT_EQ(Field(trace, "initial_states", 0, "component"), "A");
+  EXPECT_EQ(Field(trace, "initial_states", 0, "init"), 1);  // the second declaration
+  EXPECT_EQ(Field(trace, "initial_states", 0, "mode"), "A.n");
+  EXPECT_EQ(Field(trace, "start", "values", "x"), 10.0);
+  EXPECT_EQ(Field(trace, "start", "mode"), "A.n|B.p");
+  const Result text = RunHybrid("check " + Quote(path) + " --method prove");
+  EXPECT_NE(text.out.find("start in A.n|B.p: x = 10; B.y = 0; (init 2 of 2 of A)"),
+            std::string::npos)
+      << text.out;
+}
+
+TEST(CheckCommand, ConflictingSharedDeclarationsAreRefusedAtLoad) {
+  TempDir dir;
+  const std::string path = dir.Write("k.ha", R"(automaton compA { var x; var k; mode a { x' = 1; k' = 0; } init a { x = 0; k = 0; } }
+automaton compB { var y; var k; mode p { y' = 1; } init p { y = 0; k = 5; } }
+system s { share k; instance A = compA; instance B = compB;
+  property k0: always k <= 1; property k5: reach k >= 4; })")
+                                 .string();
+  for (const std::string command : {"check", "simulate", "info"}) {
+    const Result r = RunHybrid(command + " " + Quote(path));
+    EXPECT_EQ(r.exit_code, 1) << command;
+    EXPECT_EQ(r.out, "") << command;
+    EXPECT_NE(r.err.find("shared variable 'k' starts at 5 in instance 'B' but at 0 in instance 'A'"),
+              std::string::npos)
+        << command << ": " << r.err;
+  }
 }
 
 TEST(CheckCommand, InvalidModelsExitOneWithFileLineColumn) {
