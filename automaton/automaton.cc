@@ -268,6 +268,11 @@ TransitionId Automaton::AddTransition(Transition t) {
   return TransitionId(num_transitions() - 1);
 }
 
+void Automaton::DeclareLabel(std::string label) {
+  if (label.empty()) throw std::invalid_argument("Automaton::DeclareLabel: empty label");
+  declared_labels_.insert(std::move(label));
+}
+
 void Automaton::SetGuard(TransitionId id, Constraint guard) {
   if (!id.is_valid() || id.value() >= num_transitions()) {
     Fail("guard for a transition that automaton '" + name_ + "' does not have");

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -94,6 +95,14 @@ class Automaton {
   ModeId AddMode(Mode mode);
   /// Source and target must exist; resets must assign continuous variables; the name must be new.
   TransitionId AddTransition(Transition transition);
+  /// Adds `label` to the automaton's alphabet without a transition: a label it synchronises on
+  /// but never takes, so that, composed, it blocks the transitions of other components on that
+  /// label (SpaceEx's reading of a declared, unused label). Labels of transitions are in the
+  /// alphabet anyway; declaring one of them again, or twice, changes nothing. Throws
+  /// std::invalid_argument ("Automaton::DeclareLabel: ...") for an empty label.
+  void DeclareLabel(std::string label);
+  /// The labels declared with DeclareLabel, sorted, without those of transitions added later.
+  const std::set<std::string>& declared_labels() const { return declared_labels_; }
   /// Replaces the guard of transition `id` (a model transformation, e.g. contact guards computed
   /// from geometry). Throws std::invalid_argument ("Automaton::SetGuard: ...") for an unknown
   /// transition or a guard reading undeclared slots.
@@ -164,6 +173,7 @@ class Automaton {
   std::vector<std::optional<Range>> parameter_ranges_;
   std::vector<Mode> modes_;
   std::vector<Transition> transitions_;
+  std::set<std::string> declared_labels_;
   // Name -> index look-ups (derived from modes_ and transitions_).
   std::unordered_map<std::string, int> mode_index_;
   std::unordered_map<std::string, int> transition_index_;

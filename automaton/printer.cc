@@ -149,6 +149,15 @@ std::string PrintAutomaton(const Automaton& a) {
     if (t.urgency == Urgency::kLazy) out << "    lazy;\n";
     out << "  }\n";
   }
+  if (!a.declared_labels().empty()) {  // labels in the alphabet that no transition takes
+    out << "  label ";
+    bool first = true;
+    for (const std::string& label : a.declared_labels()) {
+      out << (first ? "" : ", ") << label;
+      first = false;
+    }
+    out << ";\n";
+  }
   for (const InitialState& init : a.initial_states()) {
     out << "\n  init " << a.mode(init.mode).name << " {";
     for (const InitialValue& v : init.values) {

@@ -132,6 +132,7 @@ Automaton Renamed(const Automaton& a, const std::function<std::string(const std:
     if (!copy.label.empty()) copy.label = rename_label(copy.label);
     out.AddTransition(std::move(copy));
   }
+  for (const std::string& label : a.declared_labels()) out.DeclareLabel(rename_label(label));
   for (const InitialState& init : a.initial_states()) {
     InitialState copy = init;
     for (InitialValue& v : copy.values) v.range = range(v.range);
@@ -170,7 +171,8 @@ void CheckBinds(const Automaton& a, const std::map<std::string, std::string>& bi
   for (const auto& bind : binds) {
     const std::string& from = bind.first;
     const std::string& to = bind.second;
-    const bool label = std::any_of(a.transitions().begin(), a.transitions().end(),
+    const bool label = a.declared_labels().count(from) ||
+                       std::any_of(a.transitions().begin(), a.transitions().end(),
                                    [&from](const Transition& t) { return t.label == from; });
     if (!a.symbols().Find(from) && !label) {
       Fail("bind '" + from + "': '" + a.name() + "' has no variable, input, parameter or label '" +
@@ -513,11 +515,11 @@ std::vector<std::vector<Participant>> Combinations(
   return combos;
 }
 
-// The labels each component's transitions use (for synchronisation).
+// The labels each component synchronises on: its declared labels and its transitions'.
 std::vector<std::set<std::string>> Alphabets(std::span<const Component> components) {
   std::vector<std::set<std::string>> alphabet;
   for (const Component& c : components) {
-    std::set<std::string>& labels = alphabet.emplace_back();
+    std::set<std::string>& labels = alphabet.emplace_back(c.automaton.declared_labels());
     for (const Transition& t : c.automaton.transitions()) {
       if (!t.label.empty()) labels.insert(t.label);
     }

@@ -120,7 +120,8 @@ class System {
   /// uncertain parameters reads derived ones through this. Throws std::invalid_argument if
   /// `slot` is not a parameter.
   Expression ResolvedParameter(int slot) const;
-  /// The labels component `c` synchronises on (System names): those of its transitions. A
+  /// The labels component `c` synchronises on (System names): those of its transitions and
+  /// those its automaton declares (Automaton::DeclareLabel). A
   /// transition labelled `l` fires only together with an `l`-transition of every other
   /// component whose alphabet has `l`. Throws std::out_of_range for a bad index.
   std::set<std::string> Alphabet(int c) const;

@@ -154,7 +154,7 @@ class ComponentCompiler {
         fixed_(fixed) {}
 
   // The compiled component: its modes, then its transitions (each the outgoing one of its source
-  // mode, its label in the alphabet), then its first initial state (interval values at their
+  // mode), then its first initial state (interval values at their
   // midpoint). Throws std::invalid_argument if the component has no initial state.
   CompiledComponent Compile() const {
     const Automaton& a = comp_.automaton;
@@ -168,7 +168,6 @@ class ComponentCompiler {
     for (int t = 0; t < a.num_transitions(); ++t) {
       const Transition& tr = a.transitions()[t];
       CompiledTransition ct = CompileTransition(tr);
-      if (!tr.label.empty()) cc.alphabet.insert(tr.label);
       cc.modes[ct.source].outgoing.push_back(t);
       cc.transitions.push_back(std::move(ct));
     }
@@ -354,9 +353,11 @@ Simulator::Simulator(const System& system) : c_(std::make_unique<Compiled>()) {
     }
   }
   c_->fixed.assign(symbols.size(), 0);
-  for (const Component& comp : system.components()) {
+  for (int c = 0; c < static_cast<int>(system.components().size()); ++c) {
+    const Component& comp = system.components()[static_cast<std::size_t>(c)];
     c_->components.push_back(
         ComponentCompiler(symbols, comp, x_index, c_->parameter_env, c_->fixed).Compile());
+    c_->components.back().alphabet = system.Alphabet(c);  // the IR's synchronisation alphabet
   }
   FixDefiningParameters(system, c_->fixed);
 }

@@ -1089,9 +1089,8 @@ std::vector<int> InteractionGroups(const System& system) {
       const auto [it, added] = slot_user.emplace(g, c);
       if (!added) parent[find(c)] = find(it->second);
     }
-    for (const Transition& t : components[c].automaton.transitions()) {
-      if (t.label.empty()) continue;
-      const auto [it, added] = label_user.emplace(t.label, c);
+    for (const std::string& label : system.Alphabet(c)) {
+      const auto [it, added] = label_user.emplace(label, c);
       if (!added) parent[find(c)] = find(it->second);
     }
   }

@@ -893,5 +893,22 @@ TEST(System, SetScenarioValidatesLikeAnAutomaton) {
   EXPECT_EQ(s.Product().scenario(), s.scenario());
 }
 
+TEST(System, ADeclaredLabelIsInTheAlphabetAndBlocksPartners) {
+  const Automaton mover = Parse(
+      "automaton mover { var x; mode a { x' = 1; } mode b { } "
+      "transition a -> b { guard x >= 1; label go; } init a { x = 0; } }");
+  Automaton blocker = Parse("automaton blocker { var y; mode p { } init p { y = 0; } }");
+  blocker.DeclareLabel("go");
+  blocker.DeclareLabel("go");  // twice: once
+  EXPECT_EQ(blocker.declared_labels(), (std::set<std::string>{"go"}));
+  EXPECT_THROW(blocker.DeclareLabel(""), std::invalid_argument);
+  System s("s");
+  s.AddComponent("A", mover, {{"go", "B.go"}});  // bound to B's declared label
+  s.AddComponent("B", blocker);
+  EXPECT_EQ(s.Alphabet(1), (std::set<std::string>{"B.go"}));
+  EXPECT_TRUE(s.StepsFrom(std::vector<int>{0, 0}).empty());  // B never takes go
+  EXPECT_EQ(s.Product().num_transitions(), 0);
+}
+
 }  // namespace
 }  // namespace hybrid

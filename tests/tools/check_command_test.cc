@@ -621,17 +621,21 @@ TEST(CheckCommand, ATraceNamesTheInitItStartsFrom) {
 
 TEST(CheckCommand, ConflictingSharedDeclarationsAreRefusedAtLoad) {
   TempDir dir;
-  const std::string path = dir.Write("k.ha", R"(automaton compA { var x; var k; mode a { x' = 1; k' = 0; } init a { x = 0; k = 0; } }
+  const std::string path =
+      dir.Write(
+             "k.ha",
+             R"(automaton compA { var x; var k; mode a { x' = 1; k' = 0; } init a { x = 0; k = 0; } }
 automaton compB { var y; var k; mode p { y' = 1; } init p { y = 0; k = 5; } }
 system s { share k; instance A = compA; instance B = compB;
   property k0: always k <= 1; property k5: reach k >= 4; })")
-                                 .string();
+          .string();
   for (const std::string command : {"check", "simulate", "info"}) {
     const Result r = RunHybrid(command + " " + Quote(path));
     EXPECT_EQ(r.exit_code, 1) << command;
     EXPECT_EQ(r.out, "") << command;
-    EXPECT_NE(r.err.find("shared variable 'k' starts at 5 in instance 'B' but at 0 in instance 'A'"),
-              std::string::npos)
+    EXPECT_NE(
+        r.err.find("shared variable 'k' starts at 5 in instance 'B' but at 0 in instance 'A'"),
+        std::string::npos)
         << command << ": " << r.err;
   }
 }

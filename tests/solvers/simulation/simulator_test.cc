@@ -320,6 +320,32 @@ double BallZenoTime(const BallParameters& p) {
   return std::sqrt(2.0 * p.h0 / p.g) * (1.0 + p.e) / (1.0 - p.e);
 }
 
+// A label that a component declares but never takes is in its alphabet: another component's
+// transition on it is blocked (SpaceEx's reading), and the run completes without that jump.
+TEST(SimulatorTest, ADeclaredUnusedLabelBlocksItsPartners) {
+  const System mover = ParseModel(
+      "automaton mover { var x; mode a { x' = 1; } mode b { x' = 0; } "
+      "transition a -> b { guard x >= 1; label go; } init a { x = 0; } }",
+      "mover.ha");
+  Automaton blocker =
+      ParseModel("automaton blocker { var y; mode p { y' = 0; } init p { y = 0; } }", "blocker.ha")
+          .components()[0]
+          .source;
+  for (const bool declared : {false, true}) {
+    Automaton b = blocker;
+    if (declared) b.DeclareLabel("go");
+    System s("s");
+    s.Share("go");
+    s.AddComponent("A", mover.components()[0].source);
+    s.AddComponent("B", b);
+    const Simulator sim(s);
+    const SimulationResult r = sim.Run(Until(3));
+    EXPECT_EQ(r.status, SimulationStatus::kCompleted);
+    EXPECT_EQ(r.events.size(), declared ? 0u : 1u) << (declared ? "declared" : "not declared");
+    EXPECT_NEAR(r.samples.back().x[0], declared ? 3.0 : 1.0, 1e-9);
+  }
+}
+
 TEST(SimulatorTest, BallBounceTimesMatchTheAnalyticSolution) {
   const BallParameters p;
   const Model m(BallText(p));
