@@ -177,7 +177,10 @@ rc::Gen<std::vector<T>> Each(std::vector<rc::Gen<T>> gens) {
 
 // A drawn run: input schedules (one per input), parameter levels, initial-value levels. The
 // tuple order is the shrinking priority.
-using Draw = std::tuple<std::vector<std::vector<Piece>>, std::vector<Level>, std::vector<Level>>;
+// Input schedules, parameter levels, initial-value levels (one per box), and the init
+// declaration of each component that has several (Space::inits order).
+using Draw = std::tuple<std::vector<std::vector<Piece>>, std::vector<Level>, std::vector<Level>,
+                        std::vector<int>>;
 
 // ---------------------------------------------------------------------------------------------
 // What can vary in a system.
@@ -196,13 +199,21 @@ struct InputSpace {
 struct InitialBox {
   std::string name;  // System name of the variable
   int component = 0;
+  int init = 0;  // the component's init declaration that gives it this box
   Range range;
+};
+
+// A component with several init declarations: a run starts from one of them.
+struct InitChoice {
+  int component = 0;
+  int count = 0;
 };
 
 struct Space {
   std::vector<InputSpace> inputs;
   std::vector<UncertainParameter> parameters;
   std::vector<InitialBox> boxes;
+  std::vector<InitChoice> inits;
   // Whether anything varies at nominal parameter values (otherwise one run is enough).
   bool random = false;
 };
@@ -230,19 +241,19 @@ Space SpaceOf(const System& system) {
   for (std::size_t c = 0; c < system.components().size(); ++c) {
     const Component& component = system.components()[c];
     const Automaton& a = component.automaton;
-    if (a.initial_states().empty()) continue;  // the simulator rejects it (checked by the caller)
+    const int count = static_cast<int>(a.initial_states().size());
+    if (count > 1) {
+      space.inits.push_back({static_cast<int>(c), count});
+      space.random = true;
+    }
     const std::vector<double> env = a.ParameterEnvironment();
-    for (const InitialValue& v : a.initial_states().front().values) {
-      if (v.is_point) continue;
-      const std::string& name = system.symbols()[component.global_slot[v.slot]].name;
-      if (std::any_of(space.boxes.begin(), space.boxes.end(),
-                      [&](const InitialBox& b) { return b.name == name; })) {
-        continue;  // a shared variable: one value
+    for (int init = 0; init < count; ++init) {
+      for (const InitialValue& v : a.initial_states()[static_cast<std::size_t>(init)].values) {
+        if (v.is_point) continue;
+        const std::string& name = system.symbols()[component.global_slot[v.slot]].name;
+        space.boxes.push_back({name, static_cast<int>(c), init, v.range});
+        if (v.range.lo.Evaluate(env) < v.range.hi.Evaluate(env)) space.random = true;
       }
-      const double lo = v.range.lo.Evaluate(env);
-      const double hi = v.range.hi.Evaluate(env);
-      space.boxes.push_back({name, static_cast<int>(c), v.range});
-      if (lo < hi) space.random = true;
     }
   }
   return space;
@@ -262,15 +273,17 @@ rc::Gen<Draw> DrawGen(const Space& space, int max_segments) {
   for (std::size_t i = 0; i < space.boxes.size(); ++i) {
     initials.push_back(LevelGen(kInitialWeights, 0.5));
   }
+  std::vector<rc::Gen<int>> inits;  // shrinking towards the first declaration
+  for (const InitChoice& choice : space.inits) inits.push_back(rc::gen::inRange(0, choice.count));
   return rc::gen::tuple(Each(std::move(schedules)), Each(std::move(parameters)),
-                        Each(std::move(initials)));
+                        Each(std::move(initials)), Each(std::move(inits)));
 }
 
 // The trace of `draw` (inputs, parameters, initial values; not yet replayed). Input bounds and
 // initial boxes are evaluated under the drawn parameter values. Throws std::invalid_argument when
 // the model rejects the parameter values.
 Trace ToTrace(const System& system, const Space& space, const Draw& draw, double horizon) {
-  const auto& [schedules, parameter_levels, initial_levels] = draw;
+  const auto& [schedules, parameter_levels, initial_levels, init_choices] = draw;
   Trace trace;
   for (std::size_t i = 0; i < space.parameters.size(); ++i) {
     const UncertainParameter& p = space.parameters[i];
@@ -284,8 +297,19 @@ Trace ToTrace(const System& system, const Space& space, const Draw& draw, double
   }
   const System& model = drawn ? *drawn : system;
 
+  // The init declaration of each component (its first unless drawn), named in the trace.
+  std::vector<int> chosen(system.components().size(), 0);
+  for (std::size_t i = 0; i < space.inits.size(); ++i) {
+    chosen[static_cast<std::size_t>(space.inits[i].component)] = init_choices[i];
+    trace.initial_states.emplace_back(space.inits[i].component, init_choices[i]);
+  }
   for (std::size_t i = 0; i < space.boxes.size(); ++i) {
     const InitialBox& box = space.boxes[i];
+    if (box.init != chosen[static_cast<std::size_t>(box.component)]) continue;
+    if (std::any_of(trace.initial_values.begin(), trace.initial_values.end(),
+                    [&](const auto& v) { return v.first == box.name; })) {
+      continue;  // a shared variable: one value (the first component's)
+    }
     const std::vector<double> env =
         model.components()[box.component].automaton.ParameterEnvironment();
     const double lo = box.range.lo.Evaluate(env);
@@ -297,12 +321,6 @@ Trace ToTrace(const System& system, const Space& space, const Draw& draw, double
                                       Resolve(initial_levels[i], 0.5 * (lo + hi), lo, hi));
   }
 
-  // Runs start from each component's first init declaration (named where there are several).
-  for (std::size_t c = 0; c < system.components().size(); ++c) {
-    if (system.components()[c].automaton.initial_states().size() > 1) {
-      trace.initial_states.emplace_back(static_cast<int>(c), 0);
-    }
-  }
   trace.inputs.until = horizon;
   for (std::size_t i = 0; i < space.inputs.size(); ++i) {
     const auto [lo, hi] = model.InputBounds(space.inputs[i].slot);
@@ -331,8 +349,8 @@ Trace ToTrace(const System& system, const Space& space, const Draw& draw, double
 
 // Whether two traces apply the same run (before replay).
 bool SameRun(const Trace& a, const Trace& b) {
-  return a.parameters == b.parameters && a.initial_values == b.initial_values &&
-         a.inputs == b.inputs;
+  return a.parameters == b.parameters && a.initial_states == b.initial_states &&
+         a.initial_values == b.initial_values && a.inputs == b.inputs;
 }
 
 int InputPieces(const Trace& trace) {

@@ -25,10 +25,12 @@ namespace hybrid {
 ///   pieces grows with the run index over the first half of the runs, as in rapidcheck).
 /// - for every uncertain parameter (UncertainParameters: `param p = v in [lo, hi];`), a value in
 ///   [lo, hi]: the nominal value, lo, hi (25% each) or uniform.
-/// - for every continuous variable whose initial value in the first initial state of its
+/// - for every component with several `init` declarations, one of them (uniformly; shrinking
+///   towards the first), named in the trace (Trace::initial_states);
+/// - for every continuous variable whose initial value in the chosen initial state of its
 ///   component is an interval (`x in [lo, hi]`), a value in it: the midpoint (what a simulation
-///   starts from, 20%), lo, hi (30% each) or uniform. The bounds are evaluated under the drawn
-///   parameter values.
+///   starts from, 20%), lo, hi (30% each) or uniform (a shared variable: the first component's).
+///   The bounds are evaluated under the drawn parameter values.
 /// Each drawn trace is replayed (ReplayTrace). A run that ends early (invariant violated, Zeno,
 /// solver failure) still counts: its recorded states are real states of the model. A draw that
 /// the model rejects (ReplayTrace or the simulator throws std::invalid_argument, e.g. an initial

@@ -227,6 +227,27 @@ TEST(PropertySamplerTest, UncertainParameterIsReportedAndShrunkToItsNominalValue
   ExpectReplays(system, property, result);
 }
 
+TEST(PropertySamplerTest, EveryInitDeclarationIsSampledAndNamed) {
+  // Only a start from the second declaration, high in its box, reaches x > 9.6.
+  const System system = Parse(R"(
+automaton two_starts {
+  var x;
+  mode up { x' = 0; }
+  mode down { x' = -1; }
+  init up { x = 0; }
+  init down { x in [9, 10]; }
+  scenario { until 1; }
+  property low: always x <= 9.6;
+})");
+  const Property& property = Named(system, "low");
+  const CheckResult result = PropertySampler().Check(system, property);
+  ASSERT_EQ(result.verdict, Verdict::kViolated) << result.reason;
+  EXPECT_EQ(result.trace->initial_states, (std::vector<std::pair<int, int>>{{0, 1}}));
+  ASSERT_EQ(result.trace->initial_values.size(), 1u);
+  EXPECT_DOUBLE_EQ(result.trace->initial_values[0].second, 10.0);  // shrunk to the end
+  ExpectReplays(system, property, result);
+}
+
 TEST(PropertySamplerTest, IntervalInitialValueIsSampledAndShrunkToTheEndThatMatters) {
   const System system = Parse(kIntervalInitModel);
   const Property& property = Named(system, "below");
