@@ -100,9 +100,12 @@ class SolverBudget {
 /// (ConfirmTrace); one that does not replay is reported `unknown`.
 ///
 /// Systems: a property that reads one component whose continuous variables no other component
-/// shares is checked on that component alone (composition only removes runs of a component:
-/// other components cannot write its variables, and synchronisation only restricts its jumps);
-/// otherwise on System::Product (up to `max_product_modes`), else `unknown`.
+/// shares, and none of whose urgent transitions synchronises with another component, is checked
+/// on that component alone (composition then only removes runs of the component: other
+/// components cannot write its variables, and synchronisation only removes lazy jumps; an urgent
+/// jump that waits for a partner would let time pass where the component alone cannot);
+/// otherwise on the product of its interaction group (components joined by shared variables or
+/// labels, System::Product, up to `max_product_modes`), else `unknown`.
 class PropertyProver {
  public:
   struct Options {
