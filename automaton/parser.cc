@@ -238,7 +238,9 @@ struct horizon : seq<kw_within, must<signed_number_tok>> {};
 struct property_decl : seq<kw_property, must<ident_tok>, must<colon>, must<property_kind>,
                            must<predicate>, opt<horizon>, must<semi>> {};
 
-struct automaton_item : sor<var_decl, discrete_decl, param_decl, input_decl, mode_decl,
+// `label l1, l2;`: labels in the automaton's alphabet that it may have no transition for.
+struct label_decl : seq<kw_label, must<name_tok>, star<comma, must<name_tok>>, must<semi>> {};
+struct automaton_item : sor<var_decl, discrete_decl, param_decl, input_decl, label_decl, mode_decl,
                             transition_decl, init_decl, scenario_decl, property_decl> {};
 struct automaton_body_end : rbrace {};
 struct automaton_decl : seq<kw_automaton, must<ident_tok>, must<lbrace>, star<automaton_item>,
@@ -412,11 +414,11 @@ using selector = parse_tree::selector<
     parse_tree::remove_content::on<
         call, negation, comparison, conjunction, paren_predicate, in_mode, negated, non_predicate,
         param_range, unit, range, var_item, var_decl, discrete_decl, param_decl, input_decl,
-        discrete_value, flow, invariant, mode_decl, transition_name, source_mode, target_mode,
-        guard, assignment, reset, label, urgency, transition_decl, init_point, init_range,
-        init_item, init_decl, point, signal_shape, until_item, signal_item, scenario_decl, horizon,
-        property_decl, automaton_decl, instance_alias, bind_item, binds, instance_item, share_item,
-        system_decl, import_decl, power, arguments>,
+        label_decl, discrete_value, flow, invariant, mode_decl, transition_name, source_mode,
+        target_mode, guard, assignment, reset, label, urgency, transition_decl, init_point,
+        init_range, init_item, init_decl, point, signal_shape, until_item, signal_item,
+        scenario_decl, horizon, property_decl, automaton_decl, instance_alias, bind_item, binds,
+        instance_item, share_item, system_decl, import_decl, power, arguments>,
     parse_tree::fold_one::on<sum, product, and_predicate, predicate>>;
 
 template <class Rule>
@@ -864,39 +866,15 @@ class Builder {
     const std::string name = Text(name_node);
     if (automata_.count(name)) Fail(name_node, "duplicate automaton '" + name + "'");
     Automaton a(name);
-    const Scope scope = ConstantScope(a.symbols());
     bool has_scenario = false;
     std::vector<const Node*> inits;  // the mode name of each init declaration, in order
     const std::set<std::string> rated = RatedVariables(n);
     TransitionNames transition_names;
     for (size_t i = 1; i < n.children.size(); ++i) {
       const Node& item = *n.children[i];
-      if (item.is_type<var_decl>()) {
-        for (const auto& v : item.children) {
-          const Node& id = *v->children.at(0);
-          std::optional<Range> domain;
-          if (const Node* r = Child(*v, range{})) domain = RangeOf(*r, scope);
-          At(id, [&] { return a.AddVariable(Text(id), Unit(*v), domain); });
-          if (rated.count(Text(id))) DeclareRateInput(a, Text(id));
-        }
-      } else if (item.is_type<discrete_decl>()) {
-        for (const auto& id : item.children) {
-          At(*id, [&] { return a.AddDiscreteVariable(Text(*id)); });
-        }
-      } else if (item.is_type<param_decl>()) {
-        // Children: the name, the unit if any, the value, the range if any.
-        const Node& id = *item.children.at(0);
-        const size_t value_index = item.children.at(1)->is_type<unit>() ? 2 : 1;
-        const Expression value = Expr(*item.children.at(value_index), scope);
-        std::optional<Range> declared;
-        if (const Node* r = Child(item, param_range{})) {
-          declared = RangeOf(*r->children.at(0), scope);
-        }
-        At(id, [&] { return a.AddParameter(Text(id), value, Unit(item), declared); });
-      } else if (item.is_type<input_decl>()) {
-        const Node& id = *item.children.at(0);
-        const Range bounds = RangeOf(*Child(item, range{}), scope);
-        At(id, [&] { return a.AddInput(Text(id), bounds, Unit(item)); });
+      if (SymbolDecl(item, rated, &a)) continue;
+      if (item.is_type<label_decl>()) {
+        for (const auto& id : item.children) At(*id, [&] { a.DeclareLabel(Text(*id)); });
       } else if (item.is_type<mode_decl>()) {
         ModeDecl(item, &a);
       } else if (item.is_type<transition_decl>()) {
@@ -922,6 +900,41 @@ class Builder {
     automata_.emplace(name, std::move(a));
     local_automata_.push_back(name);
     local_positions_.push_back(Where(name_node));
+  }
+
+  // Declares the symbols of `item` in `a` if it is a var, discrete, param or input declaration
+  // (`rated`: the variables some mode gives a rectangular rate); returns whether it was.
+  bool SymbolDecl(const Node& item, const std::set<std::string>& rated, Automaton* a) {
+    using namespace grammar;  // NOLINT(google-build-using-namespace)
+    const Scope scope = ConstantScope(a->symbols());
+    if (item.is_type<var_decl>()) {
+      for (const auto& v : item.children) {
+        const Node& id = *v->children.at(0);
+        std::optional<Range> domain;
+        if (const Node* r = Child(*v, range{})) domain = RangeOf(*r, scope);
+        At(id, [&] { return a->AddVariable(Text(id), Unit(*v), domain); });
+        if (rated.count(Text(id))) DeclareRateInput(*a, Text(id));
+      }
+    } else if (item.is_type<discrete_decl>()) {
+      for (const auto& id : item.children) {
+        At(*id, [&] { return a->AddDiscreteVariable(Text(*id)); });
+      }
+    } else if (item.is_type<param_decl>()) {
+      // Children: the name, the unit if any, the value, the range if any.
+      const Node& id = *item.children.at(0);
+      const size_t value_index = item.children.at(1)->is_type<unit>() ? 2 : 1;
+      const Expression value = Expr(*item.children.at(value_index), scope);
+      std::optional<Range> declared;
+      if (const Node* r = Child(item, param_range{})) declared = RangeOf(*r->children.at(0), scope);
+      At(id, [&] { return a->AddParameter(Text(id), value, Unit(item), declared); });
+    } else if (item.is_type<input_decl>()) {
+      const Node& id = *item.children.at(0);
+      const Range bounds = RangeOf(*Child(item, range{}), scope);
+      At(id, [&] { return a->AddInput(Text(id), bounds, Unit(item)); });
+    } else {
+      return false;
+    }
+    return true;
   }
 
   // The scenario `n` of automaton `a`.

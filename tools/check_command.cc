@@ -417,8 +417,7 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   PropertyProver::Options prove;
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
-  found.results =
-      CheckProperties(args, prove, system, found.chosen, budget, progress, found.reach);
+  found.results = CheckProperties(args, prove, system, found.chosen, budget, progress, found.reach);
   if (args.modes) {
     stage = "modes";
     for (std::size_t c = 0; c < system.components().size(); ++c) {

@@ -18,7 +18,7 @@ struct CheckArgs {
   bool json = false;
   bool modes = false;      ///< also report which modes (discrete states) are reachable
   int depth = 10;          ///< prove: longest counterexample searched, in steps
-  double budget = 60.0;    ///< prove: the solver budget, in budget seconds
+  double budget = 60.0;    ///< prove and reach: each one's budget, in budget seconds
   int induction = 1;       ///< prove: largest k of k-induction
   int runs = 200;          ///< sample: random runs per property
   std::uint64_t seed = 1;  ///< sample: seed

@@ -116,7 +116,8 @@ struct Template {
   std::vector<std::optional<Located>> flow_formulas;
   std::vector<std::optional<Located>> guards;  // per transition
   std::vector<std::optional<Located>> assignments;
-  std::set<std::string> used;  // params read or written somewhere
+  std::set<std::string> used;  // params read or written somewhere, and non-local labels
+  std::set<std::string> transition_labels;  // labels some transition takes
 };
 
 // Where a parameter of an instance goes: a name of the system or a constant.
@@ -179,6 +180,7 @@ class Translator {
   void ModeLines(const Instance& inst, std::size_t l, Lines& out) const;
   void TransitionLines(const Instance& inst, std::size_t i, Lines& out) const;
   void InitLines(const Instance& inst, Lines& out) const;
+  void DeclaredLabelLines(const Instance& inst, Lines& out) const;
   std::string ParamLine(const Instance& inst, const SxParam& p) const;
   const Bound& InitialBound(const Instance& inst, const std::string& param) const;
   std::string Forbidden(const Located& f, const SxFormula& node) const;
@@ -359,9 +361,15 @@ Template& Translator::TemplateOf(const SxComponent& c, const Origin& used_at) {
              "'" + label + "' is not a label of component '" + c.id + "'");
       }
       t.used.insert(label);
+      t.transition_labels.insert(label);
     }
     t.guards.push_back(std::move(guard));
     t.assignments.push_back(std::move(assignment));
+  }
+  // A non-local label is in the component's alphabet whether or not a transition takes it: in a
+  // network it blocks the other components' transitions on it (AutomatonBody declares it).
+  for (const SxParam& p : c.params) {
+    if (p.type == SxParam::Type::kLabel && !p.local) t.used.insert(p.name);
   }
   return t;
 }
@@ -714,6 +722,20 @@ void Translator::InitLines(const Instance& inst, Lines& out) const {
   }
 }
 
+// `label l1, l2;` for the non-local labels of an instance that none of its transitions takes:
+// SpaceEx puts them in its alphabet, so that the others' transitions on them are blocked.
+void Translator::DeclaredLabelLines(const Instance& inst, Lines& out) const {
+  const Template& t = *inst.tmpl;
+  std::string labels;
+  std::optional<Origin> at;
+  for (const SxParam& p : t.sx->params) {
+    if (p.type != SxParam::Type::kLabel || p.local || t.transition_labels.count(p.name)) continue;
+    labels += (labels.empty() ? "" : ", ") + *t.names.Find(p.name);
+    if (!at) at = At(p.offset);
+  }
+  if (!labels.empty()) out.Add("  label " + labels + ";", *at);
+}
+
 Lines Translator::AutomatonBody(const Instance& inst) const {
   const Template& t = *inst.tmpl;
   Lines out;
@@ -727,6 +749,7 @@ Lines Translator::AutomatonBody(const Instance& inst) const {
   if (!vars.empty()) out.Add("  var " + vars + ";", At(t.sx->offset));
   for (std::size_t l = 0; l < t.sx->locations.size(); ++l) ModeLines(inst, l, out);
   for (std::size_t i = 0; i < t.sx->transitions.size(); ++i) TransitionLines(inst, i, out);
+  if (inst.bind) DeclaredLabelLines(inst, out);
   if (initially_at_) InitLines(inst, out);
   return out;
 }
@@ -935,19 +958,18 @@ Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg) {
   const std::optional<std::filesystem::path> cfg_path = cfg ? cfg : DefaultConfigFile(xml);
   const std::string xml_text = ReadModelText(xml);
-  const std::string cfg_text = cfg_path ? ReadModelText(*cfg_path) : std::string();
-  Translation translation =
-      TranslateSpaceEx(xml_text, xml.string(), cfg_text, cfg_path ? cfg_path->string() : "");
   if (!cfg_path) {
-    // Without a configuration the model has no initial states, which no model may lack: say
-    // which file was looked for (once the model itself has been read without error).
+    // Without a configuration the model has neither initial states nor values for its
+    // constants, which the translation would report in the model's terms: name the file looked
+    // for instead, once the XML itself has been read without error.
+    (void)SpaceExDocument(xml_text, xml.string());
     std::filesystem::path beside = xml;
     beside.replace_extension(".cfg");
     throw ParseError(beside.string(), 0, 0,
                      "missing: the SpaceEx model " + xml.string() +
                          " needs its configuration (initial states, forbidden set) in this file");
   }
-  return translation;
+  return TranslateSpaceEx(xml_text, xml.string(), ReadModelText(*cfg_path), cfg_path->string());
 }
 
 bool IsSpaceExFile(const std::filesystem::path& path) {

@@ -49,8 +49,8 @@ Translation TranslateSpaceEx(std::string_view xml, const std::string& xml_file,
 /// Reads `xml` and its configuration (`cfg`, or else the file next to `xml` with the extension
 /// `.cfg`) and translates them. Throws ParseError (line 0) for a file that cannot be read, as
 /// TranslateSpaceEx for errors in them, and, when `cfg` is not given and there is no `.cfg` next
-/// to `xml`, a ParseError naming the file looked for (line 0, after any error of `xml`): without
-/// a configuration the model has no initial states.
+/// to `xml`, a ParseError naming the file looked for (line 0; malformed XML is reported first):
+/// without a configuration the model has no initial states and its constants no values.
 Translation ImportSpaceExFile(const std::filesystem::path& xml,
                               const std::optional<std::filesystem::path>& cfg = std::nullopt);
 

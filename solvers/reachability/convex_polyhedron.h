@@ -110,9 +110,10 @@ class ConvexPolyhedron {
   /// (constraints and generators as far as computed, their coefficients' digits, saturation
   /// matrices): what operations on it read, so a measure of their cost that grows with the
   /// number of constraints and generators, the dimension and the coefficients' length. It
-  /// depends only on the operations that made this polyhedron (and the PPL and GMP builds), not
-  /// on the machine's load or speed: reachability's deterministic budget charges it. Cheap
-  /// (linear in the representation), and it neither minimises nor converts anything.
+  /// counts what is allocated (a copy, allocated to fit, may measure less than its original), so
+  /// it depends on the operations that made this polyhedron (and on the PPL, GMP and C++ library
+  /// builds), never on the machine's load or speed: reachability's deterministic budget charges
+  /// it. Cheap (linear in the representation); it neither minimises nor converts anything.
   std::size_t RepresentationBytes() const;
 
  private:

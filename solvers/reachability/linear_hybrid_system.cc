@@ -5,7 +5,7 @@
 
 #include "automaton/interval.h"
 #include "automaton/rectangular_rate.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 
 namespace hybrid {
 namespace {

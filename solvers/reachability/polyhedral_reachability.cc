@@ -12,8 +12,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <cstdio>
-#include <cstdlib>
 
 #include "solvers/reachability/linear_hybrid_system.h"
 
@@ -39,30 +37,23 @@ class Meter {
   // Charges `count` operations that read a polyhedron of the size of `p` (and one of `q`'s).
   void Op(const ConvexPolyhedron& p, std::uint64_t count = 1) {
     used_ += count * (kReachUnitsPerOperation + p.RepresentationBytes() / kReachBytesPerUnit);
-    const double b = p.RepresentationBytes() / 64.0;
-    cal_ops += count; cal_bytes += count * (p.RepresentationBytes() / kReachBytesPerUnit);
-    cal_sq += count * b * std::sqrt(b);
   }
   void Op(const ConvexPolyhedron& p, const ConvexPolyhedron& q) {
     used_ += kReachUnitsPerOperation +
              (p.RepresentationBytes() + q.RepresentationBytes()) / kReachBytesPerUnit;
-    cal_ops += 1; cal_bytes += (p.RepresentationBytes() + q.RepresentationBytes()) / kReachBytesPerUnit;
-    const double b = p.RepresentationBytes() / 64.0, c = q.RepresentationBytes() / 64.0;
-    cal_sq += (b + c) * std::sqrt(b + c);
   }
-  double cal_sq = 0; std::uint64_t cal_locs = 0;
+
   // Charges `count` comparisons of bounding boxes.
-  void Boxes(std::uint64_t count) { used_ += count * kReachUnitsPerBoxComparison; cal_boxes += count; }
+  void Boxes(std::uint64_t count) { used_ += count * kReachUnitsPerBoxComparison; }
   // Charges the construction of a location.
-  void Location() { used_ += kReachUnitsPerLocation; cal_locs += 1; }
+  void Location() { used_ += kReachUnitsPerLocation; }
   // Charges the replay of a run along a path of `steps` symbolic states.
-  void Replay(std::size_t steps) { used_ += steps * kReachUnitsPerReplayedStep; cal_replay += steps; }
-  std::uint64_t cal_ops = 0, cal_bytes = 0, cal_boxes = 0, cal_replay = 0;
-  double cal_cpu() const { return ThreadCpuSeconds() - start_; }
+  void Replay(std::size_t steps) { used_ += steps * kReachUnitsPerReplayedStep; }
 
   // The next exploration's share: what is left split equally among the `parts` still to run.
   void ShareAmong(int parts) {
-    limit_ = used_ + (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
+    share_ = (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
+    limit_ = used_ + share_;
   }
   // Whether the current exploration has used its share.
   bool Exhausted() const { return used_ >= limit_; }
@@ -71,10 +62,12 @@ class Meter {
 
   std::uint64_t used() const { return used_; }
   std::uint64_t total() const { return total_; }
+  std::uint64_t share() const { return share_; }
   double cpu_seconds() const { return cpu_seconds_; }
 
  private:
   std::uint64_t total_;
+  std::uint64_t share_ = total_;
   std::uint64_t limit_;
   std::uint64_t used_ = 0;
   double cpu_seconds_;
@@ -422,7 +415,6 @@ class Explorer {
         r.reason = "a path of " + std::to_string(PathOf(n).size()) +
                    " symbolic states reaches it; the simulator replayed its run";
         g.decided = true;
-        if (std::getenv("HYBRID_REACH_CALIBRATE")) std::fprintf(stderr, "CALGOAL %s units %llu\n", g.property->name.c_str(), (unsigned long long)meter_.used());
         return;
       }
       g.why_no_trace = r.reason;
@@ -659,24 +651,26 @@ Trace Explorer::TraceOf(const PathRun& run, const std::vector<int>& path,
 // How an exploration that stopped early says why (in "reachability stopped ... before a
 // fixpoint").
 std::string Explorer::StopText(Stop stop) const {
+  std::ostringstream out;
   switch (stop) {
-    case Stop::kBudget: {
-      std::ostringstream out;
-      out << "by its deterministic budget (" << options_.budget << " budget seconds, "
-          << meter_.total() << " reach units)";
-      return out.str();
-    }
+    case Stop::kBudget:
+      out << "by its deterministic budget (";
+      if (meter_.share() < meter_.total()) {
+        out << "this exploration's share, " << meter_.share() << " of ";
+      }
+      out << meter_.total() << " reach units = " << options_.budget << " budget seconds)";
+      break;
     case Stop::kStateBound:
-      return "after " + std::to_string(options_.max_states) + " symbolic states (its state bound)";
+      out << "after " << options_.max_states << " symbolic states (its state bound)";
+      break;
     case Stop::kSafetyNet:
-      return "by the CPU-time safety net (" +
-             std::to_string(static_cast<long long>(meter_.cpu_seconds())) +
-             " s of CPU time), not by the deterministic budget: this verdict may differ on "
-             "another machine";
+      out << "by the CPU-time safety net (" << meter_.cpu_seconds()
+          << " s of CPU time), not by its deterministic budget,";
+      break;
     case Stop::kNone:
       break;
   }
-  return "";
+  return out.str();
 }
 
 // Writes each goal's verdict and reason.
@@ -685,8 +679,10 @@ void Explorer::Finish(Stop stop) {
   std::ostringstream size;
   size << nodes_.size() << " symbolic states in " << lhs_.num_locations() << " locations";
   // A goal met but left without a run sought met it after a bound was reached.
-  const std::string stopped =
-      "reachability stopped " + StopText(stop != Stop::kNone ? stop : Bound());
+  const Stop bound = stop != Stop::kNone ? stop : Bound();
+  const std::string stopped = "reachability stopped " + StopText(bound);
+  const std::string caveat =
+      bound == Stop::kSafetyNet ? ": this verdict may differ on another machine" : "";
   for (Goal& g : goals_) {
     if (g.decided) continue;
     CheckResult& r = *g.result;
@@ -694,7 +690,7 @@ void Explorer::Finish(Stop stop) {
     r.trace.reset();
     if (g.met && g.concretizations == 0) {
       r.reason = "the reachable set meets the property's states, but " + stopped +
-                 " before a run reaching them was sought (" + size.str() + ")";
+                 " before a run reaching them was sought (" + size.str() + ")" + caveat;
     } else if (g.met) {
       r.reason = "the reachable set meets the property's states, but no run found replays (" +
                  g.why_no_trace +
@@ -704,7 +700,7 @@ void Explorer::Finish(Stop stop) {
                       : std::string()) +
                  ")";
     } else if (!complete) {
-      r.reason = stopped + " before a fixpoint (" + size.str() + ")";
+      r.reason = stopped + " before a fixpoint (" + size.str() + ")" + caveat;
     } else {
       r.verdict =
           g.property->kind == Property::Kind::kReach ? Verdict::kUnreachable : Verdict::kProved;
@@ -756,10 +752,10 @@ std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
     results[i].method = "reach";
     by_horizon[properties[i].horizon].push_back(i);
   }
-  Meter meter(static_cast<std::uint64_t>(
-                  std::llround(options_.budget * static_cast<double>(kReachUnitsPerBudgetSecond))),
-              options_.cpu_seconds > 0 ? options_.cpu_seconds
-                                       : std::max(60.0, 10.0 * options_.budget));
+  Meter meter(
+      static_cast<std::uint64_t>(
+          std::llround(options_.budget * static_cast<double>(kReachUnitsPerBudgetSecond))),
+      options_.cpu_seconds > 0 ? options_.cpu_seconds : std::max(60.0, 10.0 * options_.budget));
   Usage used;
   int parts = static_cast<int>(by_horizon.size());
   for (const auto& [horizon, which] : by_horizon) {
@@ -778,12 +774,6 @@ std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
         results[i].reason = std::string("not a linear hybrid automaton: ") + e.what();
       }
     }
-  }
-  if (std::getenv("HYBRID_REACH_CALIBRATE")) {
-    std::fprintf(stderr, "CAL cpu %.3f ops %llu bytes %llu boxes %llu replay %llu sq %.0f locs %llu units %llu states %lld\n",
-                 meter.cal_cpu(), (unsigned long long)meter.cal_ops, (unsigned long long)meter.cal_bytes,
-                 (unsigned long long)meter.cal_boxes, (unsigned long long)meter.cal_replay, meter.cal_sq, (unsigned long long)meter.cal_locs,
-                 (unsigned long long)meter.used(), used.states);
   }
   used.units_total = meter.total();
   used.units_used = meter.used();

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "automaton/system.h"
-#include "solvers/verification/check_result.h"
+#include "solvers/checking/check_result.h"
 
 namespace hybrid {
 
@@ -24,11 +24,11 @@ namespace hybrid {
 /// - building a location (its invariant, rates and edges): kReachUnitsPerLocation;
 /// - replaying a run found (ConfirmTrace): kReachUnitsPerReplayedStep per symbolic state of its
 ///   path.
-inline constexpr std::uint64_t kReachUnitsPerBudgetSecond = 75'000'000;
+inline constexpr std::uint64_t kReachUnitsPerBudgetSecond = 100'000'000;
 inline constexpr std::uint64_t kReachUnitsPerOperation = 4;
 inline constexpr std::uint64_t kReachBytesPerUnit = 16;
-inline constexpr std::uint64_t kReachUnitsPerBoxComparison = 1;
-inline constexpr std::uint64_t kReachUnitsPerLocation = 16'000;
+inline constexpr std::uint64_t kReachUnitsPerBoxComparison = 2;
+inline constexpr std::uint64_t kReachUnitsPerLocation = 20'000;
 inline constexpr std::uint64_t kReachUnitsPerReplayedStep = 2'000;
 
 /// The `reach` method of `hybrid check`: exact polyhedral reachability for linear hybrid

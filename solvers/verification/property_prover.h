@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "automaton/system.h"
-#include "solvers/verification/check_result.h"
+#include "solvers/checking/check_result.h"
 
 namespace hybrid {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "solvers/simulation/simulator.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 
 namespace hybrid {
 namespace {

@@ -5,7 +5,7 @@
 
 #include "automaton/property.h"
 #include "automaton/system.h"
-#include "solvers/verification/check_result.h"
+#include "solvers/checking/check_result.h"
 
 namespace hybrid {
 
@@ -14,7 +14,7 @@ namespace hybrid {
 /// `never P`) or a witness of a reachability query (`reach P`), and shrinks the first one it finds
 /// to a minimal one. Sampling finds bugs; it never proves anything.
 ///
-/// A run is a Trace (solvers/verification/trace.h), drawn from:
+/// A run is a Trace (solvers/checking/trace.h), drawn from:
 /// - for every input of the system (bounds from System::InputBounds, under the drawn parameter
 ///   values), a step signal of 1 to
 ///   Options::max_segments pieces over the horizon. Each piece has a value, drawn from the

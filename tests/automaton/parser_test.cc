@@ -248,6 +248,19 @@ TEST(ParseErrors, BinaryGarbageIsReportedAtTheFirstControlByte) {
   EXPECT_EQ(e.message(), "control character 2 in model file (binary file?)");
 }
 
+// Messages quote the input; what they quote reaches a terminal escaped (automaton/quoted_text.h):
+// a vertical tab and a C1 CSI (U+009B, ESC [ to some terminals) in an import's file name.
+TEST(ParseErrors, ControlCharactersQuotedFromTheInputAreEscaped) {
+  const ParseError e = ParseFailure("import \"a\vb\xc2\x9b[2J.ha\";\n" + std::string(kSmallModel));
+  EXPECT_EQ(e.message(), "cannot import 'a\\x0bb\\u009b[2J.ha': no such file");
+  EXPECT_EQ(std::string(e.what()), "test.ha:1:1: " + e.message());
+  // The file name too, in what(); file() keeps it as given.
+  const ParseError named("m\x1b]0;t\a.ha", 2, 3, "line\nbreak");
+  EXPECT_EQ(std::string(named.what()), "m\\x1b]0;t\\x07.ha:2:3: line\\nbreak");
+  EXPECT_EQ(named.file(), "m\x1b]0;t\a.ha");
+  EXPECT_EQ(named.message(), "line\\nbreak");
+}
+
 TEST(ParseErrors, NonAsciiBytesOutsideCommentsAreSyntaxErrors) {
   const ParseError e = ParseFailure("automaton \xc3\xa9t\xc3\xa9 { }\n");
   EXPECT_EQ(e.line(), 1);
@@ -1127,6 +1140,40 @@ TEST(LargeInputs, TwentyThousandVariablesWithFlowsResetsAndInitialValues) {
                                     " x7' = 2; }\n  init m {" + values + " }\n}\n");
   EXPECT_EQ(e.line(), 3);
   EXPECT_EQ(e.message(), "second flow for 'x7' in mode 'm'");
+}
+
+// `label l1, l2;` puts labels in an automaton's alphabet without a transition; composed, such a
+// label blocks the other components' transitions on it. The printer writes it back.
+TEST(Parser, DeclaredLabelsJoinTheAlphabetAndBlockPartners) {
+  const System s = ParseModel(R"(
+automaton idle {
+  mode m { }
+  label go, stop;
+  label go;
+  init m { }
+}
+automaton mover {
+  mode a { }
+  mode b { }
+  transition a -> b { label go; }
+  init a { }
+}
+system both {
+  share go;
+  instance I = idle;
+  instance M = mover;
+}
+)",
+                              "test.ha");
+  const Automaton& idle = s.components()[0].source;
+  EXPECT_EQ(idle.declared_labels(), (std::set<std::string>{"go", "stop"}));
+  EXPECT_EQ(ParseAutomaton(PrintAutomaton(idle), "printed.ha"), idle);
+  EXPECT_EQ(s.Alphabet(0), (std::set<std::string>{"go", "I.stop"}));
+  const std::vector<int> start = {0, 0};
+  EXPECT_TRUE(s.StepsFrom(start).empty());
+  const ParseError e = ParseFailure("automaton a {\n  mode m { }\n  label ;\n  init m { }\n}\n");
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.column(), 9);
 }
 
 TEST(Parser, ScenarioSignals) {

@@ -461,6 +461,26 @@ TEST(ReadMeasuredDataErrors, RunLabelReusedAfterAnotherRun) {
                       "run 'a' (from line 2) reappears after run 'b'"));
 }
 
+// Messages quote cells, column names and run labels escaped (automaton/quoted_text.h): an ESC
+// sequence in a file reaches the terminal as text, not as a command (clear screen, colours).
+TEST(ReadMeasuredDataErrors, ControlCharactersInQuotedCellsAreEscaped) {
+  EXPECT_TRUE(FailsAt(WithRow("1,3,\x1b[2J,20,30"), 5, 3, "not a number: '\\x1b[2J'"));
+  EXPECT_TRUE(FailsAt("run,g,theta1,theta2,the\x1bta3\n", 1, 5, "unknown column 'the\\x1bta3'"));
+  EXPECT_TRUE(FailsAt(std::string(kHeader) + Rows("a\x1b[31m", 9) + Rows("b", 10), 2, 1,
+                      "run 'a\\x1b[31m' has 9 samples"));
+  EXPECT_TRUE(FailsAt(WithRow("1,3,1\x7f,20,30"), 5, 3, "not a number: '1\\x7f'"));
+  try {
+    Read(std::string(kHeader) + Rows("a\x1b[31m", 9));
+    ADD_FAILURE() << "no error";
+  } catch (const DataError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\x1b'), std::string::npos) << e.what();
+  }
+  // The source name too, in what(); source() keeps it as given.
+  const DataError e("d\x1b.csv", 1, 2, "m\n");
+  EXPECT_EQ(std::string(e.what()), "d\\x1b.csv:1:2: m\\n");
+  EXPECT_EQ(e.source(), "d\x1b.csv");
+}
+
 TEST(ReadMeasuredDataErrors, CellsAreCheckedFromLeftToRight) {
   EXPECT_TRUE(FailsAt(WithRow("1,300,abc,20,nan"), 5, 2, "column 'g'"));
   EXPECT_TRUE(FailsAt(WithRow("1,3,abc,20,nan"), 5, 3, "column 'theta1'"));

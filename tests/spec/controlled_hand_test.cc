@@ -17,7 +17,7 @@
 #include "automaton/parser.h"
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/robotiq_rig.h"
 

@@ -9,7 +9,7 @@
 #include "automaton/parser.h"
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"

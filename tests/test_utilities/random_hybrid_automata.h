@@ -1,18 +1,20 @@
 #pragma once
 
-// Random hybrid automata written as model-language TEXT, for the differential soundness test
-// (tests/solvers/verification/soundness_test.cc). The generator never touches the IR builders of
-// the code under test: it keeps its own small description of the automaton (flows, guards, resets,
-// properties as sums of products of names), prints that as a `.ha` text for the parser, and
-// evaluates the properties' predicates itself, so that a test can judge a simulated state without
-// the checker's code. Randomness comes from a caller-owned std::mt19937_64 only (no distribution
-// objects, whose output the C++ standard leaves to the library): one seed gives the same models
-// everywhere.
+// Random hybrid automata and composed systems written as model-language TEXT, for the differential
+// soundness test (tests/solvers/verification/soundness_test.cc: automata) and the engine agreement
+// test (tests/solvers/verification/engine_agreement_test.cc: systems of automata,
+// GenerateRandomSystem). The generator never touches the IR builders of the code under test: it
+// keeps its own small description of the automaton (flows, guards, resets, properties as sums of
+// products of names), prints that as a `.ha` text for the parser, and evaluates the properties'
+// predicates itself, so that a test can judge a simulated state without the checker's code.
+// Randomness comes from a caller-owned std::mt19937_64 only (no distribution objects, whose output
+// the C++ standard leaves to the library): one seed gives the same models everywhere.
 
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <random>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -38,7 +40,9 @@ struct RandomSum {
   std::vector<RandomTerm> terms;
 };
 
-enum class RandomRelation { kLess, kLessEqual, kGreater, kGreaterEqual };
+/// kEqual (`==`) is drawn only for discrete variables (integers), in properties: a continuous
+/// value never clearly equals a constant, so Holds reads it exactly when asked for a clear answer.
+enum class RandomRelation { kLess, kLessEqual, kGreater, kGreaterEqual, kEqual };
 
 /// `lhs REL rhs`.
 struct RandomComparison {
@@ -71,6 +75,9 @@ struct RandomParameter {
   std::string name;
   double nominal = 0.0;
   std::optional<std::pair<double, double>> range;  ///< uncertain: `param p = v in [lo, hi];`
+  /// A derived parameter `param q = 2 * p + 0.5;` over earlier parameters (no range); `nominal`
+  /// is then its value at the nominal values (EvaluateParameters gives it for others).
+  std::optional<RandomSum> definition = {};
 };
 
 /// A rectangular rate `x' in [lo, hi];` of one variable in one mode.
@@ -85,6 +92,8 @@ struct RandomMode {
   std::vector<std::pair<std::string, RandomSum>> flows;  ///< variable, right-hand side
   std::vector<RandomComparison> invariant;               ///< conjunction (empty: none)
   std::vector<RandomRate> rates;  ///< variables with a rectangular rate (no flow)
+  /// The value of every discrete variable in this mode: `mode m (c = 1, e = -1) { ... }`.
+  std::vector<std::pair<std::string, int>> discrete_values = {};
 };
 
 struct RandomTransition {
@@ -95,6 +104,7 @@ struct RandomTransition {
   std::vector<RandomComparison> guard;                    ///< conjunction (empty: true)
   std::vector<std::pair<std::string, RandomSum>> resets;  ///< variable := sum
   Urgency urgency = Urgency::kDefault;
+  std::string label = {};  ///< synchronisation label (empty: none)
 };
 
 struct RandomInit {
@@ -150,6 +160,9 @@ struct RandomHybridAutomaton {
   std::optional<RandomScenario> scenario;  ///< none from the generator
   /// Declaration order of variables (0), inputs (1) and parameters (2) as printed.
   std::vector<std::pair<int, int>> declaration_order;
+  /// Discrete variables (`discrete c, e;`, printed after the other declarations); every mode
+  /// gives each a value (RandomMode::discrete_values).
+  std::vector<std::string> discretes = {};
 
   /// The model-language text.
   std::string Text(const PrintOptions& options = {}) const;
@@ -186,6 +199,110 @@ double EvaluateSum(const RandomSum& sum, const std::map<std::string, double>& va
 /// clearly.
 bool Holds(const RandomPredicate& p, const std::map<std::string, double>& values,
            std::string_view mode, double tolerance);
+
+/// Parameter values of `a`: nominal values, except those named in `overrides` (which replace
+/// them), with derived parameters (RandomParameter::definition) evaluated in declaration order.
+std::map<std::string, double> EvaluateParameters(
+    const RandomHybridAutomaton& a, const std::map<std::string, double>& overrides = {});
+
+// ---- composed systems ----
+
+/// `instance NAME = AUTOMATON { local = SYSTEM_NAME; ... }` (NAME empty: `instance AUTOMATON;`,
+/// whose names are not qualified).
+struct RandomInstance {
+  std::string name;
+  int automaton = 0;  ///< index into RandomSystem::automata
+  /// Binds: a name of the automaton (symbol or transition label) and the system name it takes.
+  std::vector<std::pair<std::string, std::string>> binds;
+};
+
+/// The kind of a deliberate conflict between the declarations of two instances, which the IR
+/// refuses at load (System::AddComponent throws ConflictError, the parser reports it).
+enum class RandomConflict {
+  kNone,
+  kInitialValue,  ///< a shared or bound variable started at different values
+  kInputBounds,   ///< a shared or bound input with different bounds
+  kDiscrete,      ///< a shared or bound discrete variable given values by two instances
+  kResets,        ///< transitions synchronised by one label both reset one variable
+};
+
+/// "none", "initial value", "input bounds", "discrete values", "synchronised resets".
+std::string ConflictName(RandomConflict conflict);
+
+/// A random composed system in a form the test understands without the code under test: the
+/// automata as declared (their properties empty), shared names, instances with binds, and
+/// properties over system names (`A.x`, a shared `x`, `A.c`, `in A.m`).
+struct RandomSystem {
+  std::string name;
+  std::vector<RandomHybridAutomaton> automata;
+  std::vector<std::string> shared;  ///< `share a, b;`
+  std::vector<RandomInstance> instances;
+  std::vector<RandomProperty> properties;
+  std::optional<RandomScenario> scenario;  ///< over system input names; none from the generator
+  /// kNone for a system every engine must accept; otherwise the conflict it was given on purpose,
+  /// between instances `conflict_instances` (earlier, later), which the parser must refuse with
+  /// a message containing `conflict_message`.
+  RandomConflict conflict = RandomConflict::kNone;
+  std::pair<int, int> conflict_instances = {-1, -1};
+  std::string conflict_message;
+  /// How the conflicting names are connected: "share" or "bind" (empty without a conflict).
+  std::string conflict_via;
+
+  /// The model-language text: the automata, then the system. `automaton_options[k]`, if
+  /// given, prints automaton k (lazy choices, explicit rates; first_init must be 0 here or name
+  /// an init the text keeps).
+  std::string Text(const std::vector<PrintOptions>& automaton_options = {}) const;
+  /// The text of property `i` as declared.
+  std::string PropertyText(int i) const;
+  /// The system name of `local` (a symbol or label of instance `instance`'s automaton): its
+  /// bind target if bound, `local` if shared or the instance is unqualified, else `NAME.local`.
+  std::string SystemName(int instance, const std::string& local) const;
+  /// The name of mode `mode` of instance `instance` at system level (`A.m`, or `m`).
+  std::string ModeName(int instance, const std::string& mode) const;
+};
+
+/// How to draw a RandomSystem.
+struct RandomSystemOptions {
+  /// Chance (percent) that the system is given a conflict on purpose (RandomSystem::conflict);
+  /// a system with fewer than two instances of different automata gets none.
+  int conflict_percent = 0;
+};
+
+/// A random system: 1 to 3 instances (sometimes two of one automaton, sometimes one unqualified:
+/// `instance a;`) of random automata (GenerateRandomAutomaton, then decorated with discrete
+/// variables and their mode values, labels on transitions, and derived parameters
+/// `param q = 2 * p;` read by flows, guards, resets or properties). Between instances: shared
+/// (`share x;`) and bound (`instance B = b { x = A.y; }`) variables, inputs, labels, parameters
+/// and discrete variables. The declarations are made to agree where the IR requires it (one
+/// initial value per shared variable, one flow owner, equal input bounds and parameters, one
+/// value for a shared discrete variable, no variable reset by two synchronised transitions),
+/// unless a conflict is drawn (options). 2 to 5 properties (`always`, `never`, `reach`, some
+/// `within T`) over system names: comparisons of variables (also across instances), against
+/// parameters, of discrete variables (`A.c == 1`), `in A.m`, `not`, `and`, `or`. Every name is
+/// drawn from ShortNamePool().
+RandomSystem GenerateRandomSystem(std::mt19937_64& rng, const RandomSystemOptions& options = {});
+
+/// Values of every parameter of `s` by system name (EvaluateParameters per instance), with the
+/// uncertain ones named in `overrides` (system names) set.
+std::map<std::string, double> SystemParameterValues(
+    const RandomSystem& s, const std::map<std::string, double>& overrides = {});
+
+/// Adds the values of the discrete variables of `s` (system names) when instance k is in mode
+/// `modes[k]` (index into its automaton's modes) to `values`.
+void AddDiscreteValues(const RandomSystem& s, const std::vector<int>& modes,
+                       std::map<std::string, double>& values);
+
+/// The system names of the modes `modes` (one index per instance): what `in MODE` reads.
+std::set<std::string> ModeNames(const RandomSystem& s, const std::vector<int>& modes);
+
+/// Whether every instance's invariant (in mode `modes[k]`) holds at `values` (system names)
+/// within `tolerance` (relative, as in Holds).
+bool InsideInvariants(const RandomSystem& s, const std::vector<int>& modes,
+                      const std::map<std::string, double>& values, double tolerance);
+
+/// Holds for a system state: `in M` holds when M is one of `modes` (ModeNames).
+bool HoldsInModes(const RandomPredicate& p, const std::map<std::string, double>& values,
+                  const std::set<std::string>& modes, double tolerance);
 
 /// A uniform integer in [lo, hi] drawn from `rng` (same values on every platform).
 int UniformInt(std::mt19937_64& rng, int lo, int hi);

@@ -1,6 +1,6 @@
 #pragma once
 
-// Simulating a verifier's trace again, apart from ReplayTrace (solvers/verification/trace.h), for
+// Simulating a verifier's trace again, apart from ReplayTrace (solvers/checking/trace.h), for
 // tests that judge the states it reaches themselves (shared by the verification tests).
 
 #include <gtest/gtest.h>
@@ -11,8 +11,8 @@
 
 #include "automaton/system.h"
 #include "solvers/simulation/simulator.h"
-#include "solvers/verification/check_result.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/check_result.h"
+#include "solvers/checking/trace.h"
 
 namespace hybrid::testing {
 

@@ -86,5 +86,80 @@ TEST(SpaceExDocumentTest, BadDocumentsAreReportedWithLineAndColumn) {
             "m.xml:3:63: transition attribute 'priority' is not supported");
 }
 
+// `asap`, `local` and `controlled` are booleans written true/false or 1/0, in any case (SpaceEx
+// files in the wild use all of these); `asap="1"` and `local="TRUE"` used to be read as false.
+TEST(SpaceExDocumentTest, BooleanAttributesAreTrueFalseOneOrZeroInAnyCase) {
+  for (const char* yes : {"true", "TRUE", "True", "1"}) {
+    for (const char* no : {"false", "FALSE", "False", "0"}) {
+      const std::string xml =
+          std::string(kHead) + "<component id=\"c\">" +
+          "<param name=\"l\" type=\"label\" local=\"" + yes + "\" controlled=\"" + yes + "\"/>" +
+          "<param name=\"m\" type=\"label\" local=\"" + no + "\"/>" +
+          "<transition source=\"1\" target=\"1\" asap=\"" + yes + "\"/>" +
+          "<transition source=\"1\" target=\"1\" asap=\"" + no + "\"/>" + "</component></sspaceex>";
+      const SpaceExDocument doc(xml, "m.xml");
+      const SxComponent& c = doc.components().at(0);
+      EXPECT_TRUE(c.params.at(0).local) << yes;
+      EXPECT_FALSE(c.params.at(1).local) << no;
+      EXPECT_TRUE(c.transitions.at(0).asap) << yes;
+      EXPECT_FALSE(c.transitions.at(1).asap) << no;
+    }
+  }
+}
+
+TEST(SpaceExDocumentTest, OtherBooleanValuesAreErrorsAtTheValue) {
+  const std::string head = std::string(kHead) + "<component id=\"c\">";
+  EXPECT_EQ(Error(head + "<transition source=\"1\" target=\"1\" asap=\"yes\"/></component>"
+                         "</sspaceex>"),
+            "m.xml:3:59: attribute 'asap' of <transition> must be true or false (or 1 or 0), "
+            "not 'yes'");
+  EXPECT_EQ(Error(head + "<param name=\"x\" type=\"real\" local=\"\"/></component></sspaceex>"),
+            "m.xml:3:54: attribute 'local' of <param> must be true or false (or 1 or 0), not ''");
+  // An uncontrolled variable may change at the component's jumps: refused, not ignored.
+  EXPECT_EQ(Error(head + "<param name=\"x\" type=\"real\" controlled=\"0\"/></component>"
+                         "</sspaceex>"),
+            "m.xml:3:59: controlled=\"false\" is not supported: parameters are controlled by their "
+            "component");
+}
+
+// An attribute SpaceEx does not give an element is refused at its name: a misspelt `dynamics`
+// would otherwise make a constant a variable unseen. Layout attributes are known.
+TEST(SpaceExDocumentTest, UnknownAttributesAreErrorsAtTheirName) {
+  const std::string head = std::string(kHead) + "<component id=\"c\">";
+  EXPECT_EQ(Error(head + "<param name=\"a\" type=\"real\" dynamic=\"const\"/></component>"
+                         "</sspaceex>"),
+            "m.xml:3:47: unknown attribute 'dynamic' of <param> (known: name, type, local, d1, "
+            "d2, dynamics, controlled)");
+  EXPECT_EQ(Error(head + "<transition source=\"1\" target=\"1\" urgent=\"true\"/></component>"
+                         "</sspaceex>"),
+            "m.xml:3:53: unknown attribute 'urgent' of <transition> (known: source, target, asap, "
+            "timedriven, priority, bezier)");
+  EXPECT_EQ(Error(head + "<location id=\"1\"><flow\n type=\"x\">x' == 1</flow></location>"
+                         "</component></sspaceex>"),
+            "m.xml:4:2: unknown attribute 'type' of <flow> (it takes none)");
+  EXPECT_EQ(Error("<sspaceex version=\"0.2\" lang=\"x\"><component id=\"c\"/></sspaceex>"),
+            "m.xml:1:25: unknown attribute 'lang' of <sspaceex> (known: xmlns, version, math)");
+  EXPECT_EQ(Error(head + "</component><component id=\"n\"><bind component=\"c\" as=\"A\">"
+                         "<map key=\"a\" value=\"1\">2</map></bind></component></sspaceex>"),
+            "m.xml:3:89: unknown attribute 'value' of <map> (known: key)");
+  // Namespaces, layout and notes are fine.
+  EXPECT_EQ(Error("<sspaceex xmlns=\"http://www-verimag.imag.fr/xml-namespaces/sspaceex\" "
+                  "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" version=\"0.2\" "
+                  "math=\"SpaceEx\"><component id=\"c\"><note>any text</note>"
+                  "<location id=\"1\" name=\"a\" x=\"1\" y=\"2\" width=\"3\" height=\"4\"/>"
+                  "<transition source=\"1\" target=\"1\" bezier=\"true\"><labelposition "
+                  "x=\"1\" y=\"2\" width=\"3\" height=\"4\"/><middlepoint x=\"1\" y=\"2\"/>"
+                  "</transition></component></sspaceex>"),
+            "no error");
+}
+
+// Names may hold any character through character references: what a message quotes of them
+// is escaped.
+TEST(SpaceExDocumentTest, ControlCharactersInNamesAreEscapedInMessages) {
+  EXPECT_EQ(Error(std::string(kHead) + "<component id=\"c&#27;[2J\"/>\n"
+                                       "<component id=\"c&#27;[2J\"/></sspaceex>"),
+            "m.xml:4:16: duplicate component 'c\\x1b[2J'");
+}
+
 }  // namespace
 }  // namespace hybrid::spaceex

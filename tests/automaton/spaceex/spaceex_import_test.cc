@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -219,6 +220,138 @@ TEST(SpaceExImportTest, NetworkErrorsPointAtTheBind) {
                   ""),
             "m.xml:5:33: 'k' is given a flow by 'A' and by 'B': the import supports one component "
             "per variable (or x' == 0 in all)");
+}
+
+// `asap="1"` (and TRUE, True) is urgent like `asap="true"`: it used to be read as false, which
+// made the transition lazy.
+TEST(SpaceExImportTest, AsapWrittenOneIsUrgent) {
+  auto lazy_count = [](const std::string& asap) {
+    const std::string xml = Base(Var("x"),
+                                 "<location id=\"1\" name=\"a\"><flow>x' == 1</flow></location>\n"
+                                 "<transition source=\"1\" target=\"1\" asap=\"" +
+                                     asap + "\"><guard>x &gt;= 1</guard></transition>\n");
+    const std::string text = Translate(xml, "initially = \"x == 0\"\n").text;
+    std::size_t count = 0;
+    for (std::size_t at = text.find("lazy;"); at != std::string::npos;
+         at = text.find("lazy;", at + 1))
+      ++count;
+    return count;
+  };
+  for (const char* urgent : {"true", "1", "TRUE", "True"})
+    EXPECT_EQ(lazy_count(urgent), 0u) << urgent;
+  for (const char* lazy : {"false", "0", "FALSE"}) EXPECT_EQ(lazy_count(lazy), 1u) << lazy;
+}
+
+// A constant read only by `forbidden` is declared by its component and takes its value from
+// `initially` (it used to be left out, and the property then read an undefined name).
+TEST(SpaceExImportTest, ConstantReadOnlyInForbiddenIsDeclared) {
+  const std::string xml = Base(Var("x") + Const("limit"),
+                               "<location id=\"1\" name=\"a\"><invariant>x &lt;= 3</invariant>"
+                               "<flow>x' == 1</flow></location>\n");
+  auto cfg = [](const std::string& limit) {
+    return "initially = \"x == 0 & limit == " + limit + "\"\nforbidden = \"x >= limit\"\n";
+  };
+  EXPECT_NE(Translate(xml, cfg("2")).text.find("param limit = 2;"), std::string::npos);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("2")), Verdict::kViolated);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("4")), Verdict::kProved);
+}
+
+// The same in a network: a constant of the network that its instance declares but does not
+// read, and one that no component declares (its value from `initially` is then written in the
+// property); a range for the latter has no place to go and is an error at the name.
+TEST(SpaceExImportTest, NetworkConstantReadOnlyInForbiddenResolves) {
+  const std::string xml =
+      "<?xml version=\"1.0\"?>\n<sspaceex>\n<component id=\"t\">" + Var("x") + Const("c") +
+      "<location id=\"1\" name=\"a\"><invariant>x &lt;= 3</invariant><flow>x' == 1</flow>"
+      "</location></component>\n<component id=\"n\">" +
+      Var("x") + Const("c") + Const("d") +
+      "<bind component=\"t\" as=\"A\"/></component>\n</sspaceex>\n";
+  auto cfg = [](const std::string& values, const std::string& forbidden) {
+    return "initially = \"x == 0 & " + values + "\"\nforbidden = \"" + forbidden + "\"\n";
+  };
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("c == 2 & d == 9", "x >= c")), Verdict::kViolated);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("c == 4 & d == 9", "x >= c")), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("c == 4 & d == 2", "x >= d")), Verdict::kViolated);
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg("c == 4 & d == 5", "x >= d")), Verdict::kProved);
+  EXPECT_EQ(Error(xml, cfg("c == 4 & 1 <= d & d <= 2", "x >= d")),
+            "m.cfg:2:19: constant 'd' read in 'forbidden' is declared by no component: give it "
+            "one value in 'initially' (d == 2), or map it into a component");
+}
+
+// Without a configuration the model has no initial states: the error names the file looked for
+// (after the errors of the model itself).
+TEST(SpaceExImportTest, MissingConfigurationNamesTheFileLookedFor) {
+  hybrid::testing::TempDir dir;
+  const std::string xml = dir.Write("tank.xml", SpecFile("water_tank.xml")).string();
+  for (const auto& read : {std::function<void()>([&] { (void)ImportSpaceExFile(xml); }),
+                           std::function<void()>([&] { (void)ReadModelFile(xml); })}) {
+    try {
+      read();
+      ADD_FAILURE() << "no error";
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.file(), dir.File("tank.cfg"));
+      EXPECT_EQ(e.line(), 0);
+      EXPECT_EQ(e.message(), "missing: the SpaceEx model " + xml +
+                                 " needs its configuration (initial states, forbidden set) in "
+                                 "this file");
+    }
+  }
+  const std::string broken = dir.Write("broken.xml", "<sspaceex>\n<component>\n").string();
+  try {
+    (void)ImportSpaceExFile(broken);
+    ADD_FAILURE() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), broken);
+    EXPECT_EQ(e.message().rfind("malformed XML: ", 0), 0u) << e.what();
+  }
+}
+
+// Names and option values with control characters (written as character references in XML)
+// are quoted escaped, in errors and in notes, and cannot break the translation's lines.
+TEST(SpaceExImportTest, ControlCharactersInNamesAndOptionsAreEscaped) {
+  EXPECT_EQ(Error(Base(Var("x&#27;[2J"), ""), ""),
+            "m.xml:4:1: parameter 'x\\x1b[2J' is not a name of the model language (letters, "
+            "digits and '_', not starting with a digit)");
+  const Translation t =
+      Translate(SpecFile("water_tank.xml"),
+                "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"\n"
+                "time-horizon = \"1\x1b[2J\nautomaton injected { }\"\n");
+  ASSERT_FALSE(t.notes.empty());
+  EXPECT_EQ(t.notes[0],
+            "time-horizon = 1\\x1b[2J\\nautomaton injected { } is not imported: properties hold "
+            "over unbounded time here.");
+  EXPECT_EQ(t.text.find('\x1b'), std::string::npos);
+  EXPECT_EQ(t.text.find("\nautomaton injected"), std::string::npos);
+  EXPECT_NO_THROW((void)t.Parse("m.xml"));
+}
+
+// In SpaceEx a label is in the alphabet of every component that declares it: a component that
+// declares `l` but has no transition labelled `l` blocks the `l` transitions of the others. The
+// translation declares it (`label l;`, Automaton::DeclareLabel); it used to drop it, and B's `l`
+// transition was then taken alone (`violated`). A local label is no one else's: not declared.
+TEST(SpaceExImportTest, DeclaredButUnusedLabelBlocksOtherComponents) {
+  const std::string label = "<param name=\"l\" type=\"label\" local=\"false\"/>\n";
+  const std::string xml =
+      "<?xml version=\"1.0\"?>\n<sspaceex>\n<component id=\"a\">" + label +
+      "<location id=\"1\" name=\"idle\"/></component>\n<component id=\"b\">" + Var("x") + label +
+      "<location id=\"1\" name=\"p\"><flow>x' == 1</flow></location>"
+      "<location id=\"2\" name=\"q\"><flow>x' == 1</flow></location>"
+      "<transition source=\"1\" target=\"2\"><label>l</label></transition></component>\n"
+      "<component id=\"n\">" +
+      Var("x") + label +
+      "<bind component=\"a\" as=\"A\"/><bind component=\"b\" as=\"B\"/></component>\n"
+      "</sspaceex>\n";
+  const std::string cfg = "initially = \"loc(B) == p & x == 0\"\nforbidden = \"loc(B) == q\"\n";
+  EXPECT_EQ(ForbiddenVerdict(xml, cfg), Verdict::kProved);
+  const std::string text = Translate(xml, cfg).text;
+  EXPECT_NE(text.find("automaton a {\n  mode idle {\n  }\n  label l;\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("instance A = a { l = l; }"), std::string::npos) << text;
+  // Local to A, the label blocks nothing.
+  std::string local = xml;
+  local.replace(local.find("local=\"false\""), 13, "local=\"true\"");
+  EXPECT_EQ(Translate(local, cfg).text.find("\n  label l;"), std::string::npos);
+  EXPECT_EQ(ForbiddenVerdict(local, cfg), Verdict::kViolated);
 }
 
 TEST(SpaceExImportTest, ReadModelFileReadsBothLanguages) {

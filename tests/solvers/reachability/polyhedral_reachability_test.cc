@@ -1,210 +1,37 @@
-// Tests of exact polyhedral reachability (solvers/reachability/): the ConvexPolyhedron operations
-// against sets computed by hand (time elapse forward and backward, simultaneous resets and their
-// pre-images, strict constraints, suprema and central points, MaximizeLinear), and
-// PolyhedralReachability on small models whose verdicts are known analytically: proved bounds,
-// violations and witnesses whose traces the simulator replays, a rectangular rate, an uncertain
-// parameter, a simultaneous swap and a long chain of jumps.
+// Tests of exact polyhedral reachability (solvers/reachability/polyhedral_reachability.h) on small
+// models whose verdicts are known analytically: proved bounds, violations and witnesses whose
+// traces the simulator replays, a rectangular rate, an uncertain parameter, a simultaneous swap
+// and a long chain of jumps; and its deterministic budget: models whose reachable set never
+// converges stop at the budget, with the same verdict, reason and state count on every run, also
+// while other threads load the machine (ConvexPolyhedron: convex_polyhedron_test.cc).
 
 #include "solvers/reachability/polyhedral_reachability.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "automaton/parser.h"
-#include "solvers/reachability/convex_polyhedron.h"
 #include "solvers/simulation/simulator.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"
 
 namespace hybrid {
 namespace {
 
-using Kind = LinearConstraint::Kind;
 using testing::AtTarget;
 using testing::Named;
 using testing::Replayed;
-
-// The polyhedron of R^2 where every constraint a0 x + a1 y + b REL 0 holds.
-ConvexPolyhedron Plane(const std::vector<LinearConstraint>& constraints) {
-  ConvexPolyhedron p = ConvexPolyhedron::Universe(2);
-  for (const LinearConstraint& c : constraints) p.AddConstraint(c);
-  return p;
-}
-
-// Whether a and b are the same set.
-bool SameSet(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
-  return a.Contains(b) && b.Contains(a);
-}
-
-bool Holds(const ConvexPolyhedron& p, double x, double y) {
-  return p.Contains(ConvexPolyhedron::Point(std::vector<double>{x, y}));
-}
-
-// The box [x0, x1] x [y0, y1].
-ConvexPolyhedron Box(double x0, double x1, double y0, double y1) {
-  return Plane({{{-1, 0}, x0, Kind::kLessEqual},
-                {{1, 0}, -x1, Kind::kLessEqual},
-                {{0, -1}, y0, Kind::kLessEqual},
-                {{0, 1}, -y1, Kind::kLessEqual}});
-}
-
-TEST(ConvexPolyhedron, TimeElapseOfAPointWithARateBox) {
-  // From (0, 0) at x' in [1, 2], y' = 1: {y >= 0, y <= x <= 2 y}.
-  ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{0, 0});
-  const ConvexPolyhedron rates = Box(1, 2, 1, 1);
-  p.TimeElapse(rates);
-  const ConvexPolyhedron expected = Plane({{{0, -1}, 0, Kind::kLessEqual},
-                                           {{-1, 1}, 0, Kind::kLessEqual},
-                                           {{1, -2}, 0, Kind::kLessEqual}});
-  EXPECT_TRUE(SameSet(p, expected));
-  EXPECT_TRUE(Holds(p, 1.5, 1));
-  EXPECT_FALSE(Holds(p, 0.5, 1));
-  EXPECT_FALSE(Holds(p, 3, 1));
-  EXPECT_FALSE(Holds(p, -1, -1));
-}
-
-TEST(ConvexPolyhedron, TimeElapseBackwardReversesTheRates) {
-  // The states from which (2, 1) is reached at x' in [1, 2], y' = 1: (2 - t r, 1 - t), so
-  // y <= 1 and 1 - y <= 2 - x <= 2 (1 - y): {y <= 1, x <= 1 + y, x >= 2 y}.
-  ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{2, 1});
-  p.TimeElapseBackward(Box(1, 2, 1, 1));
-  const ConvexPolyhedron expected = Plane({{{0, 1}, -1, Kind::kLessEqual},
-                                           {{1, -1}, -1, Kind::kLessEqual},
-                                           {{-1, 2}, 0, Kind::kLessEqual}});
-  EXPECT_TRUE(SameSet(p, expected));
-  EXPECT_TRUE(Holds(p, 0.5, 0));  // at rate 1.5 for 1
-  EXPECT_FALSE(Holds(p, 2.5, 1.5));
-}
-
-TEST(ConvexPolyhedron, BoundsPerDimension) {
-  using Bounds = std::vector<std::pair<double, double>>;
-  EXPECT_EQ(Box(0, 1, 2, 3).Bounds(), (Bounds{{0, 1}, {2, 3}}));
-  // A cone from the origin: unbounded above in both dimensions.
-  ConvexPolyhedron cone = ConvexPolyhedron::Point(std::vector<double>{0, 0});
-  cone.TimeElapse(Box(1, 2, 1, 1));
-  EXPECT_EQ(cone.Bounds(), (Bounds{{0, INFINITY}, {0, INFINITY}}));
-  // Strict bounds are the same numbers; a line is unbounded both ways; empty is (inf, -inf).
-  const ConvexPolyhedron open = Plane({{{1, 0}, -1, Kind::kLess}, {{-1, 0}, 0, Kind::kLess}});
-  EXPECT_EQ(open.Bounds(), (Bounds{{0, 1}, {-INFINITY, INFINITY}}));
-  EXPECT_EQ(ConvexPolyhedron::Empty(1).Bounds(), (Bounds{{INFINITY, -INFINITY}}));
-}
-
-TEST(ConvexPolyhedron, SimultaneousResetsSwap) {
-  // x := y, y := x on [0, 1] x [2, 3] gives [2, 3] x [0, 1] (one after the other would give a
-  // part of the diagonal).
-  ConvexPolyhedron p = Box(0, 1, 2, 3);
-  const std::vector<std::pair<int, AffineMap>> swap = {{0, AffineMap{{0, 1}, 0}},
-                                                       {1, AffineMap{{1, 0}, 0}}};
-  p.Assign(swap);
-  EXPECT_TRUE(SameSet(p, Box(2, 3, 0, 1)));
-  // Its pre-image is the box it came from.
-  p.AssignPreimage(swap);
-  EXPECT_TRUE(SameSet(p, Box(0, 1, 2, 3)));
-}
-
-TEST(ConvexPolyhedron, ResetPreimages) {
-  // x := x + y into {x >= 5}: {x + y >= 5}; y unchanged.
-  ConvexPolyhedron p = Plane({{{-1, 0}, 5, Kind::kLessEqual}});
-  const std::vector<std::pair<int, AffineMap>> shift = {{0, AffineMap{{1, 1}, 0}}};
-  p.AssignPreimage(shift);
-  EXPECT_TRUE(SameSet(p, Plane({{{-1, -1}, 5, Kind::kLessEqual}})));
-  // x := 2, y := x + 1 into [0, 1] x [3, 4]: x + 1 in [3, 4] (2 is in [0, 1]? no): empty.
-  ConvexPolyhedron q = Box(0, 1, 3, 4);
-  const std::vector<std::pair<int, AffineMap>> to_two = {{0, AffineMap{{0, 0}, 2}},
-                                                         {1, AffineMap{{1, 0}, 1}}};
-  q.AssignPreimage(to_two);
-  EXPECT_TRUE(q.IsEmpty());
-  // x := 0.5, y := x + 1 into the same box: x in [2, 3], y free.
-  ConvexPolyhedron r = Box(0, 1, 3, 4);
-  const std::vector<std::pair<int, AffineMap>> to_half = {{0, AffineMap{{0, 0}, 0.5}},
-                                                          {1, AffineMap{{1, 0}, 1}}};
-  r.AssignPreimage(to_half);
-  EXPECT_TRUE(SameSet(r, Plane({{{-1, 0}, 2, Kind::kLessEqual}, {{1, 0}, -3, Kind::kLessEqual}})));
-}
-
-TEST(ConvexPolyhedron, StrictConstraintsStayStrict) {
-  ConvexPolyhedron open = ConvexPolyhedron::Universe(1);
-  open.AddConstraint({{1}, -1, Kind::kLess});  // x < 1
-  open.AddConstraint({{-1}, 0, Kind::kLess});  // x > 0
-  ConvexPolyhedron closed = ConvexPolyhedron::Universe(1);
-  closed.AddConstraint({{1}, -1, Kind::kLessEqual});
-  closed.AddConstraint({{-1}, 0, Kind::kLessEqual});
-  const ConvexPolyhedron one = ConvexPolyhedron::Point(std::vector<double>{1});
-  EXPECT_FALSE(open.Contains(one));
-  EXPECT_TRUE(closed.Contains(one));
-  EXPECT_TRUE(closed.Contains(open));
-  EXPECT_FALSE(open.Contains(closed));
-  EXPECT_FALSE(open.Intersects(one));
-  // x < 1 and x >= 1: empty; x <= 1 and x >= 1: the point 1.
-  ConvexPolyhedron none = open;
-  none.AddConstraint({{-1}, 1, Kind::kLessEqual});
-  EXPECT_TRUE(none.IsEmpty());
-  ConvexPolyhedron point = closed;
-  point.AddConstraint({{-1}, 1, Kind::kLessEqual});
-  EXPECT_TRUE(point.IsPoint());
-  // The supremum 1 of x over (0, 1) is not reached, over [0, 1] it is.
-  bool attained = true;
-  EXPECT_EQ(open.Supremum(std::vector<double>{1}, &attained), 1.0);
-  EXPECT_FALSE(attained);
-  EXPECT_FALSE(open.RestrictToMaximum(std::vector<double>{1}));
-  EXPECT_EQ(closed.Supremum(std::vector<double>{1}, &attained), 1.0);
-  EXPECT_TRUE(attained);
-  EXPECT_TRUE(closed.RestrictToMaximum(std::vector<double>{1}));
-  EXPECT_TRUE(SameSet(closed, one));
-  // The central point of (0, 1) is 1/2, inside although both ends are excluded.
-  const ConvexPolyhedron middle = open.CentralPoint();
-  EXPECT_TRUE(middle.IsPoint());
-  EXPECT_TRUE(open.Contains(middle));
-  EXPECT_EQ(middle.PointCoordinates(), std::vector<double>{0.5});
-}
-
-TEST(ConvexPolyhedron, CentralPointsAreExactAndInside) {
-  // The triangle (0, 0), (3, 0), (0, 3): its barycentre (1, 1).
-  const ConvexPolyhedron triangle = Plane({{{-1, 0}, 0, Kind::kLessEqual},
-                                           {{0, -1}, 0, Kind::kLessEqual},
-                                           {{1, 1}, -3, Kind::kLessEqual}});
-  EXPECT_EQ(triangle.CentralPoint().PointCoordinates(), (std::vector<double>{1, 1}));
-  // The point x = 1/3, y = 0 (3 x - 1 = 0): no double is 1/3, the point is kept exact.
-  const ConvexPolyhedron third = Plane({{{3, 0}, -1, Kind::kEqual}, {{0, 1}, 0, Kind::kEqual}});
-  const ConvexPolyhedron p = third.CentralPoint();
-  EXPECT_TRUE(SameSet(p, third));
-  EXPECT_FALSE(third.Contains(ConvexPolyhedron::Point(std::vector<double>{1.0 / 3.0, 0})));
-  EXPECT_DOUBLE_EQ(p.PointCoordinates()[0], 1.0 / 3.0);
-  // The half-line x >= 2, y = 1: its vertex plus its unit ray, inside it.
-  const ConvexPolyhedron half_line =
-      Plane({{{-1, 0}, 2, Kind::kLessEqual}, {{0, 1}, -1, Kind::kEqual}});
-  EXPECT_EQ(half_line.CentralPoint().PointCoordinates(), (std::vector<double>{3, 1}));
-  EXPECT_THROW(ConvexPolyhedron::Empty(2).CentralPoint(), std::logic_error);
-}
-
-TEST(MaximizeLinear, SmallProgramHasItsKnownOptimum) {
-  // max 3x + 2y s.t. x + y <= 4, x + 3y <= 6, x <= 3, x, y >= 0: at (3, 1), value 11.
-  const std::vector<LinearConstraint> rows = {{{1, 1}, -4, Kind::kLessEqual},
-                                              {{1, 3}, -6, Kind::kLessEqual},
-                                              {{1, 0}, -3, Kind::kLessEqual},
-                                              {{-1, 0}, 0, Kind::kLessEqual},
-                                              {{0, -1}, 0, Kind::kLessEqual}};
-  const std::vector<double> objective = {3, 2};
-  const auto x = MaximizeLinear(2, rows, objective);
-  ASSERT_TRUE(x.has_value());
-  EXPECT_DOUBLE_EQ((*x)[0], 3.0);
-  EXPECT_DOUBLE_EQ((*x)[1], 1.0);
-  // The same optimum as the polyhedron's supremum.
-  ConvexPolyhedron p = Plane(rows);
-  EXPECT_EQ(p.Supremum(objective), 11.0);
-  // With x + y >= 5 it is infeasible.
-  std::vector<LinearConstraint> infeasible = rows;
-  infeasible.push_back({{-1, -1}, 5, Kind::kLessEqual});
-  EXPECT_FALSE(MaximizeLinear(2, infeasible, objective).has_value());
-}
 
 System Parse(std::string_view text) { return ParseModel(text, "test.ha"); }
 
@@ -456,6 +283,189 @@ TEST(PolyhedralReachability, LongChainIsConcretisedExactly) {
   EXPECT_EQ(r[1].trace->schedule.size(), static_cast<size_t>(kModes));
   const Trace replayed = Replayed(system, Named(system, "exceeded"), r[1]);
   EXPECT_GT(AtTarget(system, replayed, "x"), kModes);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The deterministic budget.
+
+// One mode, two variables, a reachable set that never converges: a clock x reset every time unit
+// beside a clock y never reset, so each time unit adds a symbolic state (all at the one location,
+// each compared with every one stored before).
+constexpr std::string_view kRampModel = R"(
+automaton ramp {
+  var x, y;
+  mode a { x' = 1; y' = 1; inv x <= 1; }
+  transition tick: a -> a { guard x >= 1; reset x := 0; }
+  init a { x = 0; y = 0; }
+  property y_nonnegative: always y >= 0;
+}
+)";
+
+// One mode, two clocks of incommensurate periods (1 and 1.41421356) reset independently: their
+// offset takes ever new values, and the states' bounding boxes overlap, so every new state is
+// compared polyhedron to polyhedron with many stored ones.
+constexpr std::string_view kDriftModel = R"(
+automaton drift {
+  var x, y;
+  mode a { x' = 1; y' = 1; inv x <= 1 and y <= 1.41421356; }
+  transition tick: a -> a { guard x >= 1; reset x := 0; }
+  transition tock: a -> a { guard y >= 1.41421356; reset y := 0; }
+  init a { x = 0; y = 0; }
+  property bounded: always x <= 1 and y <= 1.5;
+}
+)";
+
+// What one check of `property` gave: verdict, reason and what it spent.
+struct Outcome {
+  CheckResult result;
+  PolyhedralReachability::Usage usage;
+};
+
+Outcome CheckWithin(const System& system, const std::string& property,
+                    PolyhedralReachability::Options options) {
+  Outcome out;
+  out.result =
+      PolyhedralReachability(options).Check(system, {Named(system, property)}, &out.usage).at(0);
+  return out;
+}
+
+PolyhedralReachability::Options Budget(double budget_seconds) {
+  PolyhedralReachability::Options options;
+  options.budget = budget_seconds;
+  return options;
+}
+
+TEST(PolyhedralReachability, NonConvergingOneModeModelsStopAtTheDeterministicBudget) {
+  for (const auto& [model, property] :
+       {std::pair{kRampModel, "y_nonnegative"}, std::pair{kDriftModel, "bounded"}}) {
+    const System system = Parse(model);
+    const Outcome small = CheckWithin(system, property, Budget(0.02));
+    EXPECT_EQ(small.result.verdict, Verdict::kUnknown) << small.result.reason;
+    EXPECT_NE(small.result.reason.find("stopped by its deterministic budget (2000000 reach units "
+                                       "= 0.02 budget seconds) before a fixpoint"),
+              std::string::npos)
+        << small.result.reason;
+    EXPECT_EQ(small.result.reason.find("safety net"), std::string::npos) << small.result.reason;
+    EXPECT_EQ(small.usage.stop, PolyhedralReachability::Usage::Stop::kBudget);
+    EXPECT_EQ(small.usage.units_total, 2'000'000u);
+    EXPECT_GE(small.usage.units_used, small.usage.units_total);
+    EXPECT_GT(small.usage.states, 10);
+    // The reason gives the state count.
+    EXPECT_NE(small.result.reason.find("(" + std::to_string(small.usage.states) +
+                                       " symbolic states in 1 locations)"),
+              std::string::npos)
+        << small.result.reason;
+    // Twice the budget goes further (the count, not the time, stops it).
+    const Outcome larger = CheckWithin(system, property, Budget(0.04));
+    EXPECT_EQ(larger.result.verdict, Verdict::kUnknown);
+    EXPECT_GT(larger.usage.states, small.usage.states);
+  }
+}
+
+// Runs `check` while `threads` other threads burn CPU (none: unloaded).
+template <typename F>
+auto UnderLoad(int threads, F check) {
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> burners;
+  for (int i = 0; i < threads; ++i) {
+    burners.emplace_back([&stop] {
+      volatile unsigned long long spin = 0;
+      while (!stop.load(std::memory_order_relaxed)) spin = spin + 1;
+    });
+  }
+  auto result = check();
+  stop = true;
+  for (std::thread& t : burners) t.join();
+  return result;
+}
+
+// The same check gives the same verdict, reason, state count and units whether the machine is
+// loaded or not (a test of determinism, not of speed: the CPU-time safety net, far beyond, does
+// not fire, and nothing here reads a clock).
+TEST(PolyhedralReachability, SameCheckSameOutcomeUnderLoad) {
+  const unsigned cores = std::max(2u, std::thread::hardware_concurrency());
+  for (const auto& [model, property] :
+       {std::pair{kDriftModel, "bounded"}, std::pair{kRampModel, "y_nonnegative"}}) {
+    const System system = Parse(model);
+    const auto check = [&] { return CheckWithin(system, property, Budget(0.05)); };
+    const Outcome quiet = UnderLoad(0, check);
+    const Outcome loaded = UnderLoad(static_cast<int>(cores), check);
+    EXPECT_EQ(quiet.result.verdict, loaded.result.verdict);
+    EXPECT_EQ(quiet.result.reason, loaded.result.reason);
+    EXPECT_EQ(quiet.usage.states, loaded.usage.states);
+    EXPECT_EQ(quiet.usage.units_used, loaded.usage.units_used);
+    EXPECT_EQ(quiet.usage.stop, PolyhedralReachability::Usage::Stop::kBudget);
+    EXPECT_EQ(loaded.usage.stop, PolyhedralReachability::Usage::Stop::kBudget);
+  }
+  // A check that ends in verdicts (a violation with its replayed trace, a fixpoint) too.
+  const System limited = Parse(kLimitedModel);
+  const auto check = [&] {
+    PolyhedralReachability::Usage usage;
+    const auto r = PolyhedralReachability().Check(
+        limited, {Named(limited, "below_5"), Named(limited, "below_3")}, &usage);
+    return std::pair{r, usage};
+  };
+  const auto quiet = UnderLoad(0, check);
+  const auto loaded = UnderLoad(static_cast<int>(cores), check);
+  ASSERT_EQ(quiet.first.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(quiet.first[i].verdict, loaded.first[i].verdict);
+    EXPECT_EQ(quiet.first[i].reason, loaded.first[i].reason);
+  }
+  EXPECT_EQ(quiet.first[0].verdict, Verdict::kProved);
+  EXPECT_EQ(quiet.first[1].verdict, Verdict::kViolated);
+  EXPECT_EQ(quiet.second.units_used, loaded.second.units_used);
+  EXPECT_EQ(quiet.second.states, loaded.second.states);
+  EXPECT_EQ(quiet.second.stop, PolyhedralReachability::Usage::Stop::kNone);
+}
+
+// When the CPU-time safety net stops the exploration, the reason says it was not the budget.
+TEST(PolyhedralReachability, TheSafetyNetSaysItIsNotTheBudget) {
+  const System system = Parse(kRampModel);
+  PolyhedralReachability::Options options = Budget(1000);
+  options.cpu_seconds = 1e-9;  // passed before the first expansion
+  const Outcome out = CheckWithin(system, "y_nonnegative", options);
+  EXPECT_EQ(out.result.verdict, Verdict::kUnknown);
+  EXPECT_EQ(out.usage.stop, PolyhedralReachability::Usage::Stop::kSafetyNet);
+  EXPECT_NE(out.result.reason.find("stopped by the CPU-time safety net"), std::string::npos)
+      << out.result.reason;
+  EXPECT_NE(out.result.reason.find("not by its deterministic budget"), std::string::npos)
+      << out.result.reason;
+  EXPECT_NE(out.result.reason.find("this verdict may differ on another machine"), std::string::npos)
+      << out.result.reason;
+  EXPECT_LT(out.usage.units_used, out.usage.units_total);
+}
+
+TEST(PolyhedralReachability, BudgetOutOfRangeIsRefused) {
+  const System system = Parse(kLimitedModel);
+  for (const double budget : {0.0, -1.0, std::nan(""), double{INFINITY}, 2e6}) {
+    EXPECT_THROW(CheckWithin(system, "below_5", Budget(budget)), std::invalid_argument) << budget;
+  }
+}
+
+// Properties with different horizons are explored apart, each with an equal share of what is
+// left of the one budget.
+TEST(PolyhedralReachability, HorizonsShareTheBudget) {
+  std::string text(kRampModel);
+  text.insert(text.rfind('}'), "  property y_nonnegative_long: always y >= 0 within 1000000;\n");
+  const System system = Parse(text);
+  PolyhedralReachability::Usage usage;
+  const auto r =
+      PolyhedralReachability(Budget(0.02))
+          .Check(system, {Named(system, "y_nonnegative"), Named(system, "y_nonnegative_long")},
+                 &usage);
+  for (const CheckResult& result : r) {
+    EXPECT_EQ(result.verdict, Verdict::kUnknown) << result.reason;
+    EXPECT_NE(result.reason.find("stopped by its deterministic budget (this exploration's share, "),
+              std::string::npos)
+        << result.reason;
+  }
+  // The first (no horizon) had half; the second what was left of the 2000000 units.
+  EXPECT_NE(r[0].reason.find("share, 1000000 of 2000000 reach units = 0.02 budget seconds)"),
+            std::string::npos)
+      << r[0].reason;
+  EXPECT_EQ(usage.stop, PolyhedralReachability::Usage::Stop::kBudget);
+  EXPECT_GE(usage.units_used, usage.units_total);
 }
 
 }  // namespace

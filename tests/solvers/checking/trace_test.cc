@@ -1,9 +1,9 @@
-// Tests of traces (solvers/verification/trace.h): the uncertain parameters of automata and systems;
+// Tests of traces (solvers/checking/trace.h): the uncertain parameters of automata and systems;
 // replaying a trace finds the first recorded state that violates (`always`, `never`) or satisfies
 // (`reach`) a property, within a `within T` horizon, with the documented tolerance; the trace's
 // parameter and initial values are applied; misuse throws.
 
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 
 #include <gtest/gtest.h>
 

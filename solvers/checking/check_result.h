@@ -7,7 +7,7 @@
 
 #include "automaton/property.h"
 #include "automaton/system.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 
 namespace hybrid {
 

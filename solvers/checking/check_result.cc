@@ -1,4 +1,4 @@
-#include "solvers/verification/check_result.h"
+#include "solvers/checking/check_result.h"
 
 #include <exception>
 #include <utility>

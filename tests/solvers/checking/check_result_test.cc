@@ -1,8 +1,8 @@
-// Tests of the verdict names (solvers/verification/check_result.h): every verdict has its own
+// Tests of the verdict names (solvers/checking/check_result.h): every verdict has its own
 // documented name, and a default CheckResult is an undecided `always` property; ConfirmTrace lets a
 // `violated` or `reachable` verdict through only with a trace that replays.
 
-#include "solvers/verification/check_result.h"
+#include "solvers/checking/check_result.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string_view>
 
 #include "automaton/parser.h"
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 #include "tests/test_utilities/properties.h"
 
 namespace hybrid {

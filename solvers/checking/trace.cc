@@ -1,4 +1,4 @@
-#include "solvers/verification/trace.h"
+#include "solvers/checking/trace.h"
 
 #include <algorithm>
 #include <cmath>

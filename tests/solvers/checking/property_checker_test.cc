@@ -1,0 +1,138 @@
+// Tests of the checking layer (solvers/checking/property_checker.h): the registry makes checkers
+// by name and names the methods in its errors; a fallback asks each later checker only what the
+// earlier ones left unknown, and skips checkers that do not apply. The checkers here are scripted
+// fakes (a verdict per property name), so what is tested is the layer's bookkeeping alone.
+
+#include "solvers/checking/property_checker.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hybrid {
+namespace {
+
+// A checker that gives each property the verdict its script names (unknown otherwise) and
+// records what it was asked.
+class ScriptedChecker : public PropertyChecker {
+ public:
+  ScriptedChecker(std::string name, std::map<std::string, Verdict> script, bool handles = true)
+      : name_(std::move(name)), script_(std::move(script)), handles_(handles) {}
+  std::string_view name() const override { return name_; }
+  bool Handles(const System&, std::span<const Property>, std::string* why) const override {
+    if (!handles_ && why) *why = "not my kind of model";
+    return handles_;
+  }
+  std::vector<CheckResult> Check(const System&, std::span<const Property> properties) override {
+    std::vector<CheckResult> out;
+    for (const Property& p : properties) {
+      asked->push_back(name_ + ":" + p.name);
+      CheckResult r;
+      r.property = p.name;
+      r.kind = p.kind;
+      r.method = name_;
+      r.seconds = 1.0;
+      const auto it = script_.find(p.name);
+      r.verdict = it == script_.end() ? Verdict::kUnknown : it->second;
+      r.reason = name_ + " says so";
+      out.push_back(r);
+    }
+    return out;
+  }
+  std::shared_ptr<std::vector<std::string>> asked = std::make_shared<std::vector<std::string>>();
+
+ private:
+  std::string name_;
+  std::map<std::string, Verdict> script_;
+  bool handles_;
+};
+
+std::vector<Property> Named(const std::vector<std::string>& names) {
+  std::vector<Property> out;
+  for (const std::string& n : names) out.push_back({n, Property::Kind::kAlways, Predicate::True()});
+  return out;
+}
+
+TEST(CheckerRegistry, MakesByNameAndListsTheMethods) {
+  CheckerRegistry registry;
+  registry.Add("first", "the first way", [] {
+    return std::make_unique<ScriptedChecker>("first", std::map<std::string, Verdict>{});
+  });
+  registry.Add("second", "the second way", [] {
+    return std::make_unique<ScriptedChecker>("second", std::map<std::string, Verdict>{});
+  });
+  EXPECT_TRUE(registry.Has("second"));
+  EXPECT_FALSE(registry.Has("third"));
+  EXPECT_EQ(registry.Make("second")->name(), "second");
+  EXPECT_EQ(registry.Names(), (std::vector<std::string>{"first", "second"}));
+  EXPECT_EQ(registry.Summary("first"), "the first way");
+  try {
+    registry.Make("third");
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "unknown method 'third'; the methods are: first, second");
+  }
+  EXPECT_THROW(registry.Add("first", "", [] { return nullptr; }), std::invalid_argument);
+  EXPECT_THROW(registry.Add("", "", [] { return nullptr; }), std::invalid_argument);
+}
+
+TEST(FallbackChecker, AsksLaterCheckersOnlyWhatIsUnknown) {
+  auto reach = std::make_unique<ScriptedChecker>(
+      "reach", std::map<std::string, Verdict>{{"a", Verdict::kProved}});
+  auto prove = std::make_unique<ScriptedChecker>(
+      "prove", std::map<std::string, Verdict>{{"b", Verdict::kViolated}});
+  const auto reach_asked = reach->asked, prove_asked = prove->asked;
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(std::move(reach));
+  checkers.push_back(std::move(prove));
+  FallbackChecker fallback("auto", std::move(checkers));
+  const System system("s");
+  const std::vector<CheckResult> results = fallback.Check(system, Named({"a", "b", "c"}));
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_EQ(*reach_asked, (std::vector<std::string>{"reach:a", "reach:b", "reach:c"}));
+  EXPECT_EQ(*prove_asked, (std::vector<std::string>{"prove:b", "prove:c"}));
+  EXPECT_EQ(results[0].verdict, Verdict::kProved);
+  EXPECT_EQ(results[0].method, "reach");
+  EXPECT_EQ(results[1].verdict, Verdict::kViolated);
+  EXPECT_EQ(results[1].method, "prove");
+  EXPECT_EQ(results[2].verdict, Verdict::kUnknown);
+  EXPECT_EQ(results[2].reason, "reach says so; prove: prove says so");
+  EXPECT_DOUBLE_EQ(results[2].seconds, 2.0);
+}
+
+TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {
+  auto reach = std::make_unique<ScriptedChecker>(
+      "reach", std::map<std::string, Verdict>{{"a", Verdict::kProved}}, false);
+  auto prove = std::make_unique<ScriptedChecker>("prove", std::map<std::string, Verdict>{});
+  const auto reach_asked = reach->asked;
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(std::move(reach));
+  checkers.push_back(std::move(prove));
+  FallbackChecker fallback("auto", std::move(checkers));
+  const System system("s");
+  const std::vector<CheckResult> results = fallback.Check(system, Named({"a"}));
+  EXPECT_TRUE(reach_asked->empty());
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].method, "prove");
+  EXPECT_EQ(results[0].reason, "prove says so");  // nothing appended: prove decided first
+}
+
+TEST(FallbackChecker, NoCheckerThatAppliesLeavesEveryPropertyUnknownSayingWhy) {
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(
+      std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{}, false));
+  FallbackChecker fallback("auto", std::move(checkers));
+  const System system("s");
+  const std::vector<CheckResult> results = fallback.Check(system, Named({"a"}));
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].verdict, Verdict::kUnknown);
+  EXPECT_EQ(results[0].reason, "no method applies: reach: not my kind of model");
+  EXPECT_THROW(FallbackChecker("auto", {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hybrid

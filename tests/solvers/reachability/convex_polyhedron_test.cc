@@ -1,0 +1,233 @@
+// Tests of ConvexPolyhedron (solvers/reachability/convex_polyhedron.h), the exact rational
+// polyhedra of polyhedral reachability: its operations against sets computed by hand (time
+// elapse forward and backward, simultaneous resets and their pre-images, strict constraints,
+// suprema and central points, bounds), MaximizeLinear, and the size measure the deterministic
+// reachability budget charges (RepresentationBytes).
+
+#include "solvers/reachability/convex_polyhedron.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace hybrid {
+namespace {
+
+using Kind = LinearConstraint::Kind;
+
+// The polyhedron of R^2 where every constraint a0 x + a1 y + b REL 0 holds.
+ConvexPolyhedron Plane(const std::vector<LinearConstraint>& constraints) {
+  ConvexPolyhedron p = ConvexPolyhedron::Universe(2);
+  for (const LinearConstraint& c : constraints) p.AddConstraint(c);
+  return p;
+}
+
+// Whether a and b are the same set.
+bool SameSet(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
+  return a.Contains(b) && b.Contains(a);
+}
+
+bool Holds(const ConvexPolyhedron& p, double x, double y) {
+  return p.Contains(ConvexPolyhedron::Point(std::vector<double>{x, y}));
+}
+
+// The box [x0, x1] x [y0, y1].
+ConvexPolyhedron Box(double x0, double x1, double y0, double y1) {
+  return Plane({{{-1, 0}, x0, Kind::kLessEqual},
+                {{1, 0}, -x1, Kind::kLessEqual},
+                {{0, -1}, y0, Kind::kLessEqual},
+                {{0, 1}, -y1, Kind::kLessEqual}});
+}
+
+TEST(ConvexPolyhedron, TimeElapseOfAPointWithARateBox) {
+  // From (0, 0) at x' in [1, 2], y' = 1: {y >= 0, y <= x <= 2 y}.
+  ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{0, 0});
+  const ConvexPolyhedron rates = Box(1, 2, 1, 1);
+  p.TimeElapse(rates);
+  const ConvexPolyhedron expected = Plane({{{0, -1}, 0, Kind::kLessEqual},
+                                           {{-1, 1}, 0, Kind::kLessEqual},
+                                           {{1, -2}, 0, Kind::kLessEqual}});
+  EXPECT_TRUE(SameSet(p, expected));
+  EXPECT_TRUE(Holds(p, 1.5, 1));
+  EXPECT_FALSE(Holds(p, 0.5, 1));
+  EXPECT_FALSE(Holds(p, 3, 1));
+  EXPECT_FALSE(Holds(p, -1, -1));
+}
+
+TEST(ConvexPolyhedron, TimeElapseBackwardReversesTheRates) {
+  // The states from which (2, 1) is reached at x' in [1, 2], y' = 1: (2 - t r, 1 - t), so
+  // y <= 1 and 1 - y <= 2 - x <= 2 (1 - y): {y <= 1, x <= 1 + y, x >= 2 y}.
+  ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{2, 1});
+  p.TimeElapseBackward(Box(1, 2, 1, 1));
+  const ConvexPolyhedron expected = Plane({{{0, 1}, -1, Kind::kLessEqual},
+                                           {{1, -1}, -1, Kind::kLessEqual},
+                                           {{-1, 2}, 0, Kind::kLessEqual}});
+  EXPECT_TRUE(SameSet(p, expected));
+  EXPECT_TRUE(Holds(p, 0.5, 0));  // at rate 1.5 for 1
+  EXPECT_FALSE(Holds(p, 2.5, 1.5));
+}
+
+TEST(ConvexPolyhedron, BoundsPerDimension) {
+  using Bounds = std::vector<std::pair<double, double>>;
+  EXPECT_EQ(Box(0, 1, 2, 3).Bounds(), (Bounds{{0, 1}, {2, 3}}));
+  // A cone from the origin: unbounded above in both dimensions.
+  ConvexPolyhedron cone = ConvexPolyhedron::Point(std::vector<double>{0, 0});
+  cone.TimeElapse(Box(1, 2, 1, 1));
+  EXPECT_EQ(cone.Bounds(), (Bounds{{0, INFINITY}, {0, INFINITY}}));
+  // Strict bounds are the same numbers; a line is unbounded both ways; empty is (inf, -inf).
+  const ConvexPolyhedron open = Plane({{{1, 0}, -1, Kind::kLess}, {{-1, 0}, 0, Kind::kLess}});
+  EXPECT_EQ(open.Bounds(), (Bounds{{0, 1}, {-INFINITY, INFINITY}}));
+  EXPECT_EQ(ConvexPolyhedron::Empty(1).Bounds(), (Bounds{{INFINITY, -INFINITY}}));
+}
+
+TEST(ConvexPolyhedron, SimultaneousResetsSwap) {
+  // x := y, y := x on [0, 1] x [2, 3] gives [2, 3] x [0, 1] (one after the other would give a
+  // part of the diagonal).
+  ConvexPolyhedron p = Box(0, 1, 2, 3);
+  const std::vector<std::pair<int, AffineMap>> swap = {{0, AffineMap{{0, 1}, 0}},
+                                                       {1, AffineMap{{1, 0}, 0}}};
+  p.Assign(swap);
+  EXPECT_TRUE(SameSet(p, Box(2, 3, 0, 1)));
+  // Its pre-image is the box it came from.
+  p.AssignPreimage(swap);
+  EXPECT_TRUE(SameSet(p, Box(0, 1, 2, 3)));
+}
+
+TEST(ConvexPolyhedron, ResetPreimages) {
+  // x := x + y into {x >= 5}: {x + y >= 5}; y unchanged.
+  ConvexPolyhedron p = Plane({{{-1, 0}, 5, Kind::kLessEqual}});
+  const std::vector<std::pair<int, AffineMap>> shift = {{0, AffineMap{{1, 1}, 0}}};
+  p.AssignPreimage(shift);
+  EXPECT_TRUE(SameSet(p, Plane({{{-1, -1}, 5, Kind::kLessEqual}})));
+  // x := 2, y := x + 1 into [0, 1] x [3, 4]: x + 1 in [3, 4] (2 is in [0, 1]? no): empty.
+  ConvexPolyhedron q = Box(0, 1, 3, 4);
+  const std::vector<std::pair<int, AffineMap>> to_two = {{0, AffineMap{{0, 0}, 2}},
+                                                         {1, AffineMap{{1, 0}, 1}}};
+  q.AssignPreimage(to_two);
+  EXPECT_TRUE(q.IsEmpty());
+  // x := 0.5, y := x + 1 into the same box: x in [2, 3], y free.
+  ConvexPolyhedron r = Box(0, 1, 3, 4);
+  const std::vector<std::pair<int, AffineMap>> to_half = {{0, AffineMap{{0, 0}, 0.5}},
+                                                          {1, AffineMap{{1, 0}, 1}}};
+  r.AssignPreimage(to_half);
+  EXPECT_TRUE(SameSet(r, Plane({{{-1, 0}, 2, Kind::kLessEqual}, {{1, 0}, -3, Kind::kLessEqual}})));
+}
+
+TEST(ConvexPolyhedron, StrictConstraintsStayStrict) {
+  ConvexPolyhedron open = ConvexPolyhedron::Universe(1);
+  open.AddConstraint({{1}, -1, Kind::kLess});  // x < 1
+  open.AddConstraint({{-1}, 0, Kind::kLess});  // x > 0
+  ConvexPolyhedron closed = ConvexPolyhedron::Universe(1);
+  closed.AddConstraint({{1}, -1, Kind::kLessEqual});
+  closed.AddConstraint({{-1}, 0, Kind::kLessEqual});
+  const ConvexPolyhedron one = ConvexPolyhedron::Point(std::vector<double>{1});
+  EXPECT_FALSE(open.Contains(one));
+  EXPECT_TRUE(closed.Contains(one));
+  EXPECT_TRUE(closed.Contains(open));
+  EXPECT_FALSE(open.Contains(closed));
+  EXPECT_FALSE(open.Intersects(one));
+  // x < 1 and x >= 1: empty; x <= 1 and x >= 1: the point 1.
+  ConvexPolyhedron none = open;
+  none.AddConstraint({{-1}, 1, Kind::kLessEqual});
+  EXPECT_TRUE(none.IsEmpty());
+  ConvexPolyhedron point = closed;
+  point.AddConstraint({{-1}, 1, Kind::kLessEqual});
+  EXPECT_TRUE(point.IsPoint());
+  // The supremum 1 of x over (0, 1) is not reached, over [0, 1] it is.
+  bool attained = true;
+  EXPECT_EQ(open.Supremum(std::vector<double>{1}, &attained), 1.0);
+  EXPECT_FALSE(attained);
+  EXPECT_FALSE(open.RestrictToMaximum(std::vector<double>{1}));
+  EXPECT_EQ(closed.Supremum(std::vector<double>{1}, &attained), 1.0);
+  EXPECT_TRUE(attained);
+  EXPECT_TRUE(closed.RestrictToMaximum(std::vector<double>{1}));
+  EXPECT_TRUE(SameSet(closed, one));
+  // The central point of (0, 1) is 1/2, inside although both ends are excluded.
+  const ConvexPolyhedron middle = open.CentralPoint();
+  EXPECT_TRUE(middle.IsPoint());
+  EXPECT_TRUE(open.Contains(middle));
+  EXPECT_EQ(middle.PointCoordinates(), std::vector<double>{0.5});
+}
+
+TEST(ConvexPolyhedron, CentralPointsAreExactAndInside) {
+  // The triangle (0, 0), (3, 0), (0, 3): its barycentre (1, 1).
+  const ConvexPolyhedron triangle = Plane({{{-1, 0}, 0, Kind::kLessEqual},
+                                           {{0, -1}, 0, Kind::kLessEqual},
+                                           {{1, 1}, -3, Kind::kLessEqual}});
+  EXPECT_EQ(triangle.CentralPoint().PointCoordinates(), (std::vector<double>{1, 1}));
+  // The point x = 1/3, y = 0 (3 x - 1 = 0): no double is 1/3, the point is kept exact.
+  const ConvexPolyhedron third = Plane({{{3, 0}, -1, Kind::kEqual}, {{0, 1}, 0, Kind::kEqual}});
+  const ConvexPolyhedron p = third.CentralPoint();
+  EXPECT_TRUE(SameSet(p, third));
+  EXPECT_FALSE(third.Contains(ConvexPolyhedron::Point(std::vector<double>{1.0 / 3.0, 0})));
+  EXPECT_DOUBLE_EQ(p.PointCoordinates()[0], 1.0 / 3.0);
+  // The half-line x >= 2, y = 1: its vertex plus its unit ray, inside it.
+  const ConvexPolyhedron half_line =
+      Plane({{{-1, 0}, 2, Kind::kLessEqual}, {{0, 1}, -1, Kind::kEqual}});
+  EXPECT_EQ(half_line.CentralPoint().PointCoordinates(), (std::vector<double>{3, 1}));
+  EXPECT_THROW(ConvexPolyhedron::Empty(2).CentralPoint(), std::logic_error);
+}
+
+TEST(MaximizeLinear, SmallProgramHasItsKnownOptimum) {
+  // max 3x + 2y s.t. x + y <= 4, x + 3y <= 6, x <= 3, x, y >= 0: at (3, 1), value 11.
+  const std::vector<LinearConstraint> rows = {{{1, 1}, -4, Kind::kLessEqual},
+                                              {{1, 3}, -6, Kind::kLessEqual},
+                                              {{1, 0}, -3, Kind::kLessEqual},
+                                              {{-1, 0}, 0, Kind::kLessEqual},
+                                              {{0, -1}, 0, Kind::kLessEqual}};
+  const std::vector<double> objective = {3, 2};
+  const auto x = MaximizeLinear(2, rows, objective);
+  ASSERT_TRUE(x.has_value());
+  EXPECT_DOUBLE_EQ((*x)[0], 3.0);
+  EXPECT_DOUBLE_EQ((*x)[1], 1.0);
+  // The same optimum as the polyhedron's supremum.
+  ConvexPolyhedron p = Plane(rows);
+  EXPECT_EQ(p.Supremum(objective), 11.0);
+  // With x + y >= 5 it is infeasible.
+  std::vector<LinearConstraint> infeasible = rows;
+  infeasible.push_back({{-1, -1}, 5, Kind::kLessEqual});
+  EXPECT_FALSE(MaximizeLinear(2, infeasible, objective).has_value());
+}
+
+// The size measure grows with the representation, and is the same for the same operations.
+TEST(ConvexPolyhedron, RepresentationBytesGrowWithTheRepresentation) {
+  const ConvexPolyhedron square = Box(0, 1, 0, 1);
+  // A polygon with more sides: the square with its four corners cut.
+  const ConvexPolyhedron octagon = Plane({{{-1, 0}, 0, Kind::kLessEqual},
+                                          {{1, 0}, -3, Kind::kLessEqual},
+                                          {{0, -1}, 0, Kind::kLessEqual},
+                                          {{0, 1}, -3, Kind::kLessEqual},
+                                          {{-1, -1}, 1, Kind::kLessEqual},
+                                          {{1, 1}, -5, Kind::kLessEqual},
+                                          {{1, -1}, -2, Kind::kLessEqual},
+                                          {{-1, 1}, -2, Kind::kLessEqual}});
+  EXPECT_GT(square.RepresentationBytes(), ConvexPolyhedron::Universe(2).RepresentationBytes());
+  EXPECT_GT(octagon.RepresentationBytes(), square.RepresentationBytes());
+  // Longer coefficients take more bytes: the same square scaled by a large factor.
+  const double big = 1e30;
+  EXPECT_GT(Box(0, big, 0, big).RepresentationBytes(), square.RepresentationBytes());
+  // More dimensions take more bytes.
+  ConvexPolyhedron wider = square;
+  wider.AddDimensions(6);
+  EXPECT_GT(wider.RepresentationBytes(), square.RepresentationBytes());
+  // Deterministic: the same operations give the same figure. It counts what is allocated, so a
+  // copy (allocated to fit) may measure less than its original, never more.
+  auto made = [] {
+    ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{0, 0});
+    p.TimeElapse(Box(1, 2, 1, 1));
+    p.Intersect(Box(0, 3, 0, 2));
+    (void)p.Bounds();
+    return p;
+  };
+  const ConvexPolyhedron a = made();
+  EXPECT_EQ(a.RepresentationBytes(), made().RepresentationBytes());
+  const ConvexPolyhedron copy = a;
+  EXPECT_LE(copy.RepresentationBytes(), a.RepresentationBytes());
+  EXPECT_GT(copy.RepresentationBytes(), square.RepresentationBytes());
+}
+
+}  // namespace
+}  // namespace hybrid

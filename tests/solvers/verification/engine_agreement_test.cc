@@ -1,0 +1,1474 @@
+// Differential test across engines and compositions (docs/soundness.md, "Engine agreement"):
+// one meaning of a model for every engine. Random systems of 1 to 3 instances with shared and
+// bound variables, inputs, labels, parameters and discrete variables, derived and uncertain
+// parameters, strict and non-strict invariants and guards, urgent and lazy transitions and several
+// init declarations are generated as model-language text (tests/test_utilities/
+// random_hybrid_automata.h, GenerateRandomSystem) and every property is checked by every engine:
+// polyhedral reachability (`check --method reach`), the SMT prover (`prove`) and the sampler
+// (`sample`), each with a small deterministic budget. Then:
+// - every `proved` and `unreachable` verdict is attacked by simulations of concrete runs written
+//   back as model text (random values of the uncertain parameters, a random init declaration per
+//   instance with random values in its boxes, random step inputs, lazy transitions at random
+//   times), the properties judged by the generator's own evaluator: a state that breaks a claim
+//   beyond a relative 1e-6 is a contradiction;
+// - every `violated` and `reachable` verdict must carry a trace that ReplayTrace confirms and
+//   that, written back as model text and simulated, reaches the violation (or the target) by the
+//   generator's evaluator;
+// - two definite verdicts of different engines that disagree (proved vs violated, unreachable vs
+//   reachable) are a disagreement;
+// - a few systems are given a conflict on purpose (a shared variable started at two values, an
+//   input with two bounds, a discrete variable given values by two instances, a variable reset by
+//   two synchronised transitions): the parser must refuse them with the conflict's message.
+// Every failure prints the model text and the verdicts of every engine.
+//
+// Environment: HYBRID_AGREEMENT_SYSTEMS (default 200), HYBRID_AGREEMENT_SEED (default 20261127),
+// HYBRID_AGREEMENT_FIRST (index of the first system: rerun system i alone with FIRST=i
+// SYSTEMS=1), HYBRID_AGREEMENT_ATTACKS (simulations per system with a claim, default 24).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "automaton/parser.h"
+#include "solvers/checking/trace.h"
+#include "solvers/reachability/polyhedral_reachability.h"
+#include "solvers/simulation/simulator.h"
+#include "solvers/verification/property_prover.h"
+#include "solvers/verification/property_sampler.h"
+#include "tests/test_utilities/random_hybrid_automata.h"
+
+namespace hybrid {
+namespace {
+
+namespace ht = hybrid::testing;
+using ht::RandomProperty;
+using ht::RandomSystem;
+using Rng = std::mt19937_64;
+
+constexpr std::uint64_t kDefaultSeed = 20261127;
+constexpr int kDefaultSystems = 200;
+constexpr int kDefaultAttacks = 24;
+/// Percent of the systems given a conflict on purpose.
+constexpr int kConflictPercent = 6;
+/// A claim is contradicted only by a state that breaks it by more than this (relative).
+constexpr double kTolerance = 1e-6;
+/// A `violated` trace must break its property by at least this (relative) on replay.
+constexpr double kConfirmTolerance = 1e-9;
+
+/// A non-negative integer from the environment, or `fallback` when unset.
+std::uint64_t EnvNumber(const char* name, std::uint64_t fallback) {
+  const char* text = std::getenv(name);
+  if (text == nullptr || *text == '\0') return fallback;
+  char* end = nullptr;
+  const unsigned long long value = std::strtoull(text, &end, 10);
+  if (*end != '\0' || *text == '-') {
+    ADD_FAILURE() << name << "='" << text << "' is not a non-negative integer";
+    return fallback;
+  }
+  return value;
+}
+
+struct Settings {
+  std::uint64_t seed = kDefaultSeed;
+  std::uint64_t first = 0;
+  int systems = kDefaultSystems;
+  int attacks = kDefaultAttacks;
+};
+
+Settings SettingsFromEnvironment() {
+  Settings s;
+  s.seed = EnvNumber("HYBRID_AGREEMENT_SEED", kDefaultSeed);
+  s.first = EnvNumber("HYBRID_AGREEMENT_FIRST", 0);
+  s.systems = static_cast<int>(EnvNumber("HYBRID_AGREEMENT_SYSTEMS", kDefaultSystems));
+  s.attacks = static_cast<int>(EnvNumber("HYBRID_AGREEMENT_ATTACKS", kDefaultAttacks));
+  return s;
+}
+
+/// The seed of system `index` (SplitMix64 of seed and index): every system is reproducible alone.
+std::uint64_t SystemSeed(std::uint64_t seed, std::uint64_t index) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (index + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+/// System `index` of `seed`.
+RandomSystem SystemAt(std::uint64_t seed, std::uint64_t index) {
+  Rng rng(SystemSeed(seed, index));
+  ht::RandomSystemOptions options;
+  options.conflict_percent = kConflictPercent;
+  return ht::GenerateRandomSystem(rng, options);
+}
+
+std::string VerdictText(Verdict v) { return std::string(VerdictName(v)); }
+
+bool Positive(Verdict v) { return v == Verdict::kViolated || v == Verdict::kReachable; }
+bool Negative(Verdict v) { return v == Verdict::kProved || v == Verdict::kUnreachable; }
+
+// ---- the engines, with small deterministic budgets ----
+
+/// One engine's results on one system, one per property (in the order of the properties).
+struct EngineRun {
+  std::string engine;
+  std::vector<CheckResult> results;
+  std::vector<std::string> errors;  // per property: what the engine threw ("" if nothing)
+  double seconds = 0.0;
+};
+
+using Engine = std::function<std::vector<CheckResult>(const System&, const std::vector<Property>&)>;
+
+/// `check --method reach` with a small deterministic budget (and a bound on symbolic states, as
+/// random clocks that are never reset have no fixpoint).
+std::vector<CheckResult> Reach(const System& system, const std::vector<Property>& properties) {
+  PolyhedralReachability::Options o;
+  o.budget = 0.02;  // 1.5 million reach units
+  o.max_states = 400;
+  o.cpu_seconds = 30;
+  return PolyhedralReachability(o).Check(system, properties);
+}
+
+/// `check --method prove --depth 4 --induction 2` with a small deterministic budget.
+std::vector<CheckResult> Prove(const System& system, const std::vector<Property>& properties) {
+  PropertyProver::Options o;
+  o.max_depth = 4;
+  o.max_induction = 2;
+  o.budget = 0.4;  // one million Z3 resource units for the whole check
+  o.resource_limit = 400'000;
+  return PropertyProver(o).Check(system, properties);
+}
+
+/// The reason of a sampler's `unknown` for a model that rejected every drawn run.
+constexpr char kSampleRefused[] = "the sampler refused the model: ";
+
+/// `check --method sample` with 24 runs per property (horizon 12 unless `within T`).
+std::vector<CheckResult> Sample(const System& system, const std::vector<Property>& properties) {
+  std::vector<CheckResult> out;
+  for (const Property& p : properties) {
+    PropertySampler::Options o;
+    o.runs = 24;
+    o.max_segments = 4;
+    if (!p.horizon) o.horizon = 12.0;
+    o.max_shrink_replays = 64;
+    try {
+      out.push_back(PropertySampler(o).Check(system, p));
+    } catch (const std::invalid_argument& e) {
+      // Documented: a model that rejects every drawn run (its initial states all violate their
+      // invariants: a model without runs) is refused. No verdict.
+      if (std::string(e.what()).find("rejected every") == std::string::npos) throw;
+      CheckResult r;
+      r.property = p.name;
+      r.kind = p.kind;
+      r.reason = std::string(kSampleRefused) + e.what();
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
+const std::vector<std::pair<std::string, Engine>>& Engines() {
+  static const std::vector<std::pair<std::string, Engine>> engines = {
+      {"reach", Reach}, {"prove", Prove}, {"sample", Sample}};
+  return engines;
+}
+
+/// Runs `engine` on every property at once; if it throws, on each property alone, so that a
+/// throw is charged to the properties that cause it (their results are `unknown`).
+EngineRun RunEngine(const std::string& name, const Engine& engine, const System& system,
+                    const std::vector<Property>& properties) {
+  EngineRun run{name, {}, std::vector<std::string>(properties.size()), 0.0};
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    run.results = engine(system, properties);
+  } catch (const std::exception&) {
+    run.results.clear();
+    for (std::size_t i = 0; i < properties.size(); ++i) {
+      try {
+        run.results.push_back(engine(system, {properties[i]}).at(0));
+      } catch (const std::exception& e) {
+        run.errors[i] = e.what();
+        run.results.emplace_back();
+        run.results.back().reason = std::string("threw: ") + e.what();
+      }
+    }
+  }
+  if (run.results.size() != properties.size()) {
+    run.results.assign(properties.size(), CheckResult{});
+    run.errors.assign(properties.size(), "not one result per property");
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+// ---- summary ----
+
+struct Summary {
+  int systems = 0;
+  int properties = 0;
+  std::map<std::string, int> refused;  // conflicting systems refused, by kind
+  std::map<std::string, std::map<std::string, int>> verdicts;  // engine -> verdict -> count
+  std::map<std::string, double> seconds;                       // engine -> seconds
+  int reach_outside_class = 0;  // properties reach left unknown as not linear
+  int sample_refused = 0;       // properties of models whose every sampled run was rejected
+  int claims = 0;               // proved / unreachable verdicts (per property) attacked
+  long attacks = 0;             // simulations run against claims
+  long rejected = 0;            // attacks the model refused (initial state outside its invariant)
+  long states = 0;              // recorded states checked against claims
+  long outside = 0;             // attacks cut at a state outside its modes' invariants
+  int replays = 0;              // traces confirmed by ReplayTrace
+  int text_replays = 0;         // traces confirmed from model text by the test's evaluator
+  int boundary_witnesses = 0;   // of which `reach` witnesses only within the tolerance
+  int boundary_disagreements = 0;  // disagreements whose witnesses are all such
+  int agreements = 0;              // properties with definite verdicts of two engines that agree
+  std::vector<std::string> contradictions;
+  std::vector<std::string> disagreements;
+  std::vector<std::string> trace_failures;
+  std::vector<std::string> other_failures;  // parse failures, engine errors, accepted conflicts
+  double attack_seconds = 0.0;
+};
+
+std::string SummaryText(const Settings& settings, const Summary& s) {
+  std::ostringstream out;
+  out.precision(3);
+  out << "engine agreement: seed " << settings.seed << ", systems " << settings.first << ".."
+      << settings.first + settings.systems - 1 << ": " << s.systems << " checked, " << s.properties
+      << " properties\n  conflicting systems refused:";
+  int refused = 0;
+  for (const auto& [kind, n] : s.refused) {
+    out << " " << kind << " " << n << ";";
+    refused += n;
+  }
+  out << " (" << refused << ")\n";
+  for (const auto& [engine, counts] : s.verdicts) {
+    int definite = 0;
+    out << "  " << engine << ":";
+    for (const auto& [verdict, n] : counts) {
+      out << " " << verdict << " " << n << ";";
+      if (verdict != "unknown") definite += n;
+    }
+    out << " definite " << definite << "; " << s.seconds.at(engine) << " s\n";
+  }
+  out << "  reach outside its class (not linear): " << s.reach_outside_class
+      << "; sample refused models without runs: " << s.sample_refused << "\n"
+      << "  claims attacked " << s.claims << ", attacks " << s.attacks << " (" << s.rejected
+      << " refused by the model, " << s.outside
+      << " cut at a state outside the invariants), states checked " << s.states << "\n"
+      << "  traces replayed: ReplayTrace " << s.replays << ", from model text " << s.text_replays
+      << " (" << s.boundary_witnesses << " of them reach witnesses within the tolerance only)"
+      << "\n  properties with agreeing definite verdicts of two engines " << s.agreements
+      << "\n  contradictions " << s.contradictions.size() << ", disagreements "
+      << s.disagreements.size() << " (" << s.boundary_disagreements
+      << " with witnesses within the tolerance only)"
+      << ", trace failures " << s.trace_failures.size() << ", other failures "
+      << s.other_failures.size() << "\n  attacks and replays " << s.attack_seconds << " s\n";
+  return out.str();
+}
+
+// ---- concrete runs, written back as model text ----
+
+/// The choices that make a run of a system concrete.
+struct RunChoices {
+  std::map<std::string, double> parameters;      // uncertain parameters, by system name
+  std::vector<int> inits;                        // the init declaration of each instance
+  std::map<std::string, double> initial_values;  // by system variable name
+  ht::RandomScenario scenario;                   // inputs by system name
+  std::vector<bool> lazy_choices;                // per instance: urgent copies of lazy jumps
+  std::vector<ScheduledJump> schedule;           // a trace's lazy jumps
+  std::vector<double> sample_times;              // input breakpoints and other times to record
+  std::string note;
+};
+
+/// `s` as a concrete run: one automaton per instance (zz_run_K), with the run's parameter values
+/// as nominal values and its chosen init declaration alone, its initial values as points; the
+/// inputs as the scenario. `print` receives the print options of each automaton.
+RandomSystem ConcreteSystem(const RandomSystem& s, const RunChoices& c,
+                            std::vector<ht::PrintOptions>& print) {
+  RandomSystem out = s;
+  out.properties.clear();
+  out.automata.clear();
+  print.clear();
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    ht::RandomHybridAutomaton a = s.automata[s.instances[k].automaton];
+    a.name = "zz_run_" + std::to_string(k);
+    for (ht::RandomParameter& p : a.parameters) {
+      const auto it = c.parameters.find(s.SystemName(k, p.name));
+      if (it != c.parameters.end() && p.range) p.nominal = it->second;
+    }
+    a.inits = {a.inits.at(c.inits.at(k))};
+    for (auto& [v, range] : a.inits.front().values) {
+      const auto it = c.initial_values.find(s.SystemName(k, v));
+      if (it != c.initial_values.end()) range = {it->second, it->second};
+    }
+    out.instances[k].automaton = k;
+    out.automata.push_back(a);
+    ht::PrintOptions options;
+    options.lazy_choices = c.lazy_choices.at(k);
+    options.explicit_rates = true;
+    print.push_back(options);
+  }
+  out.scenario = c.scenario;
+  return out;
+}
+
+/// A step signal over [0, until] of 1 to 6 pieces with values at the bounds' ends, at 0 (when
+/// admitted) or uniform in the bounds.
+std::vector<std::pair<double, double>> DrawSignal(Rng& rng, double lo, double hi, double until) {
+  std::vector<double> times = {0.0};
+  const int pieces = ht::UniformInt(rng, 1, 6);
+  for (int i = 1; i < pieces; ++i) times.push_back(ht::UniformReal(rng, 0.0, until));
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  std::vector<std::pair<double, double>> points;
+  for (double t : times) {
+    const int kind = ht::UniformInt(rng, 0, 99);
+    const double v = kind < 30   ? lo
+                     : kind < 60 ? hi
+                     : kind < 75 ? std::clamp(0.0, lo, hi)
+                                 : ht::UniformReal(rng, lo, hi);
+    points.emplace_back(t, std::clamp(v, lo, hi));
+  }
+  return points;
+}
+
+/// Pulses of 1 on a lazy transition's choice input (or none).
+std::vector<std::pair<double, double>> DrawChoice(Rng& rng, double until) {
+  std::vector<std::pair<double, double>> points = {{0.0, 0.0}};
+  if (ht::RandomChance(rng, 40)) return points;
+  std::vector<double> times;
+  for (int i = ht::UniformInt(rng, 1, 3) * 2; i > 0; --i) {
+    times.push_back(ht::UniformReal(rng, 0.0, until));
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    if (times[i] == 0.0) points.clear();
+    points.emplace_back(times[i], i % 2 == 0 ? 1.0 : 0.0);
+  }
+  return points;
+}
+
+double DrawInRange(Rng& rng, double lo, double hi, double nominal) {
+  const int kind = ht::UniformInt(rng, 0, 99);
+  if (kind < 25) return nominal;
+  if (kind < 45) return lo;
+  if (kind < 65) return hi;
+  return std::clamp(ht::UniformReal(rng, lo, hi), lo, hi);
+}
+
+/// The variables of `a` that have a rectangular rate in some mode.
+std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
+  std::set<std::string> out;
+  for (const ht::RandomMode& m : a.modes) {
+    for (const ht::RandomRate& r : m.rates) out.insert(r.variable);
+  }
+  return out;
+}
+
+/// Random values for the uncertain parameters and a random start (init declaration per instance,
+/// values in its boxes), each system name drawn once.
+void DrawStart(const RandomSystem& s, Rng& rng, RunChoices& c) {
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    const ht::RandomHybridAutomaton& a = s.automata[s.instances[k].automaton];
+    for (const ht::RandomParameter& p : a.parameters) {
+      if (p.range && !c.parameters.count(s.SystemName(k, p.name))) {
+        c.parameters[s.SystemName(k, p.name)] =
+            DrawInRange(rng, p.range->first, p.range->second, p.nominal);
+      }
+    }
+    c.inits.push_back(ht::UniformInt(rng, 0, static_cast<int>(a.inits.size()) - 1));
+    for (const auto& [v, range] : a.inits[c.inits.back()].values) {
+      if (!c.initial_values.count(s.SystemName(k, v))) {
+        c.initial_values[s.SystemName(k, v)] =
+            DrawInRange(rng, range.first, range.second, range.first);
+      }
+    }
+  }
+}
+
+/// A random run of `s` for an attack.
+RunChoices DrawAttack(const RandomSystem& s, Rng& rng) {
+  RunChoices c;
+  DrawStart(s, rng, c);
+  ht::RandomScenario& sc = c.scenario;
+  sc.until = ht::UniformInt(rng, 5, 300) / 10.0;
+  std::set<std::string> driven;
+  const auto drive = [&](const std::string& name, std::vector<std::pair<double, double>> points) {
+    if (driven.insert(name).second) sc.steps.emplace_back(name, std::move(points));
+  };
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    const ht::RandomHybridAutomaton& a = s.automata[s.instances[k].automaton];
+    for (const ht::RandomInput& in : a.inputs) {
+      drive(s.SystemName(k, in.name), DrawSignal(rng, in.lo, in.hi, sc.until));
+    }
+    const bool lazy = std::any_of(a.transitions.begin(), a.transitions.end(), [](const auto& t) {
+      return t.urgency == ht::RandomTransition::Urgency::kLazy;
+    });
+    c.lazy_choices.push_back(lazy && ht::RandomChance(rng, 60));
+    for (int t = 0; c.lazy_choices.back() && t < static_cast<int>(a.transitions.size()); ++t) {
+      if (a.transitions[t].urgency != ht::RandomTransition::Urgency::kLazy) continue;
+      drive(s.SystemName(k, ht::LazyChoiceInput(t)), DrawChoice(rng, sc.until));
+    }
+    for (const std::string& v : RatedVariables(a)) {
+      drive(s.SystemName(k, ht::RateInput(v)), DrawSignal(rng, 0.0, 1.0, sc.until));
+    }
+  }
+  for (const auto& [name, points] : sc.steps) {
+    for (const auto& [t, v] : points) c.sample_times.push_back(t);
+  }
+  c.note = "random attack";
+  return c;
+}
+
+/// A simulation of a concrete run.
+struct Simulation {
+  std::string text;
+  std::optional<Simulator> simulator;
+  SimulationResult result;
+  double sample_step = 0.0;
+  std::map<std::string, double> parameters;  // every parameter's value, by system name
+  std::string error;                         // the model or the simulator refused the run
+};
+
+/// Whether the simulator numbers the modes of every instance as `s` declares them.
+std::string ModeNumberingProblem(const RandomSystem& s, const Simulator& sim) {
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    const auto& modes = s.automata[s.instances[k].automaton].modes;
+    for (int m = 0; m < static_cast<int>(modes.size()); ++m) {
+      if (sim.ModeName(k, m) != s.ModeName(k, modes[m].name)) {
+        return "mode " + std::to_string(m) + " of instance " + std::to_string(k) + " is '" +
+               sim.ModeName(k, m) + "', not '" + s.ModeName(k, modes[m].name) + "'";
+      }
+    }
+  }
+  return "";
+}
+
+Simulation Simulate(const RandomSystem& s, const RunChoices& c) {
+  Simulation out;
+  std::vector<ht::PrintOptions> print;
+  const RandomSystem concrete = ConcreteSystem(s, c, print);
+  out.text = concrete.Text(print);
+  out.parameters = ht::SystemParameterValues(s, c.parameters);
+  try {
+    const System system = ParseModel(out.text, "run.ha");
+    out.simulator.emplace(system);
+    out.error = ModeNumberingProblem(s, *out.simulator);
+    if (!out.error.empty()) return out;
+    SimulationOptions options;
+    out.sample_step = c.scenario.until / 256;
+    options.sample_step = out.sample_step;
+    std::vector<double> times;
+    for (double t : c.sample_times) {
+      if (t >= 0 && t <= c.scenario.until) times.push_back(t);
+    }
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    options.sample_times = times;
+    options.lazy_schedule = c.schedule;
+    out.result = out.simulator->Run(options);
+  } catch (const std::exception& e) {
+    out.error = e.what();
+    out.simulator.reset();
+  }
+  return out;
+}
+
+/// The values (variables, parameters, discrete variables; system names) at recorded state `x`.
+std::map<std::string, double> StateValues(const RandomSystem& s, const Simulation& sim,
+                                          const StateSample& x) {
+  std::map<std::string, double> values = sim.parameters;
+  const auto& names = sim.simulator->variable_names();
+  for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = x.x[static_cast<int>(i)];
+  ht::AddDiscreteValues(s, x.modes, values);
+  return values;
+}
+
+std::string StateText(const Simulator& sim, const StateSample& x) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "t = " << x.time << " in " << sim.ModeLabel(x.modes) << ":";
+  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
+    out << " " << sim.variable_names()[i] << " = " << x.x[static_cast<int>(i)] << ";";
+  }
+  return out.str();
+}
+
+/// The events of a run up to state `index` (all if negative), that state, and the run's text.
+std::string RunText(const Simulation& sim, int index) {
+  std::ostringstream out;
+  out.precision(17);
+  const SimulationResult& r = sim.result;
+  out << "  simulation status: " << StatusName(r.status)
+      << (r.message.empty() ? "" : " (" + r.message + ")") << "\n";
+  const double until = index >= 0 ? r.samples[index].time : INFINITY;
+  std::size_t shown = 0;
+  while (shown < r.events.size() && r.events[shown].time <= until) ++shown;
+  for (std::size_t i = 0; i < shown; ++i) {
+    if (i == 20 && shown > 30) {
+      out << "  ... " << shown - 25 << " more events ...\n";
+      i = shown - 5;
+    }
+    const EventRecord& e = r.events[i];
+    std::string names;
+    for (const std::string& n : e.transitions) names += (names.empty() ? "" : "+") + n;
+    out << "  event t = " << e.time << ": " << names << " ("
+        << sim.simulator->ModeLabel(e.modes_before) << " -> "
+        << sim.simulator->ModeLabel(e.modes_after) << ")\n";
+  }
+  if (index >= 0) out << "  state: " << StateText(*sim.simulator, r.samples[index]) << "\n";
+  out << "  replay: save the text below as run.ha and run `hybrid simulate run.ha --sample "
+      << sim.sample_step << "`\n--- run.ha ---\n"
+      << sim.text;
+  return out.str();
+}
+
+// ---- judging states ----
+
+/// Whether a state refutes the claim `verdict` about `p` (proved invariant, unreachable target).
+bool Refutes(const RandomProperty& p, Verdict verdict, const std::map<std::string, double>& values,
+             const std::set<std::string>& modes) {
+  using K = RandomProperty::Kind;
+  if (verdict == Verdict::kProved && p.kind == K::kAlways) {
+    return !ht::HoldsInModes(p.predicate, values, modes, kTolerance);
+  }
+  if (verdict == Verdict::kProved && p.kind == K::kNever) {
+    return ht::HoldsInModes(p.predicate, values, modes, -kTolerance);
+  }
+  if (verdict == Verdict::kUnreachable && p.kind == K::kReach) {
+    return ht::HoldsInModes(p.predicate, values, modes, -kTolerance);
+  }
+  return false;
+}
+
+/// Whether a state confirms `violated` (always, never) or `reachable` (reach): a `reach` target
+/// within the tolerance, as the engines' replays read it.
+bool Confirms(const RandomProperty& p, const std::map<std::string, double>& values,
+              const std::set<std::string>& modes) {
+  switch (p.kind) {
+    case RandomProperty::Kind::kAlways:
+      return !ht::HoldsInModes(p.predicate, values, modes, kConfirmTolerance);
+    case RandomProperty::Kind::kNever:
+      return ht::HoldsInModes(p.predicate, values, modes, -kConfirmTolerance);
+    case RandomProperty::Kind::kReach:
+      return ht::HoldsInModes(p.predicate, values, modes, kTolerance);
+  }
+  return false;
+}
+
+/// Whether a state confirms `violated` or `reachable` with margin (a `reach` target included).
+bool ClearlyConfirms(const RandomProperty& p, const std::map<std::string, double>& values,
+                     const std::set<std::string>& modes) {
+  if (p.kind != RandomProperty::Kind::kReach) return Confirms(p, values, modes);
+  return ht::HoldsInModes(p.predicate, values, modes, -kConfirmTolerance);
+}
+
+/// A recorded state of a run, as the generator's evaluator reads it.
+struct ModelState {
+  int index = 0;  // into the run's samples
+  double time = 0.0;
+  std::map<std::string, double> values;  // variables, parameters, discrete variables
+  std::set<std::string> modes;           // system names of the instances' modes
+};
+
+/// The recorded states of `sim` up to the first one outside its modes' invariants (`*outside`
+/// then): the simulator records the state a jump leads to even when it breaks the target mode's
+/// invariant, and such a state is no state of the model, nor what it records after it.
+std::vector<ModelState> ModelStates(const RandomSystem& s, const Simulation& sim, bool* outside) {
+  std::vector<ModelState> out;
+  const auto& samples = sim.result.samples;
+  for (int j = 0; j < static_cast<int>(samples.size()); ++j) {
+    ModelState x{j, samples[j].time, StateValues(s, sim, samples[j]),
+                 ht::ModeNames(s, samples[j].modes)};
+    if (!ht::InsideInvariants(s, samples[j].modes, x.values, kTolerance)) {
+      *outside = true;
+      break;
+    }
+    out.push_back(std::move(x));
+  }
+  return out;
+}
+
+// ---- one system ----
+
+/// What every engine said about one system.
+struct Verdicts {
+  const RandomSystem* model = nullptr;
+  std::string label;
+  std::vector<EngineRun> runs;
+};
+
+std::string VerdictsText(const Verdicts& v, int property) {
+  std::ostringstream out;
+  out << "property: " << v.model->PropertyText(property) << "\n";
+  for (const EngineRun& run : v.runs) {
+    if (!run.errors[property].empty()) {
+      out << "  " << run.engine << ": threw: " << run.errors[property] << "\n";
+      continue;
+    }
+    const CheckResult& r = run.results[property];
+    out << "  " << run.engine << ": " << VerdictText(r.verdict) << " (" << r.reason << ")\n";
+  }
+  return out.str();
+}
+
+std::string Header(const std::string& what, const Verdicts& v, int property) {
+  return "=== " + what + " (" + v.label + ") ===\n" + VerdictsText(v, property) +
+         "--- model ---\n" + v.model->Text();
+}
+
+// ---- traces ----
+
+/// Whether `x` lies in [lo, hi] up to a relative 1e-9.
+bool Within(double x, double lo, double hi) {
+  return x >= lo - 1e-9 * (1 + std::abs(lo)) && x <= hi + 1e-9 * (1 + std::abs(hi));
+}
+
+/// The system name of the explicit rate input (PrintOptions::explicit_rates) that stands for
+/// the rate input `name` (`A.x'`) of a trace, or "" if `name` is none.
+std::string ExplicitRateInput(const RandomSystem& s, const std::string& name) {
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    for (const std::string& v : RatedVariables(s.automata[s.instances[k].automaton])) {
+      if (s.SystemName(k, v + "'") == name || s.SystemName(k, v) + "'" == name) {
+        return s.SystemName(k, ht::RateInput(v));
+      }
+    }
+  }
+  return "";
+}
+
+/// The trace's inputs as the choices' scenario: a rate input w in [-1, 1] (rate
+/// (lo + hi)/2 + (hi - lo)/2 w) becomes the explicit rate input at (w + 1) / 2 (rate
+/// lo + (hi - lo) z); rate inputs the trace does not drive are 0, the midpoint.
+void TraceInputs(const RandomSystem& s, const System& system, const Trace& t, RunChoices& c,
+                 std::string& problem) {
+  c.scenario.until = t.inputs.until;
+  std::set<std::string> driven;
+  for (const InputSignal& signal : t.inputs.inputs) {
+    if (signal.shape != InputSignal::Shape::kStep) problem += "a signal is not a step; ";
+    const std::string& name = system.symbols()[signal.slot].name;
+    std::vector<std::pair<double, double>> points = signal.points;
+    std::string input = name;
+    if (!name.empty() && name.back() == '\'') {
+      input = ExplicitRateInput(s, name);
+      if (input.empty()) problem += "unknown rate input '" + name + "'; ";
+      for (auto& [time, w] : points) w = (w + 1) / 2;
+    }
+    driven.insert(input);
+    c.scenario.steps.emplace_back(input, points);
+    for (const auto& [time, value] : points) c.sample_times.push_back(time);
+  }
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    for (const std::string& v : RatedVariables(s.automata[s.instances[k].automaton])) {
+      const std::string input = s.SystemName(k, ht::RateInput(v));
+      if (driven.insert(input).second) {
+        c.scenario.steps.emplace_back(input, std::vector<std::pair<double, double>>{{0.0, 0.5}});
+      }
+    }
+  }
+  c.schedule = t.schedule;  // the concrete text keeps every transition's index
+  for (const ScheduledJump& j : t.schedule) c.sample_times.push_back(j.time);
+  if (t.state_index >= 0 && t.state_index < static_cast<int>(t.run.samples.size())) {
+    c.sample_times.push_back(t.run.samples[t.state_index].time);
+  }
+}
+
+/// Checks that the trace's parameter values and initial values are admitted by the model.
+void CheckTraceStart(const RandomSystem& s, const RunChoices& c, std::string& problem) {
+  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
+    const ht::RandomHybridAutomaton& a = s.automata[s.instances[k].automaton];
+    for (const ht::RandomParameter& p : a.parameters) {
+      const auto it = c.parameters.find(s.SystemName(k, p.name));
+      if (it == c.parameters.end()) continue;
+      if (!p.range || !Within(it->second, p.range->first, p.range->second)) {
+        problem += "parameter " + it->first + " = " + ht::DecimalText(it->second) +
+                   " is no value of an uncertain parameter; ";
+      }
+    }
+    for (const auto& [v, range] : a.inits.at(c.inits.at(k)).values) {
+      const auto it = c.initial_values.find(s.SystemName(k, v));
+      if (it != c.initial_values.end() && !Within(it->second, range.first, range.second)) {
+        problem += "initial value " + it->first + " = " + ht::DecimalText(it->second) +
+                   " lies outside init " + std::to_string(c.inits[k]) + " of instance " +
+                   std::to_string(k) + "; ";
+      }
+    }
+  }
+}
+
+/// The run a trace describes, as choices over system names. `problem` collects what makes the
+/// trace no run of the model.
+RunChoices TraceChoices(const RandomSystem& s, const System& system, const Trace& t,
+                        std::string& problem) {
+  RunChoices c;
+  c.note = "the engine's trace";
+  c.inits.assign(s.instances.size(), 0);
+  c.lazy_choices.assign(s.instances.size(), false);
+  for (const auto& [component, index] : t.initial_states) {
+    if (component < 0 || component >= static_cast<int>(s.instances.size()) || index < 0 ||
+        index >= static_cast<int>(s.automata[s.instances[component].automaton].inits.size())) {
+      problem += "init " + std::to_string(index) + " of component " + std::to_string(component) +
+                 " does not exist; ";
+      continue;
+    }
+    c.inits[component] = index;
+  }
+  for (const auto& [name, v] : t.parameters) c.parameters[name] = v;
+  for (const auto& [name, v] : t.initial_values) c.initial_values[name] = v;
+  CheckTraceStart(s, c, problem);
+  TraceInputs(s, system, t, c, problem);
+  return c;
+}
+
+/// Checks the trace of a `violated` or `reachable` verdict of `engine` on property `i`: present,
+/// confirmed by ReplayTrace, and, replayed from model text, reaching the violation (target) by
+/// the generator's evaluator. Returns true for a `reach` witness that meets its target only
+/// within the tolerance (a state on the boundary of a strict comparison, say), false otherwise.
+bool CheckTrace(const Verdicts& v, const System& system, const Property& property, int i,
+                const EngineRun& run, Summary& s) {
+  const RandomSystem& model = *v.model;
+  const CheckResult& r = run.results[i];
+  const std::string what = "`" + VerdictText(r.verdict) + "` of " + run.engine;
+  if (!r.trace) {
+    s.trace_failures.push_back(Header(what + " WITHOUT A TRACE", v, i));
+    return false;
+  }
+  Trace copy = *r.trace;
+  std::string replay_error;
+  bool replayed = false;
+  try {
+    replayed = ReplayTrace(system, property, copy);
+  } catch (const std::exception& e) {
+    replay_error = e.what();
+  }
+  if (!replayed) {
+    s.trace_failures.push_back(Header(what + ": ReplayTrace DOES NOT CONFIRM THE TRACE", v, i) +
+                               replay_error + "\n");
+    return false;
+  }
+  ++s.replays;
+  std::string problem;
+  const RunChoices c = TraceChoices(model, system, *r.trace, problem);
+  const Simulation sim = Simulate(model, c);
+  if (!problem.empty() || !sim.error.empty()) {
+    s.trace_failures.push_back(Header(what + ": THE TRACE IS NO RUN OF THE MODEL", v, i) +
+                               "--- problem ---\n" + problem + sim.error + "\n--- run ---\n" +
+                               sim.text);
+    return false;
+  }
+  bool outside = false, confirmed = false;
+  const RandomProperty& p = model.properties[i];
+  for (const ModelState& x : ModelStates(model, sim, &outside)) {
+    if (p.within && x.time > *p.within) break;
+    confirmed = confirmed || Confirms(p, x.values, x.modes);
+    if (ClearlyConfirms(p, x.values, x.modes)) {
+      ++s.text_replays;
+      return false;
+    }
+  }
+  if (confirmed) {  // a witness within the tolerance of the target only: noted, not a failure
+    ++s.text_replays;
+    ++s.boundary_witnesses;
+    return true;
+  }
+  s.trace_failures.push_back(
+      Header(what + ": THE TRACE DOES NOT REPLAY FROM MODEL TEXT", v, i) +
+      (outside ? "(the replay leaves its modes' invariants before it gets there)\n" : "") +
+      "--- replay ---\n" + RunText(sim, -1));
+  return false;
+}
+
+// ---- attacks on claims ----
+
+/// A `proved` or `unreachable` claim about property `property`, and the engines that made it.
+struct Claim {
+  int property = 0;
+  Verdict verdict = Verdict::kUnknown;
+  std::vector<std::string> engines;
+};
+
+std::vector<Claim> ClaimsOf(const Verdicts& v) {
+  std::vector<Claim> claims;
+  for (int i = 0; i < static_cast<int>(v.model->properties.size()); ++i) {
+    Claim c;
+    c.property = i;
+    for (const EngineRun& run : v.runs) {
+      if (!run.errors[i].empty() || !Negative(run.results[i].verdict)) continue;
+      c.verdict = run.results[i].verdict;
+      c.engines.push_back(run.engine);
+    }
+    if (!c.engines.empty()) claims.push_back(c);
+  }
+  return claims;
+}
+
+/// Attacks every claim with `attacks` random simulations; each claim is reported at its first
+/// contradiction.
+void AttackClaims(const Verdicts& v, std::vector<Claim> open, int attacks, Rng& rng, Summary& s) {
+  const RandomSystem& model = *v.model;
+  s.claims += static_cast<int>(open.size());
+  for (int k = 0; k < attacks && !open.empty(); ++k) {
+    const RunChoices c = DrawAttack(model, rng);
+    const Simulation sim = Simulate(model, c);
+    ++s.attacks;
+    if (!sim.error.empty()) {
+      ++s.rejected;
+      if (sim.error.find("initial state") != std::string::npos) continue;  // no run
+      // A run of the model that its own text refuses (reported once per system): a bug of the
+      // test, or a model the IR accepts although one of its runs gives a symbol two meanings.
+      const bool shared_parameter = sim.error.find("shared parameter") != std::string::npos;
+      s.other_failures.push_back(
+          "=== A RUN OF THE MODEL IS REFUSED (" + v.label + "): " + sim.error + " ===\n" +
+          (shared_parameter ? "(the model shares a parameter whose definition reads parameters "
+                              "of each instance: its instances give it different values)\n"
+                            : "") +
+          "--- model ---\n" + model.Text() + "--- run ---\n" + sim.text);
+      break;
+    }
+    bool outside = false;
+    const std::vector<ModelState> states = ModelStates(model, sim, &outside);
+    s.outside += outside ? 1 : 0;
+    for (const ModelState& x : states) {
+      ++s.states;
+      for (auto it = open.begin(); it != open.end();) {
+        const RandomProperty& p = model.properties[it->property];
+        if ((p.within && x.time > *p.within) || !Refutes(p, it->verdict, x.values, x.modes)) {
+          ++it;
+          continue;
+        }
+        std::string engines;
+        for (const std::string& e : it->engines) engines += (engines.empty() ? "" : ", ") + e;
+        s.contradictions.push_back(Header("CONTRADICTION: `" + VerdictText(it->verdict) + "` of " +
+                                              engines + " refuted by a simulation",
+                                          v, it->property) +
+                                   "--- counterexample: " + c.note + " ---\n" +
+                                   RunText(sim, x.index));
+        it = open.erase(it);
+      }
+    }
+  }
+}
+
+// ---- comparing engines ----
+
+/// Counts every verdict, checks that each fits its property's kind and engine, and reports
+/// properties on which two engines give opposite definite verdicts.
+void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, int>>& boundary,
+                     Summary& s) {
+  for (int i = 0; i < static_cast<int>(v.model->properties.size()); ++i) {
+    const bool reach = v.model->properties[i].kind == RandomProperty::Kind::kReach;
+    std::vector<std::string> positive, negative;
+    for (const EngineRun& run : v.runs) {
+      if (!run.errors[i].empty()) {
+        ++s.verdicts[run.engine]["threw"];
+        s.other_failures.push_back(Header(run.engine + " THREW", v, i));
+        continue;
+      }
+      const CheckResult& r = run.results[i];
+      if (r.reason.rfind(kSampleRefused, 0) == 0) ++s.sample_refused;
+      ++s.verdicts[run.engine][VerdictText(r.verdict)];
+      if (run.engine == "reach" && r.verdict == Verdict::kUnknown &&
+          r.reason.find("not a linear") != std::string::npos) {
+        ++s.reach_outside_class;
+      }
+      const bool fits = r.verdict == Verdict::kUnknown ||
+                        (reach ? (r.verdict == Verdict::kReachable ||
+                                  (r.verdict == Verdict::kUnreachable && run.engine != "sample"))
+                               : (r.verdict == Verdict::kViolated ||
+                                  (r.verdict == Verdict::kProved && run.engine != "sample")));
+      if (!fits) s.other_failures.push_back(Header("VERDICT OF THE WRONG KIND", v, i));
+      if (Positive(r.verdict)) positive.push_back(run.engine);
+      if (Negative(r.verdict)) negative.push_back(run.engine);
+    }
+    if (!positive.empty() && !negative.empty()) {
+      const bool at_boundary = std::all_of(positive.begin(), positive.end(), [&](const auto& e) {
+        return boundary.count({e, i}) > 0;
+      });
+      s.disagreements.push_back(Header(
+          "DISAGREEMENT: " + negative.front() + " vs " + positive.front() +
+              (at_boundary ? " (the witnesses meet the target within the tolerance only)" : ""),
+          v, i));
+      s.boundary_disagreements += at_boundary ? 1 : 0;
+    } else if (positive.size() + negative.size() >= 2) {
+      ++s.agreements;
+    }
+  }
+}
+
+/// The system's properties as the engines see them, in the order of model.properties.
+std::optional<std::vector<Property>> PropertiesOf(const RandomSystem& model, const System& system,
+                                                  std::string& problem) {
+  std::vector<Property> out;
+  for (const RandomProperty& p : model.properties) {
+    const auto it = std::find_if(system.properties().begin(), system.properties().end(),
+                                 [&](const Property& q) { return q.name == p.name; });
+    if (it == system.properties().end()) {
+      problem = "no property '" + p.name + "' in the parsed system";
+      return std::nullopt;
+    }
+    out.push_back(*it);
+  }
+  return out;
+}
+
+/// Parses a conflicting system, which must be refused with its conflict's message.
+void CheckRefused(const RandomSystem& model, const std::string& label, Summary& s) {
+  const std::string text = model.Text();
+  std::string message;
+  try {
+    ParseModel(text, "conflict.ha");
+  } catch (const ParseError& e) {
+    message = e.what();
+  }
+  const std::string kind = ht::ConflictName(model.conflict) + " (" + model.conflict_via + ")";
+  if (message.find(model.conflict_message) == std::string::npos) {
+    s.other_failures.push_back("=== CONFLICTING SYSTEM NOT REFUSED AS EXPECTED (" + label + ", " +
+                               kind + ": expected a message with '" + model.conflict_message +
+                               "', got '" + message + "') ===\n" + text);
+    return;
+  }
+  ++s.refused[kind];
+}
+
+/// Checks one system with every engine, then confirms every trace, attacks every claim and
+/// compares the engines' verdicts.
+void CheckSystem(const RandomSystem& model, const std::string& label, int attacks, Rng& rng,
+                 Summary& s) {
+  ++s.systems;
+  if (model.conflict != ht::RandomConflict::kNone) {
+    CheckRefused(model, label, s);
+    return;
+  }
+  const std::string text = model.Text();
+  std::optional<System> system;
+  std::string problem;
+  std::optional<std::vector<Property>> properties;
+  try {
+    system.emplace(ParseModel(text, "system.ha"));
+    properties = PropertiesOf(model, *system, problem);
+  } catch (const std::exception& e) {
+    problem = e.what();
+  }
+  if (!properties) {
+    s.other_failures.push_back("=== GENERATED SYSTEM DOES NOT PARSE (" + label + "): " + problem +
+                               " ===\n" + text);
+    return;
+  }
+  s.properties += static_cast<int>(properties->size());
+  Verdicts v{&model, label, {}};
+  for (const auto& [name, engine] : Engines()) {
+    v.runs.push_back(RunEngine(name, engine, *system, *properties));
+    s.seconds[name] += v.runs.back().seconds;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::set<std::pair<std::string, int>> boundary;  // (engine, property): boundary witnesses
+  for (const EngineRun& run : v.runs) {
+    for (int i = 0; i < static_cast<int>(properties->size()); ++i) {
+      if (Positive(run.results[i].verdict) && CheckTrace(v, *system, (*properties)[i], i, run, s))
+        boundary.emplace(run.engine, i);
+    }
+  }
+  CompareVerdicts(v, boundary, s);
+  AttackClaims(v, ClaimsOf(v), attacks, rng, s);
+  s.attack_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Reports every failure of `s` (each printed in full).
+void ReportFailures(const Summary& s) {
+  for (const auto* list :
+       {&s.contradictions, &s.disagreements, &s.trace_failures, &s.other_failures}) {
+    for (const std::string& f : *list) ADD_FAILURE() << f;
+  }
+}
+
+// ---- tests of the test ----
+
+/// What `name` is in automaton `a`: "variable", "input", "parameter", "discrete" or "label".
+std::string KindOf(const ht::RandomHybridAutomaton& a, const std::string& name) {
+  for (const auto& v : a.variables) {
+    if (v.name == name) return "variable";
+  }
+  for (const auto& in : a.inputs) {
+    if (in.name == name) return "input";
+  }
+  for (const auto& p : a.parameters) {
+    if (p.name == name) return "parameter";
+  }
+  for (const auto& d : a.discretes) {
+    if (d == name) return "discrete";
+  }
+  return "label";
+}
+
+/// Counts the features of automaton `a` (instance k of `model`) in `seen`.
+void CountAutomatonFeatures(const ht::RandomHybridAutomaton& a, std::map<std::string, int>& seen) {
+  using R = ht::RandomRelation;
+  const auto strict = [](const ht::RandomComparison& c) {
+    return c.relation == R::kLess || c.relation == R::kGreater;
+  };
+  for (const ht::RandomParameter& p : a.parameters) {
+    if (p.range) ++seen["uncertain parameter"];
+    if (p.definition) ++seen["derived parameter"];
+  }
+  if (!a.discretes.empty()) ++seen["discrete variable"];
+  if (a.inits.size() > 1) ++seen["two init declarations"];
+  for (const ht::RandomMode& m : a.modes) {
+    if (std::any_of(m.invariant.begin(), m.invariant.end(), strict)) ++seen["strict invariant"];
+    if (!m.rates.empty()) ++seen["rectangular rate"];
+  }
+  for (const ht::RandomTransition& t : a.transitions) {
+    if (std::any_of(t.guard.begin(), t.guard.end(), strict)) ++seen["strict guard"];
+    ++seen[t.urgency == ht::RandomTransition::Urgency::kLazy ? "lazy" : "urgent"];
+  }
+}
+
+/// The instances (system names' prefixes) whose modes `p` reads, and whether it compares with ==.
+void CountPredicateFeatures(const ht::RandomPredicate& p, std::set<std::string>& instances,
+                            std::map<std::string, int>& seen) {
+  if (p.kind == ht::RandomPredicate::Kind::kInMode) {
+    instances.insert(p.mode.substr(0, p.mode.find('.')));
+  } else if (p.kind == ht::RandomPredicate::Kind::kComparison &&
+             p.comparison.relation == ht::RandomRelation::kEqual) {
+    ++seen["discrete == in a property"];
+  }
+  for (const ht::RandomPredicate& q : p.operands) CountPredicateFeatures(q, instances, seen);
+}
+
+/// Counts the features of `model` in `seen`: how its instances connect and what they use.
+void CountFeatures(const RandomSystem& model, std::map<std::string, int>& seen) {
+  const int n = static_cast<int>(model.instances.size());
+  ++seen[std::to_string(n) + " instances"];
+  std::map<std::string, std::set<int>> symbol_users, label_users;  // system name -> instances
+  std::map<std::string, std::string> kinds;
+  for (int k = 0; k < n; ++k) {
+    const ht::RandomInstance& in = model.instances[k];
+    const ht::RandomHybridAutomaton& a = model.automata[in.automaton];
+    if (in.name.empty()) ++seen["unqualified instance"];
+    for (int e = 0; e < k; ++e) {
+      if (model.instances[e].automaton == in.automaton) ++seen["one automaton twice"];
+    }
+    for (const auto& [from, to] : in.binds) ++seen["bound " + KindOf(a, from)];
+    CountAutomatonFeatures(a, seen);
+    for (const ht::RandomTransition& t : a.transitions) {
+      if (!t.label.empty()) label_users[model.SystemName(k, t.label)].insert(k);
+    }
+    for (const std::string& sh : model.shared) {
+      const std::string kind = KindOf(a, sh);
+      if (kind == "label") continue;
+      symbol_users[sh].insert(k);
+      kinds[sh] = kind;
+    }
+  }
+  for (const auto& [name, users] : symbol_users) {
+    if (users.size() > 1) ++seen["shared " + kinds[name]];
+  }
+  for (const auto& [name, users] : label_users) {
+    if (users.size() > 1) ++seen["synchronising label"];
+    if (users.size() > 1 && std::count(model.shared.begin(), model.shared.end(), name) > 0) {
+      ++seen["shared label"];
+    }
+  }
+  for (const RandomProperty& p : model.properties) {
+    ++seen[p.kind == RandomProperty::Kind::kAlways  ? "always"
+           : p.kind == RandomProperty::Kind::kNever ? "never"
+                                                    : "reach"];
+    if (p.within) ++seen["within"];
+    std::set<std::string> instances;
+    CountPredicateFeatures(p.predicate, instances, seen);
+    if (instances.size() > 1) ++seen["modes of two instances in a property"];
+  }
+}
+
+/// Every name of `model` (automata, instances, symbols, labels, modes, transitions, properties).
+void CollectNames(const RandomSystem& model, std::set<std::string>& names) {
+  names.insert(model.name);
+  for (const ht::RandomInstance& in : model.instances) names.insert(in.name);
+  for (const ht::RandomHybridAutomaton& a : model.automata) {
+    names.insert(a.name);
+    for (const auto& v : a.variables) names.insert(v.name);
+    for (const auto& in : a.inputs) names.insert(in.name);
+    for (const auto& p : a.parameters) names.insert(p.name);
+    names.insert(a.discretes.begin(), a.discretes.end());
+    for (const auto& m : a.modes) names.insert(m.name);
+    for (const auto& t : a.transitions) {
+      names.insert(t.name);
+      names.insert(t.label);
+    }
+  }
+  for (const RandomProperty& p : model.properties) names.insert(p.name);
+}
+
+/// What the generator's systems must cover (CountFeatures).
+const char* const kFeatures[] = {"1 instances",
+                                 "2 instances",
+                                 "3 instances",
+                                 "unqualified instance",
+                                 "one automaton twice",
+                                 "shared variable",
+                                 "bound variable",
+                                 "shared input",
+                                 "bound input",
+                                 "shared label",
+                                 "bound label",
+                                 "shared parameter",
+                                 "shared discrete",
+                                 "synchronising label",
+                                 "uncertain parameter",
+                                 "derived parameter",
+                                 "discrete variable",
+                                 "two init declarations",
+                                 "strict invariant",
+                                 "strict guard",
+                                 "lazy",
+                                 "urgent",
+                                 "rectangular rate",
+                                 "always",
+                                 "never",
+                                 "reach",
+                                 "within",
+                                 "discrete == in a property",
+                                 "modes of two instances in a property"};
+
+// The generator's systems parse (and their attack texts too), the conflicting ones are refused
+// with their conflict's message, and they cover what the issue asks for.
+TEST(EngineAgreementTest, GeneratedSystemsParseAndCoverTheFeatures) {
+  std::map<std::string, int> seen;
+  std::set<std::string> names;
+  Summary s;
+  for (int i = 0; i < 1500; ++i) {
+    const RandomSystem model = SystemAt(kDefaultSeed, i);
+    const std::string label = "system " + std::to_string(i);
+    if (model.conflict != ht::RandomConflict::kNone) {
+      CheckRefused(model, label, s);
+      continue;
+    }
+    ASSERT_NO_THROW(ParseModel(model.Text(), "system.ha")) << label << "\n" << model.Text();
+    CountFeatures(model, seen);
+    CollectNames(model, names);
+    if (i < 300) {  // the texts of concrete runs parse too (an initial state may be refused)
+      Rng rng(i);
+      const Simulation sim = Simulate(model, DrawAttack(model, rng));
+      EXPECT_TRUE(sim.error.empty() || sim.error.find("initial state") != std::string::npos)
+          << sim.error << "\n"
+          << sim.text;
+    }
+  }
+  for (const std::string& f : s.other_failures) ADD_FAILURE() << f;
+  std::cout << "features of 1500 systems:";
+  for (const auto& [feature, count] : seen) std::cout << " " << feature << " " << count << ";";
+  std::cout << std::endl;
+  for (const char* feature : kFeatures) EXPECT_GT(seen[feature], 0) << feature;
+  for (const std::string& n : ht::ShortNamePool()) EXPECT_TRUE(names.count(n)) << n;
+  int refused = 0;
+  for (const auto& [kind, count] : s.refused) refused += count;
+  EXPECT_GT(refused, 0);
+}
+
+// Systems given a conflict on purpose are refused at parse, for every kind of conflict, whether
+// the conflicting names are shared or bound.
+TEST(EngineAgreementTest, ConflictingSystemsAreRefused) {
+  Summary s;
+  for (int i = 0; i < 150; ++i) {
+    Rng rng(SystemSeed(kDefaultSeed, i));
+    ht::RandomSystemOptions options;
+    options.conflict_percent = 100;
+    const RandomSystem model = ht::GenerateRandomSystem(rng, options);
+    if (model.conflict != ht::RandomConflict::kNone) {
+      CheckRefused(model, "system " + std::to_string(i), s);
+    }
+  }
+  for (const std::string& f : s.other_failures) ADD_FAILURE() << f;
+  for (auto kind : {ht::RandomConflict::kInitialValue, ht::RandomConflict::kInputBounds,
+                    ht::RandomConflict::kDiscrete, ht::RandomConflict::kResets}) {
+    for (const char* via : {"share", "bind"}) {
+      EXPECT_GT(s.refused[ht::ConflictName(kind) + " (" + via + ")"], 0)
+          << ht::ConflictName(kind) << " " << via;
+    }
+  }
+}
+
+ht::RandomSum Sum(double coef, const std::string& name) { return {{{coef, {name}}}}; }
+
+ht::RandomPredicate Atom(const std::string& name, ht::RandomRelation r, double rhs) {
+  ht::RandomPredicate p;
+  p.comparison = {Sum(1.0, name), r, rhs};
+  return p;
+}
+
+ht::RandomPredicate InMode(const std::string& mode) {
+  ht::RandomPredicate p;
+  p.kind = ht::RandomPredicate::Kind::kInMode;
+  p.mode = mode;
+  return p;
+}
+
+ht::RandomPredicate Both(ht::RandomPredicate a, ht::RandomPredicate b) {
+  ht::RandomPredicate p;
+  p.kind = ht::RandomPredicate::Kind::kAnd;
+  p.operands = {std::move(a), std::move(b)};
+  return p;
+}
+
+/// A handshake: A's clock x runs at q = 2 p (p uncertain in [0.5, 2]); B's urgent transition,
+/// bound to A's lazy one (label A.l), fires with it at t = 2 (y = 2), where x = 4 p, and sets B's
+/// discrete c to 1.
+RandomSystem Handshake() {
+  using R = ht::RandomRelation;
+  ht::RandomHybridAutomaton a;
+  a.name = "ta";
+  a.variables = {{"x", std::nullopt}};
+  a.parameters = {{"p", 1.0, std::make_pair(0.5, 2.0)}, {"q", 2.0, std::nullopt, Sum(2.0, "p")}};
+  a.declaration_order = {{0, 0}, {2, 0}, {2, 1}};
+  a.modes = {{"run", {{"x", Sum(1.0, "q")}}, {{Sum(1.0, "x"), R::kLessEqual, 10.0}}, {}},
+             {"done", {}, {}, {}}};
+  a.transitions = {{"go",
+                    "run",
+                    "done",
+                    {{Sum(1.0, "x"), R::kGreaterEqual, 1.0}},
+                    {},
+                    ht::RandomTransition::Urgency::kLazy,
+                    "l"}};
+  a.inits = {{"run", {{"x", {0.0, 0.0}}}}};
+  ht::RandomHybridAutomaton b;
+  b.name = "tb";
+  b.variables = {{"y", std::nullopt}};
+  b.declaration_order = {{0, 0}};
+  b.discretes = {"c"};
+  b.modes = {{"wait",
+              {{"y", ht::RandomSum{{{1.0, {}}}}}},
+              {{Sum(1.0, "y"), R::kLessEqual, 3.0}},
+              {},
+              {{"c", 0}}},
+             {"fired", {}, {}, {}, {{"c", 1}}}};
+  b.transitions = {{"t", "wait", "fired", {{Sum(1.0, "y"), R::kGreaterEqual, 2.0}}, {}, {}, "k"}};
+  b.inits = {{"wait", {{"y", {0.0, 0.0}}}}};
+  RandomSystem s;
+  s.name = "hs";
+  s.automata = {a, b};
+  s.instances = {{"A", 0, {}}, {"B", 1, {{"k", "A.l"}}}};
+  using K = RandomProperty::Kind;
+  s.properties = {
+      {"fires", K::kNever, Atom("B.c", R::kEqual, 1.0), std::nullopt},
+      {"below7", K::kAlways, Atom("A.x", R::kLessEqual, 7.0), std::nullopt},
+      {"below8", K::kAlways, Atom("A.x", R::kLessEqual, 8.0), std::nullopt},
+      {"early", K::kReach, Both(InMode("A.done"), Atom("B.y", R::kLess, 1.9)), std::nullopt},
+      {"apart", K::kNever, Both(InMode("A.run"), Atom("B.c", R::kEqual, 1.0)), std::nullopt}};
+  return s;
+}
+
+/// A run of one pretend engine that claims `verdicts` (one per property).
+EngineRun Claimed(const std::vector<Verdict>& verdicts) {
+  EngineRun run{"claimed", {}, std::vector<std::string>(verdicts.size()), 0.0};
+  for (Verdict v : verdicts) {
+    CheckResult r;
+    r.verdict = v;
+    r.reason = "claimed by the test";
+    run.results.push_back(r);
+  }
+  return run;
+}
+
+TEST(EngineAgreementTest, HandshakeTextAndEvaluator) {
+  const RandomSystem hs = Handshake();
+  const std::string text = hs.Text();
+  EXPECT_NE(text.find("param q = 2*p;"), std::string::npos) << text;
+  EXPECT_NE(text.find("mode wait (c = 0) {"), std::string::npos) << text;
+  EXPECT_NE(text.find("label l;"), std::string::npos) << text;
+  EXPECT_NE(text.find("instance B = tb { k = A.l; }"), std::string::npos) << text;
+  EXPECT_NE(text.find("property fires: never B.c == 1;"), std::string::npos) << text;
+  EXPECT_EQ(ParseModel(text, "hs.ha").properties().size(), 5u);
+  EXPECT_EQ(ht::SystemParameterValues(hs, {{"A.p", 1.5}}).at("A.q"), 3.0);
+  std::map<std::string, double> values = {{"A.x", 6.0}, {"B.y", 2.0}};
+  ht::AddDiscreteValues(hs, {1, 1}, values);
+  EXPECT_EQ(values.at("B.c"), 1.0);
+  EXPECT_TRUE(
+      ht::HoldsInModes(hs.properties[0].predicate, values, ht::ModeNames(hs, {1, 1}), -kTolerance));
+  EXPECT_FALSE(
+      ht::HoldsInModes(hs.properties[4].predicate, values, ht::ModeNames(hs, {1, 1}), kTolerance));
+}
+
+// The attacks find the handshake's false claims (B fires; x passes 7 when p > 1.75) and leave
+// its true ones alone.
+TEST(EngineAgreementTest, AttacksRefuteFalseClaimsAndSpareTrueOnes) {
+  const RandomSystem hs = Handshake();
+  const Verdicts v{&hs,
+                   "handshake",
+                   {Claimed({Verdict::kProved, Verdict::kProved, Verdict::kProved,
+                             Verdict::kUnreachable, Verdict::kProved})}};
+  Rng rng(5);
+  Summary s;
+  AttackClaims(v, ClaimsOf(v), 40, rng, s);
+  ASSERT_EQ(s.contradictions.size(), 2u) << (s.contradictions.empty() ? "" : s.contradictions[0]);
+  EXPECT_NE(s.contradictions[0].find("never B.c == 1"), std::string::npos) << s.contradictions[0];
+  EXPECT_NE(s.contradictions[1].find("always A.x <= 7"), std::string::npos) << s.contradictions[1];
+  EXPECT_TRUE(s.other_failures.empty()) << s.other_failures[0];
+  EXPECT_GT(s.states, 100);
+}
+
+// A trace must replay, through ReplayTrace and from model text; one that does not is reported.
+TEST(EngineAgreementTest, TracesAreReplayedTwice) {
+  const RandomSystem hs = Handshake();
+  const System system = ParseModel(hs.Text(), "hs.ha");
+  const Property& fires = system.properties()[0];
+  EngineRun run = Claimed({Verdict::kViolated, Verdict::kUnknown, Verdict::kUnknown,
+                           Verdict::kUnknown, Verdict::kUnknown});
+  const Verdicts v{&hs, "handshake", {}};
+  Summary missing;
+  CheckTrace(v, system, fires, 0, run, missing);
+  ASSERT_EQ(missing.trace_failures.size(), 1u);
+  EXPECT_NE(missing.trace_failures[0].find("WITHOUT A TRACE"), std::string::npos);
+  run.results[0].trace.emplace();
+  run.results[0].trace->parameters = {{"A.p", 2.0}};
+  run.results[0].trace->inputs.until = 1.0;  // B fires at t = 2
+  Summary early;
+  CheckTrace(v, system, fires, 0, run, early);
+  ASSERT_EQ(early.trace_failures.size(), 1u);
+  EXPECT_NE(early.trace_failures[0].find("DOES NOT CONFIRM"), std::string::npos);
+  run.results[0].trace->inputs.until = 3.0;
+  Summary genuine;
+  CheckTrace(v, system, fires, 0, run, genuine);
+  EXPECT_TRUE(genuine.trace_failures.empty()) << genuine.trace_failures[0];
+  EXPECT_EQ(genuine.replays, 1);
+  EXPECT_EQ(genuine.text_replays, 1);
+  run.results[0].trace->parameters = {{"A.p", 3.0}};  // outside its range
+  Summary outside;
+  CheckTrace(v, system, fires, 0, run, outside);
+  EXPECT_EQ(outside.trace_failures.size(), 1u);
+}
+
+// The differential test itself (see the file comment): 200 systems in CI; more with
+// HYBRID_AGREEMENT_SYSTEMS (docs/soundness.md, "Engine agreement").
+TEST(EngineAgreementTest, EnginesAgreeOnRandomSystems) {
+  const Settings settings = SettingsFromEnvironment();
+  std::cout << "engine agreement: seed " << settings.seed << " (HYBRID_AGREEMENT_SEED), systems "
+            << settings.systems << " (HYBRID_AGREEMENT_SYSTEMS) from " << settings.first
+            << " (HYBRID_AGREEMENT_FIRST), attacks " << settings.attacks
+            << " (HYBRID_AGREEMENT_ATTACKS)" << std::endl;
+  Summary s;
+  for (int i = 0; i < settings.systems; ++i) {
+    const std::uint64_t index = settings.first + static_cast<std::uint64_t>(i);
+    const RandomSystem model = SystemAt(settings.seed, index);
+    Rng rng(SystemSeed(settings.seed, index) ^ 0x5DEECE66Dull);
+    const std::string label =
+        "seed " + std::to_string(settings.seed) + ", system " + std::to_string(index) +
+        ": HYBRID_AGREEMENT_FIRST=" + std::to_string(index) + " HYBRID_AGREEMENT_SYSTEMS=1";
+    CheckSystem(model, label, settings.attacks, rng, s);
+    if ((i + 1) % 500 == 0) {
+      std::cout << "  ... " << i + 1 << " systems, "
+                << s.contradictions.size() + s.disagreements.size() + s.trace_failures.size() +
+                       s.other_failures.size()
+                << " failures so far" << std::endl;
+    }
+  }
+  std::cout << SummaryText(settings, s) << std::flush;
+  ReportFailures(s);
+}
+
+// ---- reproducers of what the differential test found (disabled until the engines are fixed) ----
+
+/// The results of every engine on every property `text` declares.
+std::map<std::string, std::vector<CheckResult>> CheckEveryEngine(const std::string& text) {
+  const System system = ParseModel(text, "reproducer.ha");
+  const std::vector<Property> properties = DeclaredProperties(system);
+  std::map<std::string, std::vector<CheckResult>> out;
+  for (const auto& [name, engine] : Engines()) {
+    const EngineRun run = RunEngine(name, engine, system, properties);
+    for (const std::string& e : run.errors) EXPECT_EQ(e, "") << name << " threw";
+    out[name] = run.results;
+  }
+  return out;
+}
+
+// prove throws "name 'A.p' has no slot" on a property that reads a variable of one instance and
+// a parameter of another (found as "name 'hi.g' has no slot" on a derived parameter, systems 30,
+// 62, 78, 85, 157, 166 of the default seed). reach proves it; sample finds no counterexample.
+TEST(EngineAgreementTest, DISABLED_ProveReadsAParameterOfAnotherInstance) {
+  const auto r = CheckEveryEngine(R"(
+automaton v {
+  param p = 1;
+  var c;
+  mode k { }
+  init k { c = 0; }
+}
+automaton w {
+  var y;
+  mode m { }
+  init m { y = 0; }
+}
+system sys {
+  instance A = v;
+  instance B = w;
+  property q: always B.y <= A.p;
+}
+)");
+  EXPECT_EQ(VerdictText(r.at("reach")[0].verdict), "proved") << r.at("reach")[0].reason;
+  EXPECT_EQ(VerdictText(r.at("prove")[0].verdict), "proved") << r.at("prove")[0].reason;
+}
+
+// sample reports `reachable` for a target that holds only on the boundary of its strict
+// comparison: x is 1 forever, `reach x < 1` is unreachable (so say prove and reach), yet the
+// sampler's witness is the start x = 1, which ReplayTrace confirms because a `reach` target is
+// read leniently (Predicate::Lenient with +tolerance, trace.cc IsTarget), while ReplayOptions
+// documents that it must hold with margin. Found as 4 disagreements (sample vs reach / prove) on
+// 200 systems of the default seed (systems 17, 18, 40, 194: `reach not c >= 1` with a discrete c
+// equal to 1, or a variable that starts on a strict target's boundary and moves away).
+TEST(EngineAgreementTest, DISABLED_SampleWitnessOnTheBoundaryOfAStrictTarget) {
+  const std::string text = R"(
+automaton a {
+  var x;
+  mode m { }
+  init m { x = 1; }
+  property r: reach x < 1;
+}
+)";
+  const auto r = CheckEveryEngine(text);
+  EXPECT_EQ(VerdictText(r.at("reach")[0].verdict), "unreachable") << r.at("reach")[0].reason;
+  EXPECT_EQ(VerdictText(r.at("prove")[0].verdict), "unreachable") << r.at("prove")[0].reason;
+  EXPECT_NE(VerdictText(r.at("sample")[0].verdict), "reachable") << r.at("sample")[0].reason;
+  const System system = ParseModel(text, "reproducer.ha");
+  Trace t;
+  t.inputs.until = 1.0;
+  EXPECT_FALSE(ReplayTrace(system, system.properties()[0], t)) << "x = 1 is no witness of x < 1";
+}
+
+// The IR accepts `share q;` for a derived parameter `q = 2 * p` of two instances of one automaton
+// whose uncertain `p` is not shared: one system symbol q with two definitions, 2 * A.p and 2 * B.p,
+// equal at the nominal values (which is all System::AddComponent compares), different in the runs
+// with A.p != B.p, which are runs of the model. The text of such a run (the model with A.p = 0.5
+// and B.p = 1.5 as nominal values) is refused ("shared parameter 'q' is 1 in ... but 3 in ..."),
+// and which q an engine reads there (the first instance's definition? each its own?) is not
+// defined. Found by the attacks on systems 764 and 1419 of the default seed (`share time;` with
+// `param time = -0.8*bool;`). Refusing the model at load, as for the other conflicts, is one fix.
+TEST(EngineAgreementTest, DISABLED_SharedDerivedParameterOfUnsharedUncertainOnes) {
+  const std::string text = R"(
+automaton a {
+  param p = 1 in [0, 2];
+  param q = 2 * p;
+  var x;
+  mode m { x' = q; inv x <= 10; }
+  init m { x = 0; }
+}
+system s {
+  share q;
+  instance A = a;
+  instance B = a;
+  property same: never A.x - B.x > 0.5;
+}
+)";
+  EXPECT_THROW(ParseModel(text, "reproducer.ha"), ParseError)
+      << "q would be both 2 * A.p and 2 * B.p";
+}
+
+}  // namespace
+}  // namespace hybrid
