@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -10,10 +11,14 @@
 
 #include "automaton/parser.h"
 #include "automaton/spaceex/spaceex_import.h"
+#include "solvers/checking/property_checker.h"
 #include "solvers/reachability/polyhedral_reachability.h"
+#include "solvers/reachability/reach_checker.h"
 #include "solvers/simulation/simulator.h"
 #include "solvers/verification/property_prover.h"
 #include "solvers/verification/property_sampler.h"
+#include "solvers/verification/prove_checker.h"
+#include "solvers/verification/sample_checker.h"
 #include "tools/output.h"
 #include "tools/progress.h"
 
@@ -156,13 +161,31 @@ std::string TraceText(const System& system, const Simulator& sim, const Trace& t
   return out.str();
 }
 
+// What the methods of `hybrid check` are made with: the command's options, and the prover's
+// budget, the progress line and reachability's usage once CheckReport has them (null before:
+// a registry for --method's validation only).
+struct MethodContext {
+  const CheckArgs& args;
+  PropertyProver::Options prove;
+  SolverBudget* budget = nullptr;
+  ProgressLine* progress = nullptr;
+  std::optional<PolyhedralReachability::Usage>* usage = nullptr;
+};
+
+CheckerRegistry Methods(MethodContext& context);
+
 // Throws std::invalid_argument for an option value out of its range (in the order of the
 // checks: method, depth, induction, runs, budget).
 void CheckOptions(const CheckArgs& args) {
-  if (args.method != "auto" && args.method != "reach" && args.method != "prove" &&
-      args.method != "sample") {
-    throw std::invalid_argument("--method must be 'auto', 'reach', 'prove' or 'sample', not '" +
-                                args.method + "'");
+  MethodContext names_only{args, {}};
+  const CheckerRegistry methods = Methods(names_only);
+  if (!methods.Has(args.method)) {
+    const std::vector<std::string> names = methods.Names();
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + ("'" + names[i] + "'");
+    }
+    throw std::invalid_argument("--method must be " + list + ", not '" + args.method + "'");
   }
   if (args.depth < 0 || args.depth > 1000)
     throw std::invalid_argument("--depth must be in [0, 1000]");
@@ -221,66 +244,46 @@ PolyhedralReachability::Options ReachOptions(const CheckArgs& args, ProgressLine
   return options;
 }
 
-// --method auto: polyhedral reachability when the model is a linear hybrid automaton (what it
-// spends in `usage`), then SMT k-induction (with `budget`) on what it leaves unknown; k-induction
-// alone otherwise. Each result names the method that gave it.
-std::vector<CheckResult> CheckAuto(const PolyhedralReachability::Options& reach,
-                                   const PropertyProver::Options& prove, const System& system,
-                                   const std::vector<Property>& chosen, SolverBudget& budget,
-                                   std::optional<PolyhedralReachability::Usage>& usage) {
-  std::string why;
-  if (!PolyhedralReachability::Handles(system, chosen, &why)) {
-    return PropertyProver(prove).Check(system, chosen, budget);
-  }
-  std::vector<CheckResult> results =
-      PolyhedralReachability(reach).Check(system, chosen, &usage.emplace());
-  std::vector<Property> left;
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    if (results[i].verdict == Verdict::kUnknown) left.push_back(chosen[i]);
-  }
-  if (left.empty()) return results;
-  const std::vector<CheckResult> proved = PropertyProver(prove).Check(system, left, budget);
-  std::size_t next = 0;
-  for (CheckResult& r : results) {
-    if (r.verdict != Verdict::kUnknown) continue;
-    const CheckResult& p = proved[next++];
-    if (p.verdict != Verdict::kUnknown) {
-      r = p;
-    } else {
-      r.reason += "; prove: " + p.reason;
-      r.seconds += p.seconds;
-    }
-  }
-  return results;
+std::unique_ptr<PropertyChecker> MakeReach(MethodContext& c) {
+  return std::make_unique<ReachChecker>(ReachOptions(c.args, *c.progress), c.usage);
 }
 
-// Checks `chosen` on `system` by --method (prove: with `budget`; reach: what it spends in
-// `usage`; sample: --runs runs from --seed), one result per property in order.
-std::vector<CheckResult> CheckProperties(const CheckArgs& args,
-                                         const PropertyProver::Options& prove, const System& system,
-                                         const std::vector<Property>& chosen, SolverBudget& budget,
-                                         ProgressLine& progress,
-                                         std::optional<PolyhedralReachability::Usage>& usage) {
-  if (args.method == "reach") {
-    return PolyhedralReachability(ReachOptions(args, progress))
-        .Check(system, chosen, &usage.emplace());
-  }
-  if (args.method == "prove") return PropertyProver(prove).Check(system, chosen, budget);
-  if (args.method == "auto") {
-    return CheckAuto(ReachOptions(args, progress), prove, system, chosen, budget, usage);
-  }
-  std::vector<CheckResult> results;
+std::unique_ptr<PropertyChecker> MakeProve(MethodContext& c) {
+  return std::make_unique<ProveChecker>(c.prove, *c.budget);
+}
+
+std::unique_ptr<PropertyChecker> MakeSample(MethodContext& c) {
   PropertySampler::Options options;
-  options.runs = args.runs;
-  options.seed = args.seed;
-  const PropertySampler sampler(options);
-  for (const Property& p : chosen) {
-    progress.Report("sample: property " + std::to_string(results.size() + 1) + " of " +
-                        std::to_string(chosen.size()) + " (" + p.name + ")",
-                    true);
-    results.push_back(sampler.Check(system, p));
-  }
-  return results;
+  options.runs = c.args.runs;
+  options.seed = c.args.seed;
+  ProgressLine& progress = *c.progress;
+  return std::make_unique<SampleChecker>(
+      options, [&progress](std::size_t i, std::size_t n, const Property& p) {
+        progress.Report("sample: property " + std::to_string(i + 1) + " of " + std::to_string(n) +
+                            " (" + p.name + ")",
+                        true);
+      });
+}
+
+// The methods of `hybrid check`, by name (--method): each engine is one entry; `auto` is
+// reachability for a linear hybrid automaton, then the prover on what it leaves unknown (the
+// prover alone otherwise). `context` must outlive the registry.
+CheckerRegistry Methods(MethodContext& context) {
+  CheckerRegistry r;
+  r.Add("auto", "reach for a linear hybrid automaton, then prove on what it leaves unknown",
+        [&context] {
+          std::vector<std::unique_ptr<PropertyChecker>> checkers;
+          checkers.push_back(MakeReach(context));
+          checkers.push_back(MakeProve(context));
+          return std::make_unique<FallbackChecker>("auto", std::move(checkers));
+        });
+  r.Add("reach", "exact polyhedral reachability (linear hybrid automata)",
+        [&context] { return MakeReach(context); });
+  r.Add("prove", "SMT bounded model checking and k-induction",
+        [&context] { return MakeProve(context); });
+  r.Add("sample", "random simulations, shrunk counterexamples (never proves)",
+        [&context] { return MakeSample(context); });
+  return r;
 }
 
 // The exit code: kExitViolated if a property is violated or a reach target unreachable, else
@@ -417,7 +420,8 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   PropertyProver::Options prove;
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
-  found.results = CheckProperties(args, prove, system, found.chosen, budget, progress, found.reach);
+  MethodContext context{args, prove, &budget, &progress, &found.reach};
+  found.results = Methods(context).Make(args.method)->Check(system, found.chosen);
   if (args.modes) {
     stage = "modes";
     for (std::size_t c = 0; c < system.components().size(); ++c) {
