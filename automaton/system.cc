@@ -794,6 +794,52 @@ Expression System::ResolvedParameter(int slot) const {
   Fail("ResolvedParameter: no component declares '" + symbols_[slot].name + "'");
 }
 
+namespace {
+
+// Whether initial state `init` of automaton `a` may satisfy its mode's invariant: false only
+// when its values are points and a comparison that reads no input fails clearly; `violated`
+// gets that comparison's text.
+bool MayStartIn(const Automaton& a, const InitialState& init, std::string& violated) {
+  std::vector<double> env = a.ParameterEnvironment();
+  for (const InitialValue& v : init.values) {
+    if (!v.is_point) return true;
+    env[static_cast<std::size_t>(v.slot)] = v.range.lo.Evaluate(env);
+  }
+  const Mode& mode = a.mode(init.mode);
+  for (const auto& [slot, value] : mode.discrete_values)
+    env[static_cast<std::size_t>(slot)] = value;
+  for (const Comparison& c : mode.invariant.comparisons) {
+    bool reads_input = false;
+    for (const Expression* side : {&c.lhs, &c.rhs}) {
+      for (const int s : side->Slots()) {
+        reads_input = reads_input || a.symbols()[s].kind == SymbolKind::kInput;
+      }
+    }
+    if (reads_input) continue;
+    const double scale = 1.0 + std::abs(c.lhs.Evaluate(env)) + std::abs(c.rhs.Evaluate(env));
+    if (!c.Holds(env, 1e-9 * scale, Boundary::kClosure)) {
+      violated = "the initial state of mode " + mode.name + " violates its invariant '" +
+                 c.ToString() + "'";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::string> System::NoAdmissibleStart() const {
+  for (const Component& c : components_) {
+    std::string violated;
+    bool may = c.automaton.initial_states().empty();  // no init: the engines say so themselves
+    for (const InitialState& init : c.automaton.initial_states()) {
+      may = may || MayStartIn(c.automaton, init, violated);
+    }
+    if (!may) return Named(c) + ": " + violated;
+  }
+  return std::nullopt;
+}
+
 std::set<std::string> System::Alphabet(int c) const {
   return Alphabets(std::span<const Component>(&components_.at(static_cast<std::size_t>(c)), 1))
       .front();

@@ -120,6 +120,13 @@ class System {
   /// uncertain parameters reads derived ones through this. Throws std::invalid_argument if
   /// `slot` is not a parameter.
   Expression ResolvedParameter(int slot) const;
+  /// Why the system has no run, when that is decided by evaluation: a component none of whose
+  /// `init` declarations satisfies its mode's invariant (read in its closure, within 1e-9
+  /// relative), judged on declarations with point values and invariants that read no input
+  /// ("component 'A': the initial state of mode m violates its invariant 'x <= 1'"). Nullopt when
+  /// some start may be admissible. A verdict on a system without runs holds vacuously; `hybrid
+  /// check` says so.
+  std::optional<std::string> NoAdmissibleStart() const;
   /// The labels component `c` synchronises on (System names): those of its transitions and
   /// those its automaton declares (Automaton::DeclareLabel). A
   /// transition labelled `l` fires only together with an `l`-transition of every other

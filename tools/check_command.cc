@@ -422,6 +422,12 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   prove.max_induction = args.induction;
   MethodContext context{args, prove, &budget, &progress, &found.reach};
   found.results = Methods(context).Make(args.method)->Check(system, found.chosen);
+  if (const std::optional<std::string> none = system.NoAdmissibleStart()) {
+    // A verdict about a model without runs holds vacuously: say so in every reason.
+    for (CheckResult& r : found.results) {
+      r.reason = "vacuous, the model has no run (" + *none + "); " + r.reason;
+    }
+  }
   if (args.modes) {
     stage = "modes";
     for (std::size_t c = 0; c < system.components().size(); ++c) {

@@ -893,6 +893,24 @@ TEST(System, SetScenarioValidatesLikeAnAutomaton) {
   EXPECT_EQ(s.Product().scenario(), s.scenario());
 }
 
+TEST(System, NoAdmissibleStartNamesTheComponentAndItsInvariant) {
+  const Automaton outside =
+      Parse("automaton a { var x; mode m { inv x < 1; } init m { x = 2; } init m { x = 3; } }");
+  const Automaton boundary =
+      Parse("automaton b { var y; mode p { inv y < 1; } init p { y = 1; } }");
+  const Automaton box =
+      Parse("automaton c { var z; mode q { inv z <= 1; } init q { z in [0, 5]; } }");
+  EXPECT_EQ(System::Of(outside).NoAdmissibleStart(),
+            "'a': the initial state of mode m violates its invariant 'x < 1'");
+  EXPECT_EQ(System::Of(boundary).NoAdmissibleStart(), std::nullopt);  // closure: y = 1 is in
+  EXPECT_EQ(System::Of(box).NoAdmissibleStart(), std::nullopt);       // a box: some start may be
+  System s("s");
+  s.AddComponent("B", boundary);
+  s.AddComponent("A", outside);
+  EXPECT_EQ(s.NoAdmissibleStart(),
+            "instance 'A': the initial state of mode m violates its invariant 'A.x < 1'");
+}
+
 TEST(System, ADeclaredLabelIsInTheAlphabetAndBlocksPartners) {
   const Automaton mover = Parse(
       "automaton mover { var x; mode a { x' = 1; } mode b { } "

@@ -619,6 +619,22 @@ TEST(CheckCommand, ATraceNamesTheInitItStartsFrom) {
       << text.out;
 }
 
+TEST(CheckCommand, AVacuousVerdictSaysSo) {
+  TempDir dir;
+  const std::string path = dir.Write("v.ha", R"(automaton a { var x; mode m { x' = 1; inv x <= 1; }
+  init m { x = 2; } property small: always x <= 0; })")
+                               .string();
+  for (const std::string method : {"auto", "reach", "prove"}) {
+    const Result r = RunHybrid("check " + Quote(path) + " --method " + method + " --json");
+    const json report = json::parse(r.out);
+    EXPECT_TRUE(Field(report, "properties", 0, "reason")
+                    .get<std::string>()
+                    .starts_with("vacuous, the model has no run ('a': the initial state of mode m "
+                                 "violates its invariant 'x <= 1'); "))
+        << method << ": " << r.out;
+  }
+}
+
 TEST(CheckCommand, ConflictingSharedDeclarationsAreRefusedAtLoad) {
   TempDir dir;
   const std::string path =
