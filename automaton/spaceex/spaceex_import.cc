@@ -165,6 +165,7 @@ class Translator {
   const SxComponent& ChooseSystem();
   Template& TemplateOf(const SxComponent& c, const Origin& used_at);
   void ReadFlows(Template& t, std::size_t location, const Located& flow) const;
+  void ReadTransition(Template& t, const SxTransition& tr) const;
   void CheckNames(const Template& t, const Located& f, bool allow_primes) const;
   void BuildInstances(const SxComponent& system);
   Target MapParam(const Instance& inst, const SxParam& p, const SxMap* map) const;
@@ -306,6 +307,42 @@ void CheckConjunction(const Located& f, const char* what) {
   }
 }
 
+// Reads transition `tr` of template `t`: its guard and assignment, checked, and its label.
+void Translator::ReadTransition(Template& t, const SxTransition& tr) const {
+  const SxComponent& c = *t.sx;
+  for (const std::string* id : {&tr.source, &tr.target}) {
+    if (!c.FindLocation(*id))
+      Fail(At(tr.offset), "no location with id '" + *id + "' in '" + c.id + "'");
+  }
+  auto use = [&t](const Located& f) {
+    f.formula.ForEachName([&t](const SxFormula& n) { t.used.insert(n.text); });
+  };
+  std::optional<Located> guard, assignment;
+  if (tr.guard) {
+    guard = Parse(*tr.guard);
+    CheckNames(t, *guard, false);
+    CheckConjunction(*guard, "guards");
+    use(*guard);
+  }
+  if (tr.assignment) {
+    assignment = Parse(*tr.assignment);
+    CheckNames(t, *assignment, true);
+    use(*assignment);
+  }
+  if (tr.label) {
+    const std::string label = Trimmed(tr.label->value);
+    const SxParam* p = c.FindParam(label);
+    if (!p || p->type != SxParam::Type::kLabel) {
+      Fail(At(doc_.OffsetOf(*tr.label, 0)),
+           "'" + label + "' is not a label of component '" + c.id + "'");
+    }
+    t.used.insert(label);
+    t.transition_labels.insert(label);
+  }
+  t.guards.push_back(std::move(guard));
+  t.assignments.push_back(std::move(assignment));
+}
+
 Template& Translator::TemplateOf(const SxComponent& c, const Origin& used_at) {
   if (c.IsNetwork()) {
     Fail(used_at, "component '" + c.id + "' is a network: nested networks are not supported");
@@ -336,36 +373,7 @@ Template& Translator::TemplateOf(const SxComponent& c, const Origin& used_at) {
       use(*t.flow_formulas[l]);
     }
   }
-  for (const SxTransition& tr : c.transitions) {
-    for (const std::string* id : {&tr.source, &tr.target}) {
-      if (!c.FindLocation(*id))
-        Fail(At(tr.offset), "no location with id '" + *id + "' in '" + c.id + "'");
-    }
-    std::optional<Located> guard, assignment;
-    if (tr.guard) {
-      guard = Parse(*tr.guard);
-      CheckNames(t, *guard, false);
-      CheckConjunction(*guard, "guards");
-      use(*guard);
-    }
-    if (tr.assignment) {
-      assignment = Parse(*tr.assignment);
-      CheckNames(t, *assignment, true);
-      use(*assignment);
-    }
-    if (tr.label) {
-      const std::string label = Trimmed(tr.label->value);
-      const SxParam* p = c.FindParam(label);
-      if (!p || p->type != SxParam::Type::kLabel) {
-        Fail(At(doc_.OffsetOf(*tr.label, 0)),
-             "'" + label + "' is not a label of component '" + c.id + "'");
-      }
-      t.used.insert(label);
-      t.transition_labels.insert(label);
-    }
-    t.guards.push_back(std::move(guard));
-    t.assignments.push_back(std::move(assignment));
-  }
+  for (const SxTransition& tr : c.transitions) ReadTransition(t, tr);
   // A non-local label is in the component's alphabet whether or not a transition takes it: in a
   // network it blocks the other components' transitions on it (AutomatonBody declares it).
   for (const SxParam& p : c.params) {
@@ -770,10 +778,10 @@ std::string Translator::ForbiddenName(const Located& f, const SxFormula& n) cons
   }
   const auto b = initial_.find(n.text);
   if (b == initial_.end() || !b->second.point) {
-    Fail(f.At(n), "constant '" + n.text + "' read in 'forbidden' is declared by no component: " +
-                      "give it one value in 'initially' (" + n.text +
-                      " == 2), or map it into "
-                      "a component");
+    Fail(f.At(n), "constant '" + n.text +
+                      "' read in 'forbidden' is declared by no component: give it one value in "
+                      "'initially' (" +
+                      n.text + " == 2), or map it into a component");
   }
   return "(" + b->second.lo + ")";
 }
