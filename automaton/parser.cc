@@ -1107,7 +1107,17 @@ class Builder {
     if (it == automata_.end()) {
       Fail(*automaton_node, "unknown automaton '" + Text(*automaton_node) + "'");
     }
-    At(first, [&] { s.AddComponent(instance, it->second, std::move(binds)); });
+    try {
+      s.AddComponent(instance, it->second, std::move(binds));
+    } catch (const ConflictError& e) {
+      // Both declarations: this instance, and the earlier one it contradicts.
+      const SourcePosition other = instance_positions_.at(static_cast<size_t>(e.other_component()));
+      Fail(first, std::string(e.what()) + " (the other declaration: " + file_ + ":" +
+                      std::to_string(other.line) + ":" + std::to_string(other.column) + ")");
+    } catch (const std::invalid_argument& e) {
+      Fail(first, e.what());
+    }
+    instance_positions_.push_back(Where(first));
   }
 
   void SystemDecl(const Node& n) {
@@ -1149,6 +1159,8 @@ class Builder {
   // Where each of local_automata_ is declared (its name), as plain numbers: nothing taken from the
   // parse tree may outlive it.
   std::vector<SourcePosition> local_positions_;
+  // Where each instance of the system being built is declared, in component order.
+  std::vector<SourcePosition> instance_positions_;
   std::optional<System> system_;
 };
 

@@ -201,8 +201,30 @@ void CheckDistinctNames(const Automaton& a,
 // A shared parameter is one constant: throws unless parameter `s` of the new component `c`
 // (value `value`, System slot `g`) has the value and declared range it has in the first of
 // `components` that declares `g`.
+// Whether parameter `slot` of `a` has no range of its own but is defined from one that has
+// (directly or through other parameters).
+bool DerivedFromUncertain(const Automaton& a, int slot) {
+  for (const auto& [s, value] : a.parameters()) {
+    if (s != slot) continue;
+    if (a.ParameterRange(s)) return false;
+    for (const int read : value.Slots()) {
+      if (a.ParameterRange(read) || DerivedFromUncertain(a, read)) return true;
+    }
+  }
+  return false;
+}
+
+// The defining expression of parameter `slot` of `c` over System slots (`global_slot` must map
+// every parameter it reads: those are declared before it).
+Expression DefinitionOf(const Component& c, int slot, const SymbolTable& symbols) {
+  for (const auto& [s, value] : c.automaton.parameters()) {
+    if (s == slot) return Remap(value, c.global_slot, symbols);
+  }
+  return Expression();
+}
+
 void CheckSharedParameter(const Component& c, int s, double value, int g,
-                          std::span<const Component> components) {
+                          std::span<const Component> components, const SymbolTable& symbols) {
   const std::string& name = c.automaton.symbols()[s].name;
   for (const Component& other : components) {
     const int other_slot = LocalSlot(other, g);
@@ -217,6 +239,15 @@ void CheckSharedParameter(const Component& c, int s, double value, int g,
     if (ours != their_range) {
       Fail("shared parameter '" + name + "' has range " + ours + " in '" + c.source.name() +
            "' but " + their_range + " in '" + other.automaton.name() + "'");
+    }
+    // A derived parameter is a function of uncertain ones: one function for every instance.
+    const bool derived =
+        DerivedFromUncertain(c.automaton, s) || DerivedFromUncertain(other.automaton, other_slot);
+    if (derived && !(DefinitionOf(c, s, symbols) == DefinitionOf(other, other_slot, symbols))) {
+      Fail("shared parameter '" + name + "' is defined from uncertain parameters as " +
+           DefinitionOf(c, s, symbols).ToString() + " in '" + c.source.name() + "' but as " +
+           DefinitionOf(other, other_slot, symbols).ToString() + " in '" + other.automaton.name() +
+           "': share what it is defined from, or give it a range");
     }
     break;
   }
@@ -744,7 +775,7 @@ void System::AddComponent(std::string instance, const Automaton& automaton,
              automaton.name() + "' but " + WithArticle(KindName(symbols_[*g].kind)) + " elsewhere");
       }
       if (local[s].kind == SymbolKind::kParameter) {
-        CheckSharedParameter(c, s, parameters[s], *g, components_);
+        CheckSharedParameter(c, s, parameters[s], *g, components_, symbols_);
       }
       c.global_slot.push_back(*g);
     } else {

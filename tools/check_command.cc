@@ -90,12 +90,9 @@ json TraceJson(const System& system, const Simulator& sim, const Trace& t) {
                       {"init", index},
                       {"mode", system.QualifiedModeName(c, init.mode)}});
   }
-  json out = {{"parameters", params},
-              {"initial_states", starts},
-              {"initial_values", inits},
-              {"until", t.inputs.until},
-              {"inputs", inputs},
-              {"replay_status", std::string(StatusName(t.run.status))},
+  json out = {{"parameters", params},    {"initial_states", starts},
+              {"initial_values", inits}, {"until", t.inputs.until},
+              {"inputs", inputs},        {"replay_status", std::string(StatusName(t.run.status))},
               {"events", events}};
   if (!t.run.samples.empty()) {
     const StateSample& s = t.run.samples.front();

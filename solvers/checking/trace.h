@@ -52,10 +52,11 @@ struct Trace {
   int state_index = -1;
 };
 
-/// Replay settings: a property counts as failing (or, for `reach`, holding) at a recorded state
-/// only when it does so with margin `tolerance` (the predicate is read with Predicate::Lenient,
-/// the one definition of tolerance that the SMT encoding's counterexample search shares), so a
-/// replay confirms a violation only when it is clear of rounding.
+/// Replay settings: a property counts as failing at a recorded state only when it does so with
+/// margin `tolerance` (the predicate is read with Predicate::Lenient, the one definition of
+/// tolerance that the SMT encoding's counterexample search shares), so a replay confirms a
+/// violation only when it is clear of rounding; a `reach` target counts as met when it holds
+/// within `tolerance` with strict comparisons kept strict (IsTarget).
 struct ReplayOptions {
   double tolerance = 1e-6;
   /// Also record the state this often (fraction of the horizon); 0 records only the start,
@@ -79,7 +80,9 @@ bool ReplayTrace(const System& system, const Property& property, Trace& trace,
 
 /// Evaluates `property`'s predicate at recorded state `sample` of a run of `simulator` (whose
 /// system has the parameter values of the run): true when the state is a counterexample
-/// (`always`/`never`) or a witness (`reach`) with margin `tolerance`.
+/// (`always`/`never`: the predicate fails clearly, Predicate::Lenient with `tolerance`) or a
+/// witness (`reach`: the predicate holds as the model reads it, Predicate::Evaluate with
+/// `tolerance`: non-strict comparisons within it, strict ones strictly).
 bool IsTarget(const Simulator& simulator, const Property& property, const StateSample& sample,
               double tolerance);
 

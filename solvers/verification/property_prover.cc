@@ -987,6 +987,22 @@ std::set<int> ComponentsRead(const System& system, const Property& p, const std:
   for (const std::string& m : modes) {
     if (auto found = system.FindMode(m)) comps.insert(found->first);
   }
+  // A parameter none of those components has (another instance's `A.p`): the first component
+  // that declares it joins, so that the job has the parameter (and its range) too.
+  for (int s : slots) {
+    if (system.symbols()[s].kind != SymbolKind::kParameter) continue;
+    auto has = [&](int c) {
+      const auto& g = components[static_cast<std::size_t>(c)].global_slot;
+      return std::find(g.begin(), g.end(), s) != g.end();
+    };
+    if (std::any_of(comps.begin(), comps.end(), has)) continue;
+    for (int c = 0; c < static_cast<int>(components.size()); ++c) {
+      if (has(c)) {
+        comps.insert(c);
+        break;
+      }
+    }
+  }
   if (comps.empty()) comps.insert(0);
   return comps;
 }

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "solvers/simulation/simulator.h"
 #include "solvers/checking/trace.h"
+#include "solvers/simulation/simulator.h"
 
 namespace hybrid {
 namespace {
@@ -101,6 +101,17 @@ rc::Gen<Level> LevelGen(KindWeights weights, double above) {
       level.k = side < above ? magnitude : -magnitude;
     }
     return rc::shrinkable::shrinkRecur(level, &ShrinkLevel);
+  };
+}
+
+// One of `count` > 0 choices, uniformly; shrinking towards the first. (Not rc::gen::inRange,
+// whose failure path would link a part of Debian's rapidcheck that is not position-independent,
+// which the Python module, a shared object, cannot link.)
+rc::Gen<int> ChoiceGen(int count) {
+  return [count](const rc::Random& random, int /*size*/) {
+    rc::Random r = random;
+    const int pick = static_cast<int>(r.next() % static_cast<std::uint64_t>(count));
+    return rc::shrinkable::shrinkRecur(pick, [](int k) { return rc::shrink::towards(k, 0); });
   };
 }
 
@@ -273,8 +284,8 @@ rc::Gen<Draw> DrawGen(const Space& space, int max_segments) {
   for (std::size_t i = 0; i < space.boxes.size(); ++i) {
     initials.push_back(LevelGen(kInitialWeights, 0.5));
   }
-  std::vector<rc::Gen<int>> inits;  // shrinking towards the first declaration
-  for (const InitChoice& choice : space.inits) inits.push_back(rc::gen::inRange(0, choice.count));
+  std::vector<rc::Gen<int>> inits;
+  for (const InitChoice& choice : space.inits) inits.push_back(ChoiceGen(choice.count));
   return rc::gen::tuple(Each(std::move(schedules)), Each(std::move(parameters)),
                         Each(std::move(initials)), Each(std::move(inits)));
 }

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
 #include "solvers/checking/trace.h"
+#include "solvers/simulation/simulator.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"
 

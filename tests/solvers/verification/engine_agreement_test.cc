@@ -1393,7 +1393,7 @@ std::map<std::string, std::vector<CheckResult>> CheckEveryEngine(const std::stri
 // prove throws "name 'A.p' has no slot" on a property that reads a variable of one instance and
 // a parameter of another (found as "name 'hi.g' has no slot" on a derived parameter, systems 30,
 // 62, 78, 85, 157, 166 of the default seed). reach proves it; sample finds no counterexample.
-TEST(EngineAgreementTest, DISABLED_ProveReadsAParameterOfAnotherInstance) {
+TEST(EngineAgreementTest, ProveReadsAParameterOfAnotherInstance) {
   const auto r = CheckEveryEngine(R"(
 automaton v {
   param p = 1;
@@ -1423,7 +1423,7 @@ system sys {
 // documents that it must hold with margin. Found as 4 disagreements (sample vs reach / prove) on
 // 200 systems of the default seed (systems 17, 18, 40, 194: `reach not c >= 1` with a discrete c
 // equal to 1, or a variable that starts on a strict target's boundary and moves away).
-TEST(EngineAgreementTest, DISABLED_SampleWitnessOnTheBoundaryOfAStrictTarget) {
+TEST(EngineAgreementTest, SampleWitnessOnTheBoundaryOfAStrictTarget) {
   const std::string text = R"(
 automaton a {
   var x;
@@ -1450,7 +1450,7 @@ automaton a {
 // and which q an engine reads there (the first instance's definition? each its own?) is not
 // defined. Found by the attacks on systems 764 and 1419 of the default seed (`share time;` with
 // `param time = -0.8*bool;`). Refusing the model at load, as for the other conflicts, is one fix.
-TEST(EngineAgreementTest, DISABLED_SharedDerivedParameterOfUnsharedUncertainOnes) {
+TEST(EngineAgreementTest, SharedDerivedParameterOfUnsharedUncertainOnes) {
   const std::string text = R"(
 automaton a {
   param p = 1 in [0, 2];
