@@ -158,6 +158,31 @@ bool LenientAt(const Predicate& p, std::span<const double> env, std::span<const 
 
 }  // namespace
 
+bool Predicate::Witnessed(std::span<const double> env, std::span<const std::string> modes,
+                          double tol) const {
+  switch (kind()) {
+    case Kind::kTrue:
+      return true;
+    case Kind::kFalse:
+      return false;
+    case Kind::kComparison: {
+      const Comparison& c = comparison();
+      const bool strict = c.relation == Relation::kLess || c.relation == Relation::kGreater;
+      return LenientBand(c.relation, strict ? -tol : tol)
+          .Contains(c.lhs.Evaluate(env) - c.rhs.Evaluate(env));
+    }
+    case Kind::kInMode:
+      return std::find(modes.begin(), modes.end(), mode()) != modes.end();
+    case Kind::kNot:
+      return !operands()[0].Witnessed(env, modes, tol);
+    case Kind::kAnd:
+      return operands()[0].Witnessed(env, modes, tol) && operands()[1].Witnessed(env, modes, tol);
+    case Kind::kOr:
+      return operands()[0].Witnessed(env, modes, tol) || operands()[1].Witnessed(env, modes, tol);
+  }
+  return false;
+}
+
 bool Predicate::Lenient(std::span<const double> env, std::span<const std::string> modes,
                         double tol) const {
   return LenientAt(*this, env, modes, tol, true);

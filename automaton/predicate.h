@@ -54,6 +54,13 @@ class Predicate {
   /// false satisfies p clearly. With tol = 0 this is Evaluate(env, modes). Replays of traces and
   /// the SMT encoding's counterexample search read predicates this way.
   bool Lenient(std::span<const double> env, std::span<const std::string> modes, double tol) const;
+  /// Truth value as a witness state reads it, clear of rounding by `tol` >= 0: a non-strict
+  /// comparison (`<=`, `>=`, `==`) holds within `tol` of its boundary, a strict one (`<`, `>`)
+  /// only beyond `tol` from it (its boundary is excluded, so a state within rounding of it is no
+  /// witness); `not` flips the truth value. So `reach x < 1` is not met at x = 1 - 1e-15, and
+  /// `reach x >= 3` is met at x = 3 - 1e-12. With tol = 0 this is Evaluate(env, modes). Replays
+  /// read `reach` targets this way (IsTarget).
+  bool Witnessed(std::span<const double> env, std::span<const std::string> modes, double tol) const;
   /// Calls `f` on every comparison.
   void ForEachComparison(const std::function<void(const Comparison&)>& f) const;
   /// Calls `f` on every mode name of an `in` atom.

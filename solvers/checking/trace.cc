@@ -93,9 +93,9 @@ bool IsTarget(const Simulator& simulator, const Property& property, const StateS
     case Property::Kind::kNever:
       return !Predicate::Not(property.predicate).Lenient(env, modes, tolerance);
     case Property::Kind::kReach:
-      // A witness meets the target as the model reads it: non-strict comparisons within the
-      // tolerance, strict ones strictly (x = 1 is no witness of `reach x < 1`).
-      return property.predicate.Evaluate(env, modes, tolerance);
+      // A witness meets the target clear of rounding: non-strict comparisons within the
+      // tolerance, strict ones beyond it (x = 1 is no witness of `reach x < 1`).
+      return property.predicate.Witnessed(env, modes, tolerance);
   }
   return false;
 }

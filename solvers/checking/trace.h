@@ -55,8 +55,8 @@ struct Trace {
 /// Replay settings: a property counts as failing at a recorded state only when it does so with
 /// margin `tolerance` (the predicate is read with Predicate::Lenient, the one definition of
 /// tolerance that the SMT encoding's counterexample search shares), so a replay confirms a
-/// violation only when it is clear of rounding; a `reach` target counts as met when it holds
-/// within `tolerance` with strict comparisons kept strict (IsTarget).
+/// violation only when it is clear of rounding; a `reach` target counts as met when its
+/// non-strict comparisons hold within `tolerance` and its strict ones beyond it (IsTarget).
 struct ReplayOptions {
   double tolerance = 1e-6;
   /// Also record the state this often (fraction of the horizon); 0 records only the start,
@@ -81,8 +81,9 @@ bool ReplayTrace(const System& system, const Property& property, Trace& trace,
 /// Evaluates `property`'s predicate at recorded state `sample` of a run of `simulator` (whose
 /// system has the parameter values of the run): true when the state is a counterexample
 /// (`always`/`never`: the predicate fails clearly, Predicate::Lenient with `tolerance`) or a
-/// witness (`reach`: the predicate holds as the model reads it, Predicate::Evaluate with
-/// `tolerance`: non-strict comparisons within it, strict ones strictly).
+/// witness (`reach`: Predicate::Witnessed with `tolerance`: non-strict comparisons within it,
+/// strict ones beyond it, so that no rounding error makes a witness of a strict target's
+/// boundary).
 bool IsTarget(const Simulator& simulator, const Property& property, const StateSample& sample,
               double tolerance);
 

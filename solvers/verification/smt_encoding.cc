@@ -614,24 +614,31 @@ z3::expr SmtEncoding::Power(const Expression& base, const Expression& ex,
 }
 
 z3::expr SmtEncoding::InBand(const z3::expr& r, const ResidualBand& band) {
-  z3::expr out = r.ctx().bool_val(true);
-  if (band.lower) {
-    const z3::expr lo = Num(r.ctx(), *band.lower);
-    out = out && (band.lower_strict ? r > lo : r >= lo);
+  // The plainest formula for each shape of band (`r <= hi`, `lo <= r`, `r == v`, both ends), so
+  // that the solver sees what it would for the comparison itself.
+  if (band.lower && band.upper && *band.lower == *band.upper && !band.lower_strict &&
+      !band.upper_strict) {
+    return r == Num(r.ctx(), *band.lower);
   }
+  std::optional<z3::expr> out;
   if (band.upper) {
     const z3::expr hi = Num(r.ctx(), *band.upper);
-    out = out && (band.upper_strict ? r < hi : r <= hi);
+    out = band.upper_strict ? r < hi : r <= hi;
   }
-  return out;
+  if (band.lower) {
+    const z3::expr lo = Num(r.ctx(), *band.lower);
+    const z3::expr lower = band.lower_strict ? r > lo : r >= lo;
+    out = out ? (*out && lower) : lower;
+  }
+  return out ? *out : r.ctx().bool_val(true);
 }
 
 z3::expr SmtEncoding::Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
                               double margin, Boundary boundary) {
   // The band of residuals that satisfy c (automaton/constraint.h: the one definition of a
   // comparison within tolerance, which the simulator and the replay evaluate numerically).
-  const ResidualBand band = margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary)
-                                          : LenientBand(c.relation, margin);
+  const ResidualBand band =
+      margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary) : LenientBand(c.relation, margin);
   return InBand(Translate(c.lhs, env) - Translate(c.rhs, env), band);
 }
 

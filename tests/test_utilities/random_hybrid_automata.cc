@@ -1275,7 +1275,7 @@ void MakeGroupAgree(RandomSystem& s, const std::vector<Local>& g) {
       for (RandomInput& i : a.inputs) {
         if (i.name == x.local) i = {x.local, in.lo, in.hi};
       }
-    } else if (x.kind == Sym::kParameter && g.size() > 1) {
+    } else if (x.kind == Sym::kParameter) {  // also one automaton twice: `2 * A.p`, `2 * B.p`
       const double value = EvaluateParameters(first).at(name);
       const RandomParameter& p = *std::find_if(first.parameters.begin(), first.parameters.end(),
                                                [&](const auto& q) { return q.name == name; });
