@@ -32,6 +32,9 @@ run_sanitized() {
   export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=0:strict_string_checks=1"
   export LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp:print_suppressions=0"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  # The engine agreement test's random systems (tests/solvers/verification/engine_agreement_test.cc):
+  # fewer under the sanitizers, as rapidcheck's cases above (200 in the Release stage).
+  export HYBRID_AGREEMENT_SYSTEMS="${HYBRID_AGREEMENT_SYSTEMS:-60}"
   (cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" --timeout 900)
 }
 
