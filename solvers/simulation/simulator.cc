@@ -964,9 +964,10 @@ class EventLoop {
   // strictly. Lazy transitions of a component are candidates only when its invariant boundary
   // was reached (reached_invariant_).
   std::vector<Jump> Candidates() const;
-  // Completes `jump`, transition of component c labelled `label`, with the first enabled (in its
-  // closure) transition of that label of every other component that uses the label. False if some
-  // component has none (the jump is blocked).
+  // Completes `jump`, transition of component c labelled `label`, with the first enabled
+  // transition of that label of every other component that uses the label (its guard in its
+  // closure where it crossed at this instant, strictly otherwise). False if some component has
+  // none (the jump is blocked).
   bool AddPartners(size_t c, const std::string& label, Jump* jump) const;
   // Fires `jump` at t_: records the states before and after and the event; resets are evaluated
   // in the state before the jump.
@@ -1515,7 +1516,10 @@ bool EventLoop::AddPartners(size_t c, const std::string& label, Jump* jump) cons
     const CompiledComponent& dc = components_[d];
     bool found = false;
     for (int ui : dc.modes[run_.modes()[d]].outgoing) {
-      if (dc.transitions[ui].label == label && run_.GuardHolds(static_cast<int>(d), ui, true)) {
+      // A partner's guard is read as the leader's: in its closure only where it crossed at this
+      // instant (a comparison of an input or parameter stays strict, as in every engine).
+      if (dc.transitions[ui].label == label &&
+          run_.GuardHolds(static_cast<int>(d), ui, GuardReached(static_cast<int>(d), ui))) {
         jump->emplace_back(static_cast<int>(d), ui);
         found = true;
         break;

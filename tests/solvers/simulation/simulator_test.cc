@@ -346,6 +346,21 @@ TEST(SimulatorTest, ADeclaredUnusedLabelBlocksItsPartners) {
   }
 }
 
+// A partner's guard on an input is read strictly, as the leader's would be: `aux < 0` with aux in
+// [0, 0] never holds, so the synchronised jump never fires (found by the engine agreement test:
+// the prover said `unreachable`, the simulator jumped).
+TEST(SimulatorTest, APartnersGuardOnAnInputStaysStrict) {
+  Model m(R"(
+automaton leader { var x; mode a { x' = 1; } mode b { }
+  transition go: a -> b { guard x >= 1; label sync; } init a { x = 0; } }
+automaton partner { input aux in [0, 0]; var y; mode p { } mode q { }
+  transition go: p -> q { guard aux < 0; label sync; } init p { y = 0; } }
+system s { share sync; instance L = leader; instance P = partner; })");
+  const SimulationResult r = m.Run(Until(3));
+  EXPECT_EQ(r.status, SimulationStatus::kCompleted);
+  EXPECT_TRUE(r.events.empty());
+}
+
 TEST(SimulatorTest, BallBounceTimesMatchTheAnalyticSolution) {
   const BallParameters p;
   const Model m(BallText(p));
