@@ -1,4 +1,4 @@
-#include "automaton/automaton.h"
+#include "hybrid/automaton/automaton.h"
 
 #include <algorithm>
 #include <cmath>
@@ -269,7 +269,7 @@ TransitionId Automaton::AddTransition(Transition t) {
 }
 
 void Automaton::DeclareLabel(std::string label) {
-  if (label.empty()) throw std::invalid_argument("Automaton::DeclareLabel: empty label");
+  if (label.empty()) throw std::invalid_argument("empty label");
   declared_labels_.insert(std::move(label));
 }
 

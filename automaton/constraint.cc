@@ -1,4 +1,4 @@
-#include "automaton/constraint.h"
+#include "hybrid/automaton/constraint.h"
 
 #include <algorithm>
 #include <cmath>

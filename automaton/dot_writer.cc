@@ -1,4 +1,4 @@
-#include "automaton/dot_writer.h"
+#include "hybrid/automaton/dot_writer.h"
 
 #include <map>
 #include <span>
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "automaton/printer.h"
+#include "hybrid/automaton/printer.h"
 
 namespace hybrid {
 namespace {

@@ -1,4 +1,4 @@
-#include "automaton/expression.h"
+#include "hybrid/automaton/expression.h"
 
 #include <algorithm>
 #include <charconv>

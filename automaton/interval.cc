@@ -1,4 +1,4 @@
-#include "automaton/interval.h"
+#include "hybrid/automaton/interval.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "automaton/expression.h"  // FormatNumber
+#include "hybrid/automaton/expression.h"  // FormatNumber
 
 namespace hybrid {
 namespace {

@@ -1,4 +1,4 @@
-#include "automaton/mode.h"
+#include "hybrid/automaton/mode.h"
 
 namespace hybrid {
 

@@ -1,4 +1,4 @@
-#include "automaton/mode_graph.h"
+#include "hybrid/automaton/mode_graph.h"
 
 #include <algorithm>
 #include <boost/graph/breadth_first_search.hpp>

@@ -1,4 +1,4 @@
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 #include <algorithm>
 #include <cerrno>

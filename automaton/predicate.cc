@@ -1,4 +1,4 @@
-#include "automaton/predicate.h"
+#include "hybrid/automaton/predicate.h"
 
 #include <algorithm>
 #include <optional>

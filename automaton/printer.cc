@@ -1,4 +1,4 @@
-#include "automaton/printer.h"
+#include "hybrid/automaton/printer.h"
 
 #include <cmath>
 #include <set>

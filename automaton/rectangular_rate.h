@@ -4,8 +4,8 @@
 #include <string>
 #include <string_view>
 
-#include "automaton/automaton.h"
-#include "automaton/expression.h"
+#include "hybrid/automaton/automaton.h"
+#include "hybrid/automaton/expression.h"
 
 namespace hybrid {
 

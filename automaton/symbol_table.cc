@@ -1,4 +1,4 @@
-#include "automaton/symbol_table.h"
+#include "hybrid/automaton/symbol_table.h"
 
 #include <stdexcept>
 

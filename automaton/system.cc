@@ -1,4 +1,4 @@
-#include "automaton/system.h"
+#include "hybrid/automaton/system.h"
 
 #include <algorithm>
 #include <cmath>
@@ -800,7 +800,7 @@ Mode System::ProductModeOf(std::span<const int> tuple) const {
 
 Expression System::ResolvedParameter(int slot) const {
   if (slot < 0 || slot >= symbols_.size() || symbols_[slot].kind != SymbolKind::kParameter) {
-    Fail("ResolvedParameter: slot " + std::to_string(slot) + " is not a parameter");
+    Fail("slot " + std::to_string(slot) + " is not a parameter");
   }
   for (const Component& c : components_) {
     const int local = LocalSlot(c, slot);
@@ -822,7 +822,7 @@ Expression System::ResolvedParameter(int slot) const {
       return resolved;
     }
   }
-  Fail("ResolvedParameter: no component declares '" + symbols_[slot].name + "'");
+  Fail("no component declares parameter '" + symbols_[slot].name + "'");
 }
 
 namespace {

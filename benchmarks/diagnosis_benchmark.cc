@@ -10,10 +10,10 @@
 #include <sstream>
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
-#include "gripper/finger_diagnosis.h"
-#include "gripper/synthetic_data.h"
+#include "hybrid/gripper/finger_diagnosis.h"
+#include "hybrid/gripper/synthetic_data.h"
 
 namespace {
 

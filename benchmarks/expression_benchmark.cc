@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "automaton/compiled_expression.h"
-#include "automaton/parser.h"
+#include "hybrid/automaton/compiled_expression.h"
+#include "hybrid/automaton/parser.h"
 
 namespace {
 

@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
-#include "gripper/finger_closed_form.h"
-#include "gripper/geometric_finger.h"
-#include "gripper/hand.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/gripper/finger_closed_form.h"
+#include "hybrid/gripper/geometric_finger.h"
+#include "hybrid/gripper/hand.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace {
 

@@ -7,9 +7,9 @@
 
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
-#include "solvers/verification/property_prover.h"
+#include "hybrid/verification/property_prover.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 # link privately (a program linking them must link these too): Z3 for hybrid::verification and
 # the Parma Polyhedra Library with GMP for hybrid::reachability. Included by hybridConfig.cmake,
 # which finds them on the consumer's machine, by name, and defines
-#   hybrid::z3    libz3 (and the directory of z3++.h, for solvers/verification/smt_encoding.h);
+#   hybrid::z3    libz3 (and the directory of z3++.h, which no installed header includes);
 #   hybrid::ppl   libppl with libgmpxx and libgmp (and the directory of ppl.hh).
 # The exported targets name these instead of the build machine's library paths. When one is
 # missing, hybrid_SYSTEM_LIBRARIES_MISSING lists what is missing (its Debian package in brackets).

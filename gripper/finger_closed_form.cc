@@ -1,4 +1,4 @@
-#include "gripper/finger_closed_form.h"
+#include "hybrid/gripper/finger_closed_form.h"
 
 #include <algorithm>
 #include <array>
@@ -44,21 +44,19 @@ bool Moves(FingerPhase phase, int link) {
 void Validate(const FingerContacts& contacts, const FingerParameters& p) {
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(contacts.gob[i]) || contacts.gob[i] < 0.0) {
-      throw std::invalid_argument("FingerClosedForm: contact position of link " +
-                                  std::to_string(i + 1) + " must be >= 0 (got " +
-                                  std::to_string(contacts.gob[i]) + ")");
+      throw std::invalid_argument("contact position of link " + std::to_string(i + 1) +
+                                  " must be >= 0 (got " + std::to_string(contacts.gob[i]) + ")");
     }
     if (!(p.theta_min[i] < p.theta_max[i]) || !std::isfinite(p.theta_min[i]) ||
         !std::isfinite(p.theta_max[i])) {
-      throw std::invalid_argument("FingerClosedForm: empty range for joint " +
-                                  std::to_string(i + 1));
+      throw std::invalid_argument("empty range for joint " + std::to_string(i + 1));
     }
   }
   if (p.theta_min[0] != 0.0 || p.theta_min[1] != 0.0 || p.theta_min[2] > 0.0 ||
       p.theta_max[2] < 0.0 || !(p.m1() > 0.0) || !(p.m2() > 0.0) || !(p.motor_max > 0.0) ||
       !std::isfinite(p.motor_max) || !(p.theta3_fraction > 0.0 && p.theta3_fraction < 1.0)) {
     throw std::invalid_argument(
-        "FingerClosedForm: parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
+        "the finger's parameters must have theta1_min = theta2_min = 0 <= theta1_max, "
         "theta2_max, theta3_min <= 0 <= theta3_max, a positive finite motor range and "
         "theta3_fraction in (0, 1)");
   }
@@ -153,7 +151,7 @@ const Event& FirstEvent(const std::vector<Event>& events, double end) {
   for (const Event& e : events) {
     if (e.at <= end) return e;
   }
-  throw std::logic_error("FingerClosedForm: no event at the end of a piece");
+  throw std::logic_error("finger closed form: no event at the end of a piece");
 }
 
 // Takes `event` (not the end of travel): sets the flag it changes and puts a joint reaching a
@@ -252,11 +250,13 @@ FingerClosedForm::FingerClosedForm(const FingerContacts& contacts,
     }
     Apply(first, p, c, l, theta);
   }
-  throw std::logic_error("FingerClosedForm: too many events");
+  throw std::logic_error("finger closed form: too many events");
 }
 
 void FingerClosedForm::PackEnds() {
-  if (pieces_.size() > ends_.size()) throw std::logic_error("FingerClosedForm: too many pieces");
+  if (pieces_.size() > ends_.size()) {
+    throw std::logic_error("finger closed form: too many pieces");
+  }
   ends_.fill(std::numeric_limits<double>::infinity());
   for (size_t k = 0; k < pieces_.size(); ++k) ends_[k] = pieces_[k].g1;
 }
@@ -289,8 +289,8 @@ inline double Phase3Fraction(double moved, double rest, double m3_scale) {
 
 void CheckMotorRange(double g, double motor_max) {
   if (!(g >= 0.0 && g <= motor_max)) {
-    throw std::out_of_range("FingerClosedForm::At: g = " + std::to_string(g) +
-                            " is outside the motor range [0, " + std::to_string(motor_max) + "]");
+    throw std::out_of_range("g = " + std::to_string(g) + " is outside the motor range [0, " +
+                            std::to_string(motor_max) + "]");
   }
 }
 
@@ -314,7 +314,7 @@ const FingerClosedForm::Piece& FingerClosedForm::PieceAt(double g) const {
 
 void FingerClosedForm::AnglesAt(std::span<const double> g, std::span<double> theta) const {
   if (theta.size() != 3 * g.size()) {
-    throw std::invalid_argument("FingerClosedForm::AnglesAt: 3 angles per motor position");
+    throw std::invalid_argument("the angles need 3 places per motor position");
   }
   // Evaluate's arithmetic on the pieces laid out column by column (at most 8), so that the loop
   // below is straight-line code without branches (random g would mispredict them).

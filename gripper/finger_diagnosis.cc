@@ -1,11 +1,11 @@
-#include "gripper/finger_diagnosis.h"
+#include "hybrid/gripper/finger_diagnosis.h"
 
 #include <algorithm>
 #include <optional>
 #include <stdexcept>
 #include <utility>
 
-#include "gripper/finger_diagnosis_model.h"
+#include "hybrid/gripper/finger_diagnosis_model.h"
 #include "solvers/diagnosis/parallel_for.h"
 
 namespace hybrid {
@@ -19,7 +19,7 @@ std::vector<FingerPrediction> BaselinePredictions(const FingerPredictor& predict
   ParallelFor(runs, threads, [&](int r) {
     base[r] = predictor.Predict(data.runs[r], FingerEffects{});
     if (base[r].status != SimulationStatus::kCompleted) {
-      throw std::invalid_argument("Diagnose: the model stopped on run '" + data.runs[r].label +
+      throw std::invalid_argument("the model stopped on run '" + data.runs[r].label +
                                   "': " + base[r].message);
     }
   });
@@ -148,7 +148,7 @@ Diagnosis DiagnoseCleaned(const FingerPredictor& predictor, const MeasuredData& 
 
 Diagnosis Diagnose(const FingerPredictor& predictor, MeasuredData data,
                    const FingerDiagnosisOptions& options) {
-  if (data.runs.empty()) throw std::invalid_argument("Diagnose: the data have no runs");
+  if (data.runs.empty()) throw std::invalid_argument("the data have no runs");
   const std::vector<FingerPrediction> base = BaselinePredictions(predictor, data, options.threads);
   MeasuredData cleaned = data;
   OutlierReport outliers = CleanAgainstModel(cleaned, base, options.outlier_threshold);

@@ -1,4 +1,4 @@
-#include "gripper/finger_diagnosis_model.h"
+#include "hybrid/gripper/finger_diagnosis_model.h"
 
 #include <cstdio>
 #include <functional>
@@ -123,7 +123,7 @@ std::vector<DiagnosisRun> FingerDiagnosisModel::Runs() const {
 FingerPrediction FingerDiagnosisModel::Checked(int r, const FingerEffects& e) const {
   FingerPrediction p = predictor_.Predict(data_.runs[r], e);
   if (p.status != SimulationStatus::kCompleted) {
-    throw std::invalid_argument("Diagnose: the model stopped on run '" + data_.runs[r].label +
+    throw std::invalid_argument("the model stopped on run '" + data_.runs[r].label +
                                 "': " + p.message);
   }
   return p;

@@ -1,4 +1,4 @@
-#include "gripper/finger_effects.h"
+#include "hybrid/gripper/finger_effects.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,18 +11,20 @@ constexpr double kMotorMax = 255.0;
 
 const char* const kJointNames[3] = {"theta1", "theta2", "theta3"};
 
-[[noreturn]] void Fail(std::string_view api, const std::string& message) {
-  throw std::invalid_argument(std::string(api) + ": " + message);
+// Throws std::invalid_argument "CONTEXT: MESSAGE", `context` saying in words what was being done
+// ("extending the finger model").
+[[noreturn]] void Fail(std::string_view context, const std::string& message) {
+  throw std::invalid_argument(std::string(context) + ": " + message);
 }
 
-int SlotOf(const Automaton& a, std::string_view name, std::string_view api) {
+int SlotOf(const Automaton& a, std::string_view name, std::string_view context) {
   const auto slot = a.symbols().Find(name);
-  if (!slot) Fail(api, "the finger model has no '" + std::string(name) + "'");
+  if (!slot) Fail(context, "the finger model has no '" + std::string(name) + "'");
   return *slot;
 }
 
-Expression Sym(const Automaton& a, std::string_view name, std::string_view api) {
-  return Expression::Symbol(std::string(name), SlotOf(a, name, api));
+Expression Sym(const Automaton& a, std::string_view name, std::string_view context) {
+  return Expression::Symbol(std::string(name), SlotOf(a, name, context));
 }
 
 Comparison Compare(Expression lhs, Relation r, Expression rhs) {
@@ -148,13 +150,13 @@ std::vector<EffectParameter> AllEffectParameters() {
 }
 
 double NeutralValue(const EffectParameter& p, const Automaton& finger) {
-  constexpr std::string_view kApi = "NeutralValue";
+  constexpr std::string_view kContext = "an effect's neutral value";
   const std::vector<double> env = finger.ParameterEnvironment();
   switch (p.cause) {
     case Cause::kJointRange:
-      return env[SlotOf(finger, std::string(kJointNames[p.index]) + "_max", kApi)];
+      return env[SlotOf(finger, std::string(kJointNames[p.index]) + "_max", kContext)];
     case Cause::kTheta3Law:
-      return env[SlotOf(finger, "theta3_fraction", kApi)];
+      return env[SlotOf(finger, "theta3_fraction", kContext)];
     default:
       return 0.0;
   }
@@ -202,12 +204,14 @@ void SetEffect(FingerEffects& e, const EffectParameter& p, double value) {
 }
 
 std::vector<double> DrivePositions(std::span<const double> g, double backlash, double offset) {
-  if (!std::isfinite(backlash) || backlash < 0.0) Fail("DrivePositions", "backlash must be >= 0");
-  if (!std::isfinite(offset)) Fail("DrivePositions", "the offset must be finite");
+  if (!std::isfinite(backlash) || backlash < 0.0) {
+    Fail("the drive positions", "backlash must be >= 0");
+  }
+  if (!std::isfinite(offset)) Fail("the drive positions", "the offset must be finite");
   std::vector<double> q(g.size());
   double last = 0.0;
   for (size_t k = 0; k < g.size(); ++k) {
-    if (!std::isfinite(g[k])) Fail("DrivePositions", "a motor position is not finite");
+    if (!std::isfinite(g[k])) Fail("the drive positions", "a motor position is not finite");
     const double lo = g[k] - offset;
     last = std::clamp(std::clamp(last, lo, lo + backlash), 0.0, kMotorMax);
     q[k] = last;
@@ -216,18 +220,18 @@ std::vector<double> DrivePositions(std::span<const double> g, double backlash, d
 }
 
 void CheckDynamicEffects(const FingerEffects& effects) {
-  constexpr std::string_view kApi = "ApplyDynamicEffects";
+  constexpr std::string_view kContext = "the finger's effects";
   if (effects.theta3_fraction) {
     const double f = *effects.theta3_fraction;
-    if (!(f > 0.0 && f < 1.0)) Fail(kApi, "theta3_fraction must lie in (0, 1)");
+    if (!(f > 0.0 && f < 1.0)) Fail(kContext, "theta3_fraction must lie in (0, 1)");
   }
   for (const double k : effects.compliance) {
-    if (!std::isfinite(k) || k < 0.0) Fail(kApi, "compliance must be finite and >= 0");
+    if (!std::isfinite(k) || k < 0.0) Fail(kContext, "compliance must be finite and >= 0");
   }
 }
 
 Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effects) {
-  constexpr std::string_view kApi = "ApplyDynamicEffects";
+  constexpr std::string_view kContext = "the finger's effects";
   CheckDynamicEffects(effects);
   const bool compliant = effects.compliance[0] != 0.0 || effects.compliance[1] != 0.0;
   Automaton out = compliant ? CopySymbols(finger) : finger;
@@ -238,7 +242,7 @@ Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effe
   }
   if (effects.theta3_fraction) {
     const double f = *effects.theta3_fraction;
-    if (!(f > 0.0 && f < 1.0)) Fail(kApi, "theta3_fraction must lie in (0, 1)");
+    if (!(f > 0.0 && f < 1.0)) Fail(kContext, "theta3_fraction must lie in (0, 1)");
     out.SetParameter("theta3_fraction", f);
   }
   if (!compliant) return out;
@@ -246,17 +250,17 @@ Automaton ApplyDynamicEffects(const Automaton& finger, const FingerEffects& effe
   for (int i = 0; i < 2; ++i) {
     const double k = effects.compliance[i];
     if (k == 0.0) continue;
-    if (!std::isfinite(k) || k < 0.0) Fail(kApi, "compliance must be finite and >= 0");
+    if (!std::isfinite(k) || k < 0.0) Fail(kContext, "compliance must be finite and >= 0");
     const std::string name = "compliance_link" + std::to_string(i + 1);
     const int slot = out.AddParameter(name, Expression::Constant(k), "deg/count");
-    rate[i] = Expression::Symbol(name, slot) * Sym(finger, "u", kApi);
+    rate[i] = Expression::Symbol(name, slot) * Sym(finger, "u", kContext);
   }
   for (const Mode& m : finger.modes()) {
     Mode copy = m;
     for (int i = 0; i < 2; ++i) {
-      const int c = SlotOf(finger, "c" + std::to_string(i + 1), kApi);
+      const int c = SlotOf(finger, "c" + std::to_string(i + 1), kContext);
       if (rate[i] && m.DiscreteValueOf(c) == 1) {
-        SetFlow(copy, SlotOf(finger, kJointNames[i], kApi), rate[i]);
+        SetFlow(copy, SlotOf(finger, kJointNames[i], kContext), rate[i]);
       }
     }
     out.AddMode(std::move(copy));
@@ -283,10 +287,10 @@ struct Play {
 // Adds the play's parameters (motor_offset; backlash, ranging over [0, backlash]) and the
 // variable g_motor to `out`.
 Play AddPlay(Automaton& out, const Automaton& dyn, const FingerEffects& effects,
-             std::string_view api) {
-  const Expression u = Sym(dyn, "u", api);
-  const Expression g = Sym(dyn, "g", api);
-  const int g_slot = SlotOf(dyn, "g", api);
+             std::string_view context) {
+  const Expression u = Sym(dyn, "u", context);
+  const Expression g = Sym(dyn, "g", context);
+  const int g_slot = SlotOf(dyn, "g", context);
   const int d_slot =
       out.AddParameter("motor_offset", Expression::Constant(effects.motor_offset), "count");
   const int b_slot = out.AddParameter(
@@ -308,14 +312,14 @@ struct Measured {
 // Adds the output map to `out`: for each joint with a sensor bias, the parameter theta_j_bias
 // and the variable theta_j_measured.
 std::vector<Measured> AddMeasuredAngles(Automaton& out, const Automaton& dyn,
-                                        const FingerEffects& effects, std::string_view api) {
+                                        const FingerEffects& effects, std::string_view context) {
   std::vector<Measured> measured;
   for (int j = 0; j < 3; ++j) {
     if (effects.sensor_bias[j] == 0.0) continue;
     const std::string name = std::string(kJointNames[j]) + "_bias";
     const int p = out.AddParameter(name, Expression::Constant(effects.sensor_bias[j]), "deg");
     const int v = out.AddVariable(std::string(kJointNames[j]) + "_measured", "deg");
-    measured.push_back({SlotOf(dyn, kJointNames[j], api), v, Expression::Symbol(name, p)});
+    measured.push_back({SlotOf(dyn, kJointNames[j], context), v, Expression::Symbol(name, p)});
   }
   return measured;
 }
@@ -428,7 +432,7 @@ void AddInitialStates(Automaton& out, const Automaton& dyn, const std::vector<Mo
                       const std::vector<Measured>& measured, const Play& play,
                       const FingerEffects& effects,
                       const std::optional<FingerInitialState>& initial_finger,
-                      std::string_view api) {
+                      std::string_view context) {
   const double q0 = DrivePositions(std::span<const double>(std::array<double, 1>{0.0}),
                                    effects.backlash, effects.motor_offset)[0];
   const bool engaged = q0 == -effects.motor_offset;
@@ -438,10 +442,10 @@ void AddInitialStates(Automaton& out, const Automaton& dyn, const std::vector<Mo
     int copy_index = engaged ? 0 : 1;
     if (initial_finger && q0 > 0.0) {
       const auto mode = dyn.FindMode(initial_finger->mode);
-      if (!mode) Fail(api, "no finger mode '" + initial_finger->mode + "'");
+      if (!mode) Fail(context, "no finger mode '" + initial_finger->mode + "'");
       copy.mode = ids[mode->value()][copy_index];
       for (const auto& [name, value] : initial_finger->values) {
-        const int slot = SlotOf(dyn, name, api);
+        const int slot = SlotOf(dyn, name, context);
         for (InitialValue& v : copy.values) {
           if (v.slot == slot)
             v = InitialValue{
@@ -449,7 +453,7 @@ void AddInitialStates(Automaton& out, const Automaton& dyn, const std::vector<Mo
         }
       }
     } else {
-      if (q0 > 0.0) Fail(api, "motor_offset < 0 needs the finger's initial state");
+      if (q0 > 0.0) Fail(context, "motor_offset < 0 needs the finger's initial state");
       copy.mode = ids[s.mode.value()][copy_index];
     }
     copy.values.push_back(InitialValue{play.motor_slot, {zero, zero}, true});
@@ -464,19 +468,19 @@ void AddInitialStates(Automaton& out, const Automaton& dyn, const std::vector<Mo
 
 Automaton ExtendFingerModel(const Automaton& finger, const FingerEffects& effects,
                             const std::optional<FingerInitialState>& initial_finger) {
-  constexpr std::string_view kApi = "ExtendFingerModel";
+  constexpr std::string_view kContext = "extending the finger model";
   const Automaton dyn = ApplyDynamicEffects(finger, effects);
   if (!std::isfinite(effects.backlash) || effects.backlash < 0.0) {
-    Fail(kApi, "backlash must be finite and >= 0");
+    Fail(kContext, "backlash must be finite and >= 0");
   }
   Automaton out = CopySymbols(dyn);
-  const Play play = AddPlay(out, dyn, effects, kApi);
-  const std::vector<Measured> measured = AddMeasuredAngles(out, dyn, effects, kApi);
+  const Play play = AddPlay(out, dyn, effects, kContext);
+  const std::vector<Measured> measured = AddMeasuredAngles(out, dyn, effects, kContext);
   const std::vector<ModeCopies> ids = AddModeCopies(out, dyn, measured, play);
   // The play's transitions first: they take priority over the finger's at the same instant.
   AddPlayTransitions(out, dyn, ids, play);
   AddFingerTransitions(out, dyn, ids, measured);
-  AddInitialStates(out, dyn, ids, measured, play, effects, initial_finger, kApi);
+  AddInitialStates(out, dyn, ids, measured, play, effects, initial_finger, kContext);
   for (const Property& p : dyn.properties()) out.AddProperty(p);
   // The finger's default scenario drives the motor (u) the same way: the model runs as written.
   if (dyn.scenario()) out.SetScenario(*dyn.scenario());

@@ -1,4 +1,4 @@
-#include "gripper/finger_geometry.h"
+#include "hybrid/gripper/finger_geometry.h"
 
 #include <cmath>
 #include <numbers>
@@ -10,11 +10,11 @@ FingerGeometry::FingerGeometry(const FingerLengths& lengths, const FingerPlaceme
     : lengths_(lengths), placement_(placement) {
   if (!std::isfinite(placement.origin_x) || !std::isfinite(placement.x_scale) ||
       placement.x_scale == 0.0) {
-    throw std::invalid_argument("FingerGeometry: placement must be finite with x_scale != 0");
+    throw std::invalid_argument("the finger's placement must be finite with x_scale != 0");
   }
   for (double l : {lengths.proximal, lengths.medial, lengths.distal}) {
     if (!(l > 0.0) || !std::isfinite(l)) {
-      throw std::invalid_argument("FingerGeometry: link lengths must be positive and finite");
+      throw std::invalid_argument("the finger's link lengths must be positive and finite");
     }
   }
   palm_y_ = Points(Eigen::Vector3d(70.0, 90.0, -55.0))[3].y();

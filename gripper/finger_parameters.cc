@@ -1,4 +1,4 @@
-#include "gripper/finger_parameters.h"
+#include "hybrid/gripper/finger_parameters.h"
 
 #include <optional>
 #include <stdexcept>

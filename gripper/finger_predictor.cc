@@ -1,4 +1,4 @@
-#include "gripper/finger_predictor.h"
+#include "hybrid/gripper/finger_predictor.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,6 @@
 namespace hybrid {
 namespace {
 
-constexpr std::string_view kApi = "FingerPredictor";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // gob beyond the motor range: no object (spec/finger.ha's parameter range is [0, 256]).
 constexpr double kNoObject = 256.0;
@@ -103,17 +102,17 @@ FingerPredictor::FingerPredictor(Automaton finger, Options options)
     : finger_(std::move(finger)), options_(options) {
   for (const char* name : {"g", "u", "gob1", "gob2", "c1", "c2", "theta3_fraction"}) {
     if (!finger_.symbols().Find(name)) {
-      throw std::invalid_argument(std::string(kApi) + ": the model has no '" + name +
+      throw std::invalid_argument(std::string("the model has no '") + name +
                                   "' (expected spec/finger.ha's finger)");
     }
   }
   for (const char* name : {"theta1", "theta2", "theta3"}) {
     if (!finger_.symbols().Find(name)) {
-      throw std::invalid_argument(std::string(kApi) + ": the model has no '" + name + "'");
+      throw std::invalid_argument(std::string("the model has no '") + name + "'");
     }
   }
   if (finger_.initial_states().empty()) {
-    throw std::invalid_argument(std::string(kApi) + ": the model has no initial state");
+    throw std::invalid_argument("the model has no initial state");
   }
 }
 
@@ -262,7 +261,7 @@ std::optional<FingerInitialState> FingerPredictor::StartState(const FingerEffect
       InputSignal{u_slot, InputSignal::Shape::kStep, {{0.0, 1.0}}}};
   const SimulationResult r = sim->Run(options, signals);
   if (r.status != SimulationStatus::kCompleted) {
-    throw std::runtime_error(std::string(kApi) + "::StartState: " + r.message);
+    throw std::runtime_error("the finger's start state: " + r.message);
   }
   const StateSample& end = r.samples.back();
   FingerInitialState state;

@@ -1,4 +1,4 @@
-#include "gripper/geometric_finger.h"
+#include "hybrid/gripper/geometric_finger.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,13 +21,13 @@ void RequireClearOfOpenFinger(const std::vector<Obstacle>& objects,
     const double lowest = std::min(o.a().y(), o.b().y()) - o.radius();
     if (lowest < geometry.palm_y()) {
       throw std::invalid_argument(
-          "GeometricFinger: object " + o.ToString() +
+          "object " + o.ToString() +
           " overlaps the palm (its lowest point y = " + FormatNumber(lowest) +
           " is below the palm surface y = " + FormatNumber(geometry.palm_y()) + ")");
     }
     for (int i = 0; i < 3; ++i) {
       if (o.Distance(open_links[i]) <= 0.0) {
-        throw std::invalid_argument("GeometricFinger: object " + o.ToString() + " overlaps link " +
+        throw std::invalid_argument("object " + o.ToString() + " overlaps link " +
                                     std::to_string(i + 1) + " of the open finger (g = 0)");
       }
     }
@@ -189,13 +189,12 @@ double GeometricFinger::Clearance(const Eigen::Vector3d& theta, int link) const 
 
 Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obstacle>& obstacles,
                                 const FingerGeometry& geometry) {
-  constexpr std::string_view kApi = "WithGeometricContacts";
-  if (obstacles.empty()) throw std::invalid_argument(std::string(kApi) + ": no obstacles");
+  if (obstacles.empty()) throw std::invalid_argument("contacts with objects need an object");
   std::array<Expression, 3> theta;
   for (int i = 0; i < 3; ++i) {
     const std::string name = "theta" + std::to_string(i + 1);
     const auto slot = finger.symbols().Find(name);
-    if (!slot) throw std::invalid_argument(std::string(kApi) + ": no variable " + name);
+    if (!slot) throw std::invalid_argument("the finger model has no variable " + name);
     theta[i] = Expression::Symbol(name, *slot);
   }
   using E = Expression;
@@ -233,7 +232,7 @@ Automaton WithGeometricContacts(const Automaton& finger, const std::vector<Obsta
     if (i < 0 || i > 2 || tr.guard.comparisons.empty() ||
         tr.guard.comparisons[0].lhs.ToString() != "g" ||
         tr.guard.comparisons[0].rhs.ToString() != "gob" + std::to_string(i + 1)) {
-      throw std::invalid_argument(std::string(kApi) + ": transition '" + tr.name +
+      throw std::invalid_argument("transition '" + tr.name +
                                   "' is not a contact transition of spec/finger.ha");
     }
     Constraint guard = tr.guard;

@@ -1,4 +1,4 @@
-#include "gripper/hand.h"
+#include "hybrid/gripper/hand.h"
 
 #include <algorithm>
 #include <cmath>
@@ -91,17 +91,17 @@ using ClosestLinks = std::array<std::array<std::array<std::array<double, 3>, 3>,
 // [0, 255].
 void ValidateMotors(double spread, const std::array<double, 3>& commands) {
   if (!(spread >= 0.0 && spread <= 255.0)) {
-    throw std::invalid_argument("Hand: spread position must be in [0, 255]");
+    throw std::invalid_argument("the spread position must be in [0, 255]");
   }
   for (double c : commands) {
     if (!(c >= 0.0 && c <= 255.0)) {
-      throw std::invalid_argument("Hand: motor commands must be in [0, 255]");
+      throw std::invalid_argument("the motor commands must be in [0, 255]");
     }
   }
 }
 
 // The three fingers of `hand` (its objects, placements and commands) with the finger-finger
-// contacts `imposed`; an invalid finger's message names it ("Hand: finger B: ...").
+// contacts `imposed`; an invalid finger's message names it ("finger B: ...").
 std::vector<GeometricFinger> BuildFingers(const Hand& hand,
                                           const std::array<FingerContacts, 3>& imposed) {
   std::vector<GeometricFinger> fingers;
@@ -110,7 +110,7 @@ std::vector<GeometricFinger> BuildFingers(const Hand& hand,
       fingers.emplace_back(hand.objects(), hand.FingerGeometryOf(f), FingerParameters{}, imposed[f],
                            hand.commands()[f]);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("Hand: finger ") + "ABC"[f] + ": " + e.what());
+      throw std::invalid_argument(std::string("finger ") + "ABC"[f] + ": " + e.what());
     }
   }
   return fingers;
@@ -239,7 +239,7 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
 
 FingerConfiguration Hand::At(int f, double g) const {
   if (!(g >= 0.0 && g <= 255.0)) {
-    throw std::out_of_range("Hand::At: g = " + std::to_string(g) + " is outside [0, 255]");
+    throw std::out_of_range("g = " + std::to_string(g) + " is outside [0, 255]");
   }
   return fingers_.at(f).At(std::min(g, commands_[f]));
 }
@@ -320,7 +320,7 @@ System Hand::ComposedAutomata(const System& hand_model, bool shared_command) con
     if (c.source.name() == "spread") spread = &c.source;
   }
   if (finger == nullptr) {
-    throw std::invalid_argument("Hand::ComposedAutomata: the model '" + hand_model.name() +
+    throw std::invalid_argument("the model '" + hand_model.name() +
                                 "' has no automaton named 'finger'");
   }
   const std::string names = "ABC";

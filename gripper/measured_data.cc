@@ -1,4 +1,4 @@
-#include "gripper/measured_data.h"
+#include "hybrid/gripper/measured_data.h"
 
 #include <algorithm>
 #include <cctype>
@@ -391,7 +391,7 @@ MeasuredData ReadMeasuredDataFile(const std::string& path) {
 
 OutlierReport CleanOutliers(MeasuredData& data, double threshold) {
   if (!std::isfinite(threshold) || threshold <= 0.0) {
-    throw std::invalid_argument("CleanOutliers: threshold must be finite and positive");
+    throw std::invalid_argument("the outlier threshold must be finite and positive");
   }
   const double t = threshold;
   OutlierReport report;

@@ -1,10 +1,10 @@
-#include "gripper/obstacle.h"
+#include "hybrid/gripper/obstacle.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "automaton/expression.h"
+#include "hybrid/automaton/expression.h"
 #include "automaton/number_syntax.h"
 
 namespace hybrid::gripper {
@@ -24,16 +24,14 @@ Obstacle::Obstacle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double ra
 
 Obstacle Obstacle::Circle(const Eigen::Vector2d& centre, double radius) {
   if (!Finite(centre) || !(radius >= kMinimumRadius) || !std::isfinite(radius)) {
-    throw std::invalid_argument(
-        "Obstacle: a circle needs a finite centre and a radius of at least 0.0001 m");
+    throw std::invalid_argument("a circle needs a finite centre and a radius of at least 0.0001 m");
   }
   return Obstacle(centre, centre, radius);
 }
 
 Obstacle Obstacle::Bar(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius) {
   if (!Finite(a) || !Finite(b) || !(radius >= kMinimumRadius) || !std::isfinite(radius)) {
-    throw std::invalid_argument(
-        "Obstacle: a segment needs finite ends and a radius of at least 0.0001 m");
+    throw std::invalid_argument("a segment needs finite ends and a radius of at least 0.0001 m");
   }
   return Obstacle(a, b, radius);
 }

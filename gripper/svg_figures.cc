@@ -1,4 +1,4 @@
-#include "gripper/svg_figures.h"
+#include "hybrid/gripper/svg_figures.h"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "plotting/svg_plot.h"
+#include "hybrid/plotting/svg_plot.h"
 
 namespace hybrid::gripper {
 namespace {
@@ -124,9 +124,10 @@ std::string AtG(const std::string& prefix, const std::vector<double>& gs) {
   return title;
 }
 
-void RequireFinite(const std::string& function, double g, bool theta_finite) {
+// Throws std::invalid_argument ("DRAWING: frame at g = ...") unless the frame is finite.
+void RequireFinite(const std::string& drawing, double g, bool theta_finite) {
   if (!std::isfinite(g) || !theta_finite) {
-    throw std::invalid_argument(function + ": frame at g = " + plotting::FormatShortest(g) +
+    throw std::invalid_argument(drawing + ": frame at g = " + plotting::FormatShortest(g) +
                                 " has a value that is not finite");
   }
 }
@@ -626,11 +627,11 @@ void DrawAngleLegend(SvgPlot& svg) {
 
 std::string FingerDrawingSvg(const FingerGeometry& geometry, const std::vector<Obstacle>& objects,
                              const std::vector<std::pair<double, FingerConfiguration>>& frames) {
-  if (frames.empty()) throw std::invalid_argument("FingerDrawingSvg: no frames to draw");
+  if (frames.empty()) throw std::invalid_argument("finger drawing: no frames to draw");
   std::vector<std::array<Eigen::Vector2d, 4>> points;
   std::vector<double> gs;
   for (const auto& [g, configuration] : frames) {
-    RequireFinite("FingerDrawingSvg", g, configuration.theta.allFinite());
+    RequireFinite("finger drawing", g, configuration.theta.allFinite());
     gs.push_back(g);
     points.push_back(geometry.Points(configuration.theta));
   }
@@ -648,13 +649,13 @@ std::string FingerDrawingSvg(const FingerGeometry& geometry, const std::vector<O
 }
 
 std::string HandDrawingSvg(const Hand& hand, const std::vector<HandFrame>& frames) {
-  if (frames.empty()) throw std::invalid_argument("HandDrawingSvg: no frames to draw");
+  if (frames.empty()) throw std::invalid_argument("hand drawing: no frames to draw");
   std::vector<HandPoints> points;
   std::vector<double> gs;
   for (const HandFrame& frame : frames) {
     bool finite = true;
     for (const FingerConfiguration& finger : frame.fingers) finite &= finger.theta.allFinite();
-    RequireFinite("HandDrawingSvg", frame.g, finite);
+    RequireFinite("hand drawing", frame.g, finite);
   }
   for (const HandFrame& frame : frames) {
     gs.push_back(frame.g);

@@ -1,4 +1,4 @@
-#include "gripper/synthetic_data.h"
+#include "hybrid/gripper/synthetic_data.h"
 
 #include <algorithm>
 #include <cmath>

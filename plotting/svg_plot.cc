@@ -1,4 +1,4 @@
-#include "plotting/svg_plot.h"
+#include "hybrid/plotting/svg_plot.h"
 
 #include <algorithm>
 #include <charconv>
@@ -54,7 +54,7 @@ std::string FormatFixed(double value, int decimals) {
   char buffer[kFixedBuffer];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::fixed,
                                  std::clamp(decimals, 0, 17));
-  if (ec != std::errc()) throw std::logic_error("FormatFixed: cannot format a number");
+  if (ec != std::errc()) throw std::logic_error("cannot format a number in fixed notation");
   std::string out(buffer, end);
   // "-0.00" (a small negative value) reads as zero: no sign.
   if (out.size() > 1 && out[0] == '-' && out.find_first_not_of("0.", 1) == std::string::npos) {
@@ -66,7 +66,7 @@ std::string FormatFixed(double value, int decimals) {
 std::string FormatShortest(double value) {
   char buffer[64];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  if (ec != std::errc()) throw std::logic_error("FormatShortest: cannot format a number");
+  if (ec != std::errc()) throw std::logic_error("cannot format a number");
   return std::string(buffer, end);
 }
 

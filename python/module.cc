@@ -8,6 +8,11 @@
 // 50 ms: on an exception from a signal handler (KeyboardInterrupt) the child is killed and the
 // exception raised, so the engines stop at once although they have no way to be cancelled
 // (docs/python.md). finger_angles checks for signals between blocks of positions.
+//
+// Errors. The commands' messages refer to their arguments by API names (commands/
+// argument_message.h), which are this module's keyword arguments: what() is the message in those
+// words. cli::OptionError becomes a ValueError with the attribute `argument`, the other command
+// errors and std::invalid_argument ValueError, hybrid::InternalError (a bug) RuntimeError.
 
 #include <fcntl.h>
 #include <poll.h>
@@ -43,20 +48,23 @@
 #include <variant>
 #include <vector>
 
-#include "automaton/dot_writer.h"
-#include "automaton/parser.h"
-#include "automaton/spaceex/spaceex_import.h"
-#include "gripper/finger_closed_form.h"
-#include "gripper/finger_parameters.h"
-#include "gripper/measured_data.h"
-#include "solvers/simulation/simulator.h"
-#include "tools/bundled_files.h"
-#include "tools/check_command.h"
-#include "tools/diagnose_command.h"
-#include "tools/gripper_command.h"
-#include "tools/info_command.h"
-#include "tools/options.h"
-#include "tools/simulate_command.h"
+#include "automaton/internal_assert.h"
+#include "commands/bundled_files.h"
+#include "commands/check_command.h"
+#include "commands/command_error.h"
+#include "commands/info_command.h"
+#include "commands/output.h"
+#include "commands/simulate_command.h"
+#include "gripper/commands/diagnose_command.h"
+#include "gripper/commands/gripper_command.h"
+#include "hybrid/automaton/dot_writer.h"
+#include "hybrid/automaton/log.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/gripper/finger_closed_form.h"
+#include "hybrid/gripper/finger_parameters.h"
+#include "hybrid/gripper/measured_data.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/spaceex/spaceex_import.h"
 
 namespace py = pybind11;
 
@@ -67,11 +75,12 @@ using gripper::FingerClosedForm;
 using gripper::FingerContacts;
 using gripper::FingerParameters;
 
-// `value` as a motor position of argument `name`; throws ValueError outside [0, 255].
+// `value` as a motor position of argument `name`; throws OptionError (ValueError) outside
+// [0, 255].
 double MotorPosition(const std::string& name, double value) {
   if (!(value >= 0.0 && value <= 255.0)) {
-    throw py::value_error(name + " must be a motor position in [0, 255] (got " +
-                          std::to_string(value) + ")");
+    throw cli::OptionError(name, cli::Arg(name) + " must be a motor position in [0, 255] (got " +
+                                     std::to_string(value) + ")");
   }
   return value;
 }
@@ -80,15 +89,15 @@ double MotorPosition(const std::string& name, double value) {
 FingerParameters ParametersOfModel(const std::string& path) {
   const System model = spaceex::ReadModelFile(path);
   if (model.components().size() != 1) {
-    throw py::value_error(path + ": not a finger model like spec/finger.ha (it has " +
-                          std::to_string(model.components().size()) + " components)");
+    throw cli::OptionError("model", path + ": not a finger model like spec/finger.ha (it has " +
+                                        std::to_string(model.components().size()) + " components)");
   }
   try {
     const FingerParameters p = gripper::FingerParametersOf(model.components()[0].automaton);
     FingerClosedForm check({}, p);  // the closed form's own conditions on its constants
     return p;
   } catch (const std::invalid_argument& e) {
-    throw py::value_error(path + ": " + e.what());
+    throw cli::OptionError("model", path + ": " + e.what());
   }
 }
 
@@ -160,7 +169,9 @@ InputSignal SignalOf(const std::string& name, const SignalValue& value) {
   if (const double* c = std::get_if<double>(&value)) {
     s.points = {{0.0, *c}};
   } else if (const auto* points = std::get_if<std::vector<std::pair<double, double>>>(&value)) {
-    if (points->empty()) throw py::value_error("inputs['" + name + "']: no points");
+    if (points->empty()) {
+      throw cli::OptionError("inputs", cli::Arg("inputs") + "['" + name + "']: no points");
+    }
     s.points = *points;
   } else {
     s = ParseSignal(std::get<std::string>(value), "inputs['" + name + "']");
@@ -215,14 +226,16 @@ class Decoder {
 // ---------------------------------------------------------------------------------------------
 // Long calls in a child process that Ctrl-C stops.
 
-// A job's answer: its result, or the exception it threw (reconstructed by Rethrow).
+// A job's answer: its result, or the exception it threw (reconstructed by DecodeOrRethrow).
 enum Outcome : char {
   kResult = 'R',
-  kModelError = 'M',  // hybrid::ParseError: file, line, column, message
-  kDataError = 'D',   // hybrid::DataError: source, line, column, message
-  kValueError = 'V',  // a bad argument (ValueError): its message
+  kModelError = 'M',   // hybrid::ParseError: file, line, column, message
+  kDataError = 'D',    // hybrid::DataError: source, line, column, message
+  kOptionError = 'O',  // cli::OptionError (ValueError naming the argument): argument, message
+  kValueError = 'V',   // a bad argument or input (ValueError): its message
   kMemoryError = 'N',
-  kOtherError = 'E',  // anything else (RuntimeError): its message
+  kInternalError = 'I',  // hybrid::InternalError (RuntimeError): its message
+  kOtherError = 'E',     // anything else (RuntimeError): its message
 };
 
 // Runs `job` and encodes what came of it: the Outcome, then the result or the exception's fields.
@@ -246,10 +259,14 @@ std::string RunAndEncode(const std::function<std::string()>& job) {
     located(kDataError, x.source(), x.line(), x.column(), x.message());
   } catch (const std::bad_alloc&) {
     e.Number(kMemoryError);
-  } catch (const std::invalid_argument& x) {
-    e.Number(kValueError);
+  } catch (const cli::OptionError& x) {
+    e.Number(kOptionError);
+    e.Text(x.argument());
     e.Text(x.what());
-  } catch (const cli::UsageError& x) {
+  } catch (const InternalError& x) {
+    e.Number(kInternalError);
+    e.Text(x.what());
+  } catch (const std::invalid_argument& x) {
     e.Number(kValueError);
     e.Text(x.what());
   } catch (const cli::InputError& x) {
@@ -284,7 +301,12 @@ std::string DecodeOrRethrow(std::string_view answer) {
     throw DataError(file, line, column, message);
   }
   if (kind == kMemoryError) throw std::bad_alloc();
+  if (kind == kOptionError) {
+    std::string argument = d.Text();
+    throw cli::OptionError(std::move(argument), d.Text());
+  }
   if (kind == kValueError) throw std::invalid_argument(d.Text());
+  if (kind == kInternalError) throw InternalError(d.Text());
   throw std::runtime_error(d.Text());
 }
 
@@ -607,6 +629,32 @@ std::string DiagnoseJsonText(const std::string& data, const std::optional<std::s
   return RunStoppable([&] { return cli::DiagnoseReport(args).dump(); });
 }
 
+// set_log_level: the engines' log (include/hybrid/automaton/log.h) on standard error from `level`
+// ("debug", "info" or "warning") up, or none (None). Standard error rather than Python's logging:
+// engines log from worker threads and from the child processes of RunStoppable, where Python
+// cannot be called.
+void SetLogLevel(const std::optional<std::string>& level) {
+  if (!level) {
+    SetLogSink({});
+    return;
+  }
+  LogLevel minimum;
+  if (!ParseLogLevel(*level, &minimum)) {
+    throw cli::OptionError(
+        "level",
+        cli::Arg("level") + " must be 'debug', 'info', 'warning' or None, not '" + *level + "'");
+  }
+  SetLogSink(StderrLogSink(), minimum);
+}
+
+// Sets the Python error for an OptionError: a ValueError whose message names the keyword
+// argument and whose attribute `argument` is its name.
+void RaiseOptionError(const cli::OptionError& e) {
+  py::object error = py::handle(PyExc_ValueError)(e.what());
+  error.attr("argument") = e.argument();
+  PyErr_SetObject(PyExc_ValueError, error.ptr());
+}
+
 }  // namespace
 }  // namespace hybrid::python
 
@@ -615,23 +663,30 @@ PYBIND11_MODULE(_hybrid, m) {
   m.doc() = "C++ core of the hybrid package (see the package docstrings; docs/python.md).";
   static py::exception<hybrid::ParseError> model_error(m, "ModelError", PyExc_ValueError);
   static py::exception<hybrid::DataError> data_error(m, "DataError", PyExc_ValueError);
+  // Errors in Python's words: the commands' messages refer to arguments by their API names, which
+  // are the keyword arguments (what() renders them so).
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const hybrid::ParseError& e) {
       model_error(e.what());
-    } catch (const std::invalid_argument& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const hybrid::DataError& e) {
       data_error(e.what());
-    } catch (const hybrid::cli::UsageError& e) {
+    } catch (const hybrid::cli::OptionError& e) {
+      RaiseOptionError(e);
+    } catch (const hybrid::cli::OutputError& e) {
+      PyErr_SetString(PyExc_OSError, e.what());
+    } catch (const hybrid::cli::CommandError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const hybrid::cli::InputError& e) {
+    } catch (const hybrid::InternalError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    } catch (const std::invalid_argument& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const std::out_of_range& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }
   });
+  m.def("set_log_level", &SetLogLevel, py::arg("level"));
   m.def("finger_angles", &FingerAngles, py::arg("g"), py::arg("gob1") = py::none(),
         py::arg("gob2") = py::none(), py::arg("gob3") = py::none(), py::arg("model") = py::none());
   m.def("hand_json", &HandJsonText, py::arg("objects"), py::arg("mode"), py::arg("spread"),

@@ -14,7 +14,7 @@ speed ratio (plain Python time per query / hybrid's); exits 1 if an
 agreement check fails (never on timings: they are measured, not asserted).
 
 Usage: PYTHONPATH=build/python /usr/bin/python3 tools/bench_python_finger.py [--n N]
-       [--python-queries M] [--hybrid build/tools/hybrid] [--repeat R]
+       [--python-queries M] [--hybrid build/bin/hybrid] [--repeat R]
 """
 
 import argparse
@@ -68,7 +68,7 @@ def main():
     parser.add_argument("--python-queries", type=int, default=100000,
                         help="positions the plain-Python finger answers (default 10^5)")
     parser.add_argument("--hybrid", default=os.path.join(
-        os.path.dirname(os.path.abspath(__file__)), "..", "build", "tools", "hybrid"))
+        os.path.dirname(os.path.abspath(__file__)), "..", "build", "bin", "hybrid"))
     parser.add_argument("--repeat", type=int, default=5, help="timing runs, best kept (default 5)")
     args = parser.parse_args()
     if args.n < 1 or not 1 <= args.python_queries <= args.n or args.repeat < 1:

@@ -42,7 +42,7 @@ EXPECTED = os.path.join(BENCHMARKS, "expected.tsv")
 
 # The quick subset (--quick): models whose every verdict is decided and as expected today
 # (docs/benchmarks_lha.md), about 10 s together on this 2-core machine under load (fischer_5.ha
-# and tte_5.ha take most of it). The ctest BenchmarksTest.QuickSubsetIsDecidedAsExpected runs
+# and tte_5.ha take most of it). The test BenchmarksTest.QuickSubsetIsDecidedAsExpected runs
 # `--quick --require-all`, so only fully decided models belong here. Left out: the models with
 # an unknown verdict (nav4, fischer_6) and the decided but slow ones (fiscs05, tte_7, disc_3:
 # 13 to 100 s each).
@@ -194,8 +194,8 @@ def main():
                              "(default: every file of expected.tsv)")
     parser.add_argument("--quick", action="store_true",
                         help="the quick subset (fully decided models, under 60 s in all)")
-    parser.add_argument("--hybrid", default=os.path.join(REPO, "build", "tools", "hybrid"),
-                        help="the hybrid binary (default: build/tools/hybrid of the repository)")
+    parser.add_argument("--hybrid", default=os.path.join(REPO, "build", "bin", "hybrid"),
+                        help="the hybrid binary (default: build/bin/hybrid of the repository)")
     parser.add_argument("--budget", type=float,
                         help="passed to `hybrid check --budget` (default: the tool's)")
     parser.add_argument("--method", choices=["auto", "reach", "prove", "sample"],

@@ -5,7 +5,8 @@ Usage: tools/function_sizes.py [--over N] [--max M] [--allow K] [paths...]
   --over N   list the functions longer than N lines (default 100)
   --max M    exit 1 if any function is longer than M lines (default 150)
   --allow K  ... or if more than K functions are longer than N lines (default 5)
-  paths      files or folders (default: automaton solvers gripper plotting tools)
+  paths      files or folders (default: automaton solvers gripper plotting commands cli python
+             include)
 
 A function's length is the number of lines from its opening brace to its closing one, both
 included; lambdas and local classes count towards the function that holds them. The scan is
@@ -112,7 +113,8 @@ def main():
     parser.add_argument("--max", type=int, default=150)
     parser.add_argument("--allow", type=int, default=5)
     parser.add_argument("paths", nargs="*",
-                        default=["automaton", "solvers", "gripper", "plotting", "tools"])
+                        default=["automaton", "solvers", "gripper", "plotting", "commands", "cli",
+                                 "python", "include"])
     args = parser.parse_args()
     found = []
     for path in sources(args.paths):

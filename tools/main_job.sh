@@ -4,8 +4,8 @@
 # scenario (trajectory and event log as CSV). Results in out/.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/tools/build.sh"
-hybrid="$root/build/tools/hybrid"
+"$root/tools/build.sh" --program   # the program only: the tests are built by tools/test.sh
+hybrid="$root/build/bin/hybrid"
 out="$root/out"
 mkdir -p "$out"
 for model in "$root"/spec/*.ha; do

@@ -3,7 +3,7 @@
 #include <cctype>
 #include <utility>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid::spaceex {
 namespace {

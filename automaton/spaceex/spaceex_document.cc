@@ -7,7 +7,7 @@
 #include <set>
 #include <utility>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid::spaceex {
 namespace {

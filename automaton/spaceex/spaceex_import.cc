@@ -1,4 +1,4 @@
-#include "automaton/spaceex/spaceex_import.h"
+#include "hybrid/spaceex/spaceex_import.h"
 
 #include <algorithm>
 #include <cctype>
@@ -8,7 +8,7 @@
 #include <set>
 #include <utility>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "automaton/quoted_text.h"
 #include "automaton/spaceex/spaceex_config.h"
 #include "automaton/spaceex/spaceex_document.h"

@@ -337,7 +337,7 @@ std::string WriteExpression(const SxFormula& e,
       return wrap(e.children[0], left) + " " + e.text + " " + wrap(e.children[1], right);
     }
     default:
-      throw std::logic_error("WriteExpression: not an expression");
+      throw std::logic_error("writing a SpaceEx formula: a node that is not an expression");
   }
 }
 

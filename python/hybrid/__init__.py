@@ -8,10 +8,14 @@ The C++ library behind the ``hybrid`` command line, in-process:
 - :func:`diagnose` -- measured finger data against the model (``hybrid diagnose --json``);
 - :func:`load` -- a model (``.ha``, or SpaceEx ``.xml`` with its ``.cfg``) to inspect
   (:meth:`Model.info`), draw (:meth:`Model.dot`), simulate (:meth:`Model.simulate`) and check
-  (:meth:`Model.check`).
+  (:meth:`Model.check`);
+- :func:`set_log_level` -- what the engines do, logged to standard error.
 
 Errors in a model raise :class:`ModelError` (a ``ValueError``) whose message names the file, line
-and column, as the command line does; bad arguments raise ``ValueError`` or ``KeyError``.
+and column, as the command line does; bad arguments raise ``ValueError`` (its message names the
+keyword argument, e.g. ``method must be 'auto', 'reach', 'prove' or 'sample', not 'x'``, and its
+attribute ``argument`` is that name) or ``KeyError``; a bug of the library raises
+``RuntimeError`` ("internal error ...").
 
 Ctrl-C stops a long call (:meth:`Model.check`, :meth:`Model.simulate`, :func:`diagnose`,
 :func:`finger_angles` on large arrays) at once with ``KeyboardInterrupt``: called from the main
@@ -25,7 +29,25 @@ from . import _hybrid
 ModelError = _hybrid.ModelError
 DataError = _hybrid.DataError
 
-__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger_angles", "hand", "load"]
+__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger_angles", "hand", "load",
+           "set_log_level"]
+
+
+def set_log_level(level):
+    """Logs what the engines do (solver queries, replays, induction steps) to standard error.
+
+    Args:
+        level: "debug", "info" or "warning": the lowest level logged, as ``hybrid --log LEVEL``
+            does; None: no log (the default).
+
+    The lines are ``hybrid [LEVEL] topic: message``, written to the process's standard error
+    (file descriptor 2), not through Python's ``logging``: the engines log from worker threads and
+    from the child processes long calls run in.
+
+    Raises:
+        ValueError: any other level.
+    """
+    _hybrid.set_log_level(level)
 
 
 def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):

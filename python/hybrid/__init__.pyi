@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Mapping, Sequence, Union
+from typing import Any, Literal, Mapping, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -56,3 +56,4 @@ def diagnose(
     significance: float = ...,
     threads: int = ...,
 ) -> dict[str, Any]: ...
+def set_log_level(level: Literal["debug", "info", "warning"] | None) -> None: ...

@@ -1,4 +1,4 @@
-#include "solvers/checking/check_result.h"
+#include "hybrid/checking/check_result.h"
 
 #include <exception>
 #include <utility>

@@ -1,4 +1,4 @@
-#include "solvers/checking/property_checker.h"
+#include "hybrid/checking/property_checker.h"
 
 #include <algorithm>
 #include <stdexcept>

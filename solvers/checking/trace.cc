@@ -1,4 +1,4 @@
-#include "solvers/checking/trace.h"
+#include "hybrid/checking/trace.h"
 
 #include <algorithm>
 #include <cmath>

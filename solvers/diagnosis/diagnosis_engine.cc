@@ -1,4 +1,4 @@
-#include "solvers/diagnosis/diagnosis_engine.h"
+#include "hybrid/diagnosis/diagnosis_engine.h"
 
 #include <ceres/ceres.h>
 
@@ -93,10 +93,10 @@ class Engine {
   Engine(const DiagnosisModel& model, const std::vector<DiagnosisRun>& runs,
          const ChannelNoise& noise, const DiagnosisOptions& o)
       : model_(model), runs_(runs), o_(o) {
-    if (runs.empty()) throw std::invalid_argument("Diagnose: the data have no runs");
+    if (runs.empty()) throw std::invalid_argument("the data have no runs");
     const size_t channels = noise.variance.size();
     if (channels == 0 || noise.dof.size() != channels) {
-      throw std::invalid_argument("Diagnose: the noise floor needs one entry per channel");
+      throw std::invalid_argument("the noise floor needs one entry per channel");
     }
     for (size_t c = 0; c < channels; ++c) {
       sigma_.push_back(std::sqrt(std::max(noise.variance[c], 1e-12)));
@@ -104,14 +104,14 @@ class Engine {
     dof_ = noise.dof;
     for (const DiagnosisRun& run : runs) {
       if (run.channels.size() != channels) {
-        throw std::invalid_argument("Diagnose: run '" + run.label + "' has " +
+        throw std::invalid_argument("run '" + run.label + "' has " +
                                     std::to_string(run.channels.size()) + " channels, not " +
                                     std::to_string(channels));
       }
       for (const std::vector<double>& channel : run.channels) {
         if (channel.size() != run.input.size()) {
           throw std::invalid_argument(
-              "Diagnose: run '" + run.label + "' has " + std::to_string(run.input.size()) +
+              "run '" + run.label + "' has " + std::to_string(run.input.size()) +
               " input samples but a channel of " + std::to_string(channel.size()));
         }
       }
@@ -137,7 +137,7 @@ class Engine {
     bool fits = p.channels.size() == sigma_.size() && p.mode.size() == n && p.direction.size() == n;
     for (const std::vector<double>& channel : p.channels) fits = fits && channel.size() == n;
     if (!fits) {
-      throw std::logic_error("Diagnose: the model's prediction of run '" + runs_[r].label +
+      throw std::logic_error("the model's prediction of run '" + runs_[r].label +
                              "' does not have the run's channels and samples");
     }
     return p;

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "automaton/interval.h"
+#include "hybrid/automaton/interval.h"
 #include "automaton/rectangular_rate.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/checking/trace.h"
 
 namespace hybrid {
 namespace {

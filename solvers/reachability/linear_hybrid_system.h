@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/system.h"
+#include "hybrid/automaton/system.h"
 #include "solvers/reachability/convex_polyhedron.h"
 #include "solvers/reachability/variable_liveness.h"
 

@@ -1,4 +1,4 @@
-#include "solvers/reachability/polyhedral_reachability.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
 
 #include <time.h>
 

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "automaton/system.h"
+#include "hybrid/automaton/system.h"
 
 namespace hybrid {
 

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "automaton/expression.h"
+#include "hybrid/automaton/expression.h"
 
 namespace hybrid {
 

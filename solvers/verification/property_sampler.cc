@@ -1,4 +1,4 @@
-#include "solvers/verification/property_sampler.h"
+#include "hybrid/verification/property_sampler.h"
 
 #include <rapidcheck.h>
 
@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "solvers/checking/trace.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/checking/trace.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace hybrid {
 namespace {

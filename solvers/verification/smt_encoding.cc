@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -635,8 +636,8 @@ z3::expr SmtEncoding::InBand(const z3::expr& r, const ResidualBand& band) {
 
 z3::expr SmtEncoding::Compare(const Comparison& c, const std::vector<std::optional<z3::expr>>& env,
                               double margin, Boundary boundary) {
-  // The band of residuals that satisfy c (automaton/constraint.h: the one definition of a
-  // comparison within tolerance, which the simulator and the replay evaluate numerically).
+  // The band of residuals that satisfy c (include/hybrid/automaton/constraint.h: the one definition
+  // of a comparison within tolerance, which the simulator and the replay evaluate numerically).
   const ResidualBand band =
       margin == 0.0 ? ResidualBand::Of(c.relation, 0.0, boundary) : LenientBand(c.relation, margin);
   return InBand(Translate(c.lhs, env) - Translate(c.rhs, env), band);
@@ -1202,6 +1203,34 @@ std::vector<std::pair<std::string, double>> SmtEncoding::ReadParameters(const z3
   std::vector<std::pair<std::string, double>> out;
   for (const auto& [name, e] : uncertain_) out.emplace_back(name, ValueOf(model, e));
   return out;
+}
+
+std::vector<std::string> DescribePath(
+    const Automaton& automaton, const std::vector<SmtEncoding::PathStep>& path,
+    const std::vector<std::pair<std::string, double>>& parameters) {
+  std::vector<std::string> lines;
+  std::ostringstream values;
+  values << "parameters:";
+  for (const auto& [name, v] : parameters) values << " " << name << " = " << v;
+  lines.push_back(values.str());
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const SmtEncoding::PathStep& s = path[k];
+    std::ostringstream line;
+    line << "s" << k << " " << automaton.modes()[s.mode].name;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      line << " " << automaton.symbols()[automaton.variables()[i].slot].name << "=" << s.x[i];
+    }
+    for (double u : s.input) line << " u=" << u;
+    if (k + 1 < path.size()) {
+      if (s.flow) {
+        line << ", then a flow of duration " << s.duration;
+      } else {
+        line << ", then jump " << automaton.transitions()[s.transition].name;
+      }
+    }
+    lines.push_back(line.str());
+  }
+  return lines;
 }
 
 }  // namespace hybrid

@@ -13,8 +13,8 @@
 #include <tuple>
 #include <vector>
 
-#include "automaton/automaton.h"
-#include "automaton/predicate.h"
+#include "hybrid/automaton/automaton.h"
+#include "hybrid/automaton/predicate.h"
 
 namespace hybrid {
 
@@ -73,10 +73,13 @@ std::string FlowClassName(FlowClass c);
 /// built once and reused.
 class SmtEncoding {
  public:
+  /// The encoding of `automaton` in `ctx`; both are borrowed and must outlive the encoding.
   /// Throws std::invalid_argument if `automaton` has no initial state.
   SmtEncoding(z3::context& ctx, const Automaton& automaton);
 
   const Automaton& automaton() const { return automaton_; }
+  /// The context of the encoding's formulas (borrowed at construction).
+  z3::context& context() const { return ctx_; }
   FlowClass flow_class(ModeId m) const { return modes_[m.value()].flow_class; }
 
   /// s_0 is an initial state (parameters in their ranges, and s_0 in some InitialState(j)).
@@ -308,5 +311,13 @@ class SmtEncoding {
   std::vector<std::vector<int>> outgoing_;                 // per mode: transitions from it
   int fresh_ = 0;
 };
+
+/// A path read back from a model (SmtEncoding::ReadPath, ReadParameters) in words, for the debug
+/// log: a line with the uncertain parameters' values, then one line per state (mode, continuous
+/// variables, inputs, and the step that follows: a flow and its duration, or a jump). Uses no Z3
+/// context: describing a path changes nothing the solver counts.
+std::vector<std::string> DescribePath(
+    const Automaton& automaton, const std::vector<SmtEncoding::PathStep>& path,
+    const std::vector<std::pair<std::string, double>>& parameters);
 
 }  // namespace hybrid

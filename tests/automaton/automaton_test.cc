@@ -1,5 +1,5 @@
 // The Automaton API validates every declaration; its messages speak of the model, not of the API.
-#include "automaton/automaton.h"
+#include "hybrid/automaton/automaton.h"
 
 #include <gtest/gtest.h>
 

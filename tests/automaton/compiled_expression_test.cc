@@ -1,4 +1,4 @@
-#include "automaton/compiled_expression.h"
+#include "hybrid/automaton/compiled_expression.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>

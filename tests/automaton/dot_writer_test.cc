@@ -1,7 +1,7 @@
 // Tests of WriteDot: labels, escaping, styles, clusters and product drawings, and that Graphviz
 // accepts the output (`dot -Tsvg`).
 
-#include "automaton/dot_writer.h"
+#include "hybrid/automaton/dot_writer.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid {
 namespace {

@@ -1,4 +1,4 @@
-#include "automaton/expression.h"
+#include "hybrid/automaton/expression.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "tests/automaton/stack_budget.h"
 #include "tests/test_utilities/random_models.h"
 

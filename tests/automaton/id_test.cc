@@ -1,4 +1,4 @@
-#include "automaton/id.h"
+#include "hybrid/automaton/id.h"
 
 #include <gtest/gtest.h>
 

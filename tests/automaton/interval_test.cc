@@ -1,4 +1,4 @@
-#include "automaton/interval.h"
+#include "hybrid/automaton/interval.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>

@@ -1,14 +1,14 @@
 // Tests of ModeGraph: reachability, terminal modes, strongly connected components and warnings on
 // small hand-built automata, and the finger model.
 
-#include "automaton/mode_graph.h"
+#include "hybrid/automaton/mode_graph.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid {
 namespace {

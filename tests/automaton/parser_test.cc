@@ -3,7 +3,7 @@
 // exactly); binary and 10 MB inputs give a ParseError or parse, quickly, and never crash; and
 // valid models give the expected IR.
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -22,11 +22,11 @@
 #include <thread>
 #include <vector>
 
-#include "automaton/automaton.h"
-#include "automaton/compiled_expression.h"
-#include "automaton/expression.h"
-#include "automaton/printer.h"
-#include "automaton/system.h"
+#include "hybrid/automaton/automaton.h"
+#include "hybrid/automaton/compiled_expression.h"
+#include "hybrid/automaton/expression.h"
+#include "hybrid/automaton/printer.h"
+#include "hybrid/automaton/system.h"
 #include "tests/automaton/stack_budget.h"
 #include "tests/test_utilities/command_line.h"
 

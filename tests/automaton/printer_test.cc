@@ -1,4 +1,4 @@
-#include "automaton/printer.h"
+#include "hybrid/automaton/printer.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "automaton/system.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/automaton/system.h"
 #include "tests/test_utilities/random_models.h"
 
 namespace hybrid {

@@ -1,4 +1,4 @@
-#include "automaton/property.h"
+#include "hybrid/automaton/property.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "automaton/scenario.h"
+#include "hybrid/automaton/scenario.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 
 // Running code on a small, fixed stack: the check that the recursive walks of the IR fit the stack
 // budget its depth limits are chosen for (kMaxExpressionDepth, kMaxTreeDepth in
-// automaton/expression.h), in every build, sanitized ones included.
+// include/hybrid/automaton/expression.h), in every build, sanitized ones included.
 
 #include <gtest/gtest.h>
 #include <pthread.h>

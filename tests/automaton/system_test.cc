@@ -1,7 +1,7 @@
 // Tests of System: renaming of components, shared names, composition errors, and the product
 // automaton (synchronisation on labels, interleaving, mode names and counts, limits).
 
-#include "automaton/system.h"
+#include "hybrid/automaton/system.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "automaton/automaton.h"
-#include "automaton/parser.h"
+#include "hybrid/automaton/automaton.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid {
 namespace {

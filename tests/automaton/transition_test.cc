@@ -1,4 +1,4 @@
-#include "automaton/transition.h"
+#include "hybrid/automaton/transition.h"
 
 #include <gtest/gtest.h>
 

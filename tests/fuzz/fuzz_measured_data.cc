@@ -1,5 +1,5 @@
 // libFuzzer harness: the measured-data CSV reader of `hybrid diagnose` (ReadMeasuredData in
-// gripper/measured_data.h), then the outlier cleaning and noise estimate applied to what it
+// include/hybrid/gripper/measured_data.h), then the outlier cleaning and noise estimate applied to what it
 // reads. Every input either throws DataError (line and column not negative, a message about the
 // data) or gives runs that keep the documented invariants: a non-empty label, at least
 // kMinRunSamples samples, g finite in [0, 255], angles finite or NaN (missing), gob and
@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string>
 
-#include "gripper/measured_data.h"
+#include "hybrid/gripper/measured_data.h"
 #include "tests/fuzz/fuzz_utilities.h"
 
 namespace {

@@ -1,5 +1,5 @@
 // libFuzzer harness: the model-language parser (ParseModel) on arbitrary bytes.
-// Contract checked (automaton/parser.h): every input either gives a System or throws ParseError,
+// Contract checked (include/hybrid/automaton/parser.h): every input either gives a System or throws ParseError,
 // never anything else; the error's position lies in the input when it concerns the input's own
 // file; messages speak of the model, not of C++. ASan and UBSan check memory and undefined
 // behaviour; libFuzzer's -timeout and -rss_limit_mb bound time and memory per input.
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "tests/fuzz/fuzz_models.h"
 #include "tests/fuzz/fuzz_utilities.h"
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: object descriptions (`--object circle:X,Y,R` or segment:X1,Y1,X2,Y2[,R],
-// gripper::Obstacle::Parse in gripper/obstacle.h). Every input either throws ObstacleParseError
+// gripper::Obstacle::Parse in include/hybrid/gripper/obstacle.h). Every input either throws ObstacleParseError
 // with a column of the text, or gives an object with finite coordinates and a finite radius of
 // at least kMinimumRadius whose description (ToString) parses back to the same object, from a
 // text in the documented syntax (decimal numbers, automaton/number_syntax.h) with those numbers.
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "gripper/obstacle.h"
+#include "hybrid/gripper/obstacle.h"
 #include "tests/fuzz/fuzz_utilities.h"
 #include "tests/fuzz/number_oracle.h"
 

@@ -1,12 +1,12 @@
 // libFuzzer harness: numeric options of the `hybrid` command line as CLI11 parses them
-// (AddNumberOption, AddNumberListOption and OptionNumber in tools/options.h). The input is a
+// (AddNumberOption, AddNumberListOption and OptionNumber in cli/options.h). The input is a
 // command line, one argument per line (no NUL bytes), given to an app with options of every kind
 // the tool uses (a double, an int, an unsigned seed, an optional double, a list of numbers,
 // strings, a flag). Every command line either throws CLI::ParseError or sets each given number
 // option to the value of one of its argument texts that is a number in the documented syntax (read
 // independently, tests/fuzz/number_oracle.h): never a value from an empty, hexadecimal,
 // doubled-sign or other non-number text, never a negative seed. OptionNumber on each argument
-// accepts exactly the decimal texts with a finite value (else UsageError naming the option).
+// accepts exactly the decimal texts with a finite value (else OptionError naming the argument).
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -19,7 +19,7 @@
 
 #include "tests/fuzz/fuzz_utilities.h"
 #include "tests/fuzz/number_oracle.h"
-#include "tools/options.h"
+#include "cli/options.h"
 
 namespace {
 
@@ -74,12 +74,12 @@ void CheckOptionNumber(const std::string& text) {
   const bool valid =
       n.decimal && std::isfinite(expected) && !(expected == 0.0 && n.nonzero_mantissa);
   try {
-    const double v = hybrid::cli::OptionNumber("--set a", text);
+    const double v = hybrid::cli::OptionNumber("parameters", text, "a");
     if (!valid || !SameDouble(v, expected)) FuzzFail("OptionNumber accepts '" + text + "'");
-  } catch (const hybrid::cli::UsageError& e) {
+  } catch (const hybrid::cli::OptionError& e) {
     if (valid) FuzzFail("OptionNumber refuses '" + text + "': " + e.what());
-    if (std::string(e.what()).rfind("--set a: ", 0) != 0) {
-      FuzzFail(std::string("OptionNumber's message does not name the option: ") + e.what());
+    if (e.argument() != "parameters" || std::string(e.what()).rfind("parameters a: ", 0) != 0) {
+      FuzzFail(std::string("OptionNumber's message does not name the argument: ") + e.what());
     }
   }
 }

@@ -1,4 +1,4 @@
-// libFuzzer harness: parse, print, parse again (automaton/printer.h). For every input the parser
+// libFuzzer harness: parse, print, parse again (include/hybrid/automaton/printer.h). For every input the parser
 // accepts, the printed model must parse back (no ParseError) into an equal System (operator==),
 // and printing that gives the same text again.
 
@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "automaton/parser.h"
-#include "automaton/printer.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/automaton/printer.h"
 #include "tests/fuzz/fuzz_models.h"
 #include "tests/fuzz/fuzz_utilities.h"
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: signals as given on the command line (`--input 'u=step(0: 5, 30: 15)'`,
-// ParseSignal in automaton/parser.h). Every input either throws ParseError at a position of the
+// ParseSignal in include/hybrid/automaton/parser.h). Every input either throws ParseError at a position of the
 // text, or gives a signal whose times strictly increase and whose numbers are
 // finite; writing that signal back (shortest round-trip numbers) and parsing it gives it again.
 
@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "automaton/expression.h"
-#include "automaton/parser.h"
+#include "hybrid/automaton/expression.h"
+#include "hybrid/automaton/parser.h"
 #include "tests/fuzz/fuzz_utilities.h"
 
 namespace {

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "automaton/parser.h"
-#include "automaton/spaceex/spaceex_import.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/spaceex/spaceex_import.h"
 #include "tests/fuzz/fuzz_utilities.h"
 
 namespace {

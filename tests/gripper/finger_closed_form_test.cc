@@ -1,7 +1,7 @@
-// The closed form of section 4 (gripper/finger_closed_form.h): the report's tables, the clashes
+// The closed form of section 4 (include/hybrid/gripper/finger_closed_form.h): the report's tables, the clashes
 // found in them (docs/finger_model.md), and one truth with the simulated automaton
 // spec/finger.ha.
-#include "gripper/finger_closed_form.h"
+#include "hybrid/gripper/finger_closed_form.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/robotiq_rig.h"
 
 namespace hybrid::gripper {

@@ -1,8 +1,8 @@
-// The finger as a DiagnosisModel (gripper/finger_diagnosis_model.h): its candidates, its
+// The finger as a DiagnosisModel (include/hybrid/gripper/finger_diagnosis_model.h): its candidates, its
 // shortcut for sensor biases and its pruning of runs a parameter cannot change, checked against
 // FingerPredictor itself (whose own tests check it against the closed form).
 
-#include "gripper/finger_diagnosis_model.h"
+#include "hybrid/gripper/finger_diagnosis_model.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {

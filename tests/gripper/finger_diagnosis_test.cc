@@ -1,5 +1,5 @@
-// Tests of Diagnose (gripper/finger_diagnosis.h) on data that hide an effect: synthetic runs of the
-// finger model (gripper/synthetic_data.h) with the report's measurement noise (0.7 deg on theta1
+// Tests of Diagnose (include/hybrid/gripper/finger_diagnosis.h) on data that hide an effect: synthetic runs of the
+// finger model (include/hybrid/gripper/synthetic_data.h) with the report's measurement noise (0.7 deg on theta1
 // and theta2, 1.2 deg on theta3, outliers on theta3, missing samples), written to CSV and read
 // back, so that the diagnosis sees only what `hybrid diagnose DATA.csv` sees.
 //
@@ -22,7 +22,7 @@
 //
 // Each diagnosis runs on one thread (two test processes can share a machine).
 
-#include "gripper/finger_diagnosis.h"
+#include "hybrid/gripper/finger_diagnosis.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
@@ -47,11 +47,11 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "gripper/finger_effects.h"
-#include "gripper/finger_predictor.h"
-#include "gripper/measured_data.h"
-#include "gripper/synthetic_data.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/gripper/finger_effects.h"
+#include "hybrid/gripper/finger_predictor.h"
+#include "hybrid/gripper/measured_data.h"
+#include "hybrid/gripper/synthetic_data.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/robotiq_rig.h"
 

@@ -1,7 +1,7 @@
 // Effects as changes of the finger automaton: the drive map (play with offset), parameter
 // changes, compliance flows, and the extended model's structure.
 
-#include "gripper/finger_effects.h"
+#include "hybrid/gripper/finger_effects.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
@@ -11,9 +11,9 @@
 #include <cmath>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "automaton/printer.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/automaton/printer.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {

@@ -1,12 +1,12 @@
-// Planar forward kinematics of the finger (gripper/finger_geometry.h).
-#include "gripper/finger_geometry.h"
+// Planar forward kinematics of the finger (include/hybrid/gripper/finger_geometry.h).
+#include "hybrid/gripper/finger_geometry.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
 #include <cmath>
 
-#include "automaton/compiled_expression.h"
+#include "hybrid/automaton/compiled_expression.h"
 
 namespace hybrid::gripper {
 namespace {

@@ -1,14 +1,14 @@
-// FingerParametersOf (gripper/finger_parameters.h): the closed form's constants read from a
+// FingerParametersOf (include/hybrid/gripper/finger_parameters.h): the closed form's constants read from a
 // finger automaton, as declared or as changed.
 
-#include "gripper/finger_parameters.h"
+#include "hybrid/gripper/finger_parameters.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "automaton/parser.h"
-#include "gripper/finger_closed_form.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/gripper/finger_closed_form.h"
 
 namespace hybrid::gripper {
 namespace {

@@ -1,7 +1,7 @@
 // The fast path of `hybrid diagnose` (drive map, base automaton, output map) equals the extended
 // automaton that `--out-model` writes, simulated on the motor path.
 
-#include "gripper/finger_predictor.h"
+#include "hybrid/gripper/finger_predictor.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "automaton/printer.h"
-#include "gripper/finger_effects.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/automaton/printer.h"
+#include "hybrid/gripper/finger_effects.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/robotiq_rig.h"
 

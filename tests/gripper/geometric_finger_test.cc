@@ -1,6 +1,6 @@
 // Objects by geometry: the contact positions found on the closed-form path, and the automaton
 // whose contact guards are distances finding the same ones by simulation.
-#include "gripper/geometric_finger.h"
+#include "hybrid/gripper/geometric_finger.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -9,8 +9,8 @@
 #include <numbers>
 #include <string>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace hybrid::gripper {
 namespace {

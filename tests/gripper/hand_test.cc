@@ -1,6 +1,6 @@
-// The hand (gripper/hand.h): layout and spread, fingers closing on extruded objects, fingers
-// blocking each other, and the quasistatic hand against the composed automata.
-#include "gripper/hand.h"
+// The hand (include/hybrid/gripper/hand.h): layout and spread, fingers closing on extruded objects,
+// fingers blocking each other, and the quasistatic hand against the composed automata.
+#include "hybrid/gripper/hand.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -10,8 +10,8 @@
 #include <numbers>
 #include <string>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace hybrid::gripper {
 namespace {
@@ -168,7 +168,16 @@ TEST(HandTest, BadInput) {
     Hand({Obstacle::Circle({0.0, -0.02}, 0.02)}, 137, kClose);
     ADD_FAILURE() << "an object in the palm was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("overlaps the palm"), std::string::npos) << e.what();
+    // In the words of the hand (which finger), without C++ names ("Hand: ", "GeometricFinger: ").
+    const std::string what = e.what();
+    EXPECT_TRUE(what.starts_with("finger A: object ")) << what;
+    EXPECT_NE(what.find("overlaps the palm"), std::string::npos) << what;
+  }
+  try {
+    Hand({}, -1, kClose);
+    ADD_FAILURE() << "a spread of -1 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "the spread position must be in [0, 255]");
   }
   EXPECT_THROW(Hand({}, 137, kClose).At(0, 256), std::out_of_range);
 }

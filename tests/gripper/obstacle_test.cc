@@ -1,4 +1,4 @@
-#include "gripper/obstacle.h"
+#include "hybrid/gripper/obstacle.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "automaton/compiled_expression.h"
+#include "hybrid/automaton/compiled_expression.h"
 
 namespace hybrid::gripper {
 namespace {

@@ -1,6 +1,6 @@
 // SVG figures of the finger and the hand: the drawings in small multiples and the joint angles
 // against g.
-#include "gripper/svg_figures.h"
+#include "hybrid/gripper/svg_figures.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -176,7 +176,7 @@ TEST(FingerDrawingSvgTest, RejectsNoFramesAndNonFiniteValues) {
     FingerDrawingSvg(geometry, {}, {});
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("FingerDrawingSvg: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("finger drawing: ", 0), 0u) << e.what();
   }
   FingerConfiguration bad;
   bad.theta[1] = NAN;
@@ -370,7 +370,7 @@ TEST(HandDrawingSvgTest, RejectsNoFramesAndNonFiniteValues) {
     HandDrawingSvg(hand, {});
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("HandDrawingSvg: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("hand drawing: ", 0), 0u) << e.what();
   }
   auto frames = HandFrames(hand, {0, 100});
   frames[1].fingers[2].theta[0] = NAN;

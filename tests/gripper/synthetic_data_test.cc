@@ -1,9 +1,9 @@
-// Tests of synthetic measured data (gripper/synthetic_data.h): the written CSV reads back to the
+// Tests of synthetic measured data (include/hybrid/gripper/synthetic_data.h): the written CSV reads back to the
 // same runs; the seed decides the data; noiseless data equal the predictor's angles; noise,
 // outliers and missing samples follow the design; the hidden effects outside FingerEffects
 // (ripple, theta3 hysteresis) change the angles as documented; bad designs are rejected.
 
-#include "gripper/synthetic_data.h"
+#include "hybrid/gripper/synthetic_data.h"
 
 #include <gtest/gtest.h>
 
@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "gripper/finger_predictor.h"
-#include "gripper/measured_data.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/gripper/finger_predictor.h"
+#include "hybrid/gripper/measured_data.h"
 
 namespace hybrid {
 namespace {

@@ -8,6 +8,7 @@ import csv
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -20,7 +21,7 @@ import pytest
 import hybrid
 
 SOURCE = os.environ.get("HYBRID_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
-BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "tools", "hybrid"))
+BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "bin", "hybrid"))
 sys.path.insert(0, os.path.join(SOURCE, "tools"))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "test_utilities"))
 import report_finger  # noqa: E402
@@ -174,6 +175,86 @@ def test_hand_is_the_command_lines():
     assert [f["finger"] for f in report["fingers"]] == ["A", "B", "C"]
     with pytest.raises(ValueError, match="circle"):
         hybrid.hand(objects=["circle:0,0.15"])
+
+
+def expect_argument_error(call, argument, message):
+    """`call()` raises a ValueError about keyword argument `argument` whose message starts with
+    `message`: in the module's words, never a command-line flag."""
+    with pytest.raises(ValueError) as e:
+        call()
+    assert str(e.value).startswith(message), str(e.value)
+    assert e.value.argument == argument
+    assert "--" not in str(e.value), str(e.value)
+
+
+def test_errors_name_the_keyword_argument_not_a_flag(tmp_path):
+    # The same checks as the command line's, whose messages name --method, --depth, --object,
+    # --g, --threads, --property: here the keyword arguments.
+    path = tmp_path / "tank.ha"
+    path.write_text(TANK)
+    model = hybrid.load(path)
+    expect_argument_error(lambda: model.check(method="x"), "method",
+                          "method must be 'auto', 'reach', 'prove' or 'sample', not 'x'")
+    expect_argument_error(lambda: model.check(depth=5000), "depth",
+                          "depth must be in [0, 1000]")
+    expect_argument_error(lambda: model.check(budget=0.0), "budget",
+                          "budget must be a number of budget seconds in (0, 1e6]")
+    expect_argument_error(lambda: model.check(properties=["nope"]), "properties",
+                          "properties: 'nope' is not a property of " + str(path))
+    expect_argument_error(lambda: hybrid.hand(objects=["circle:0,0.15"]), "objects",
+                          "objects 'circle:0,0.15': column ")
+    expect_argument_error(lambda: hybrid.hand(g=300.0), "g",
+                          "g must be a motor position in [0, 255] (got 300)")
+    expect_argument_error(lambda: hybrid.hand(g_b=-1.0), "g_b",
+                          "g_b must be a motor position in [0, 255] (got -1)")
+    data = os.path.join(SOURCE, "data", "finger_demo.csv")
+    expect_argument_error(lambda: hybrid.diagnose(data, threads=0), "threads",
+                          "threads must lie in [1, 64]")
+    expect_argument_error(lambda: hybrid.finger_angles(1.0, gob3=-2.0), "gob3",
+                          "gob3 must be a motor position in [0, 255]")
+    # The command line names the flags for the same mistakes.
+    out = run("check", str(path), "--method", "x")
+    assert out.returncode == 2
+    assert out.stderr == ("hybrid check: --method must be 'auto', 'reach', 'prove' or 'sample', "
+                          "not 'x'\n")
+
+
+LOG_LINE = re.compile(r"^hybrid \[(debug|info|warning)\] ([^:]+): ")
+
+
+def test_log_level_is_the_command_lines(tmp_path):
+    # set_log_level logs to standard error as `hybrid --log LEVEL` does: the same lines (their
+    # level and topic; numbers such as times may differ) for the same check.
+    path = tmp_path / "tank.ha"
+    path.write_text(TANK)
+    script = ("import sys, hybrid\n"
+              "hybrid.set_log_level('debug')\n"
+              "hybrid.load(sys.argv[1]).check(method='prove', budget=5.0, depth=4)\n"
+              "hybrid.set_log_level(None)\n"
+              "hybrid.load(sys.argv[1]).check(method='prove', budget=5.0, depth=4)\n")
+    python = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
+                            text=True)
+    assert python.returncode == 0, python.stderr
+    cli = run("--log", "debug", "check", str(path), "--method", "prove", "--budget", "5",
+              "--depth", "4")
+    assert cli.returncode in (0, 6, 7), cli.stderr
+
+    def kinds(text):
+        lines = text.splitlines()
+        for line in lines:
+            assert LOG_LINE.match(line), line
+        return sorted({LOG_LINE.match(line).groups() for line in lines})
+
+    assert kinds(python.stderr) == kinds(cli.stderr)
+    # After the command's name too; nothing without --log; a bad level is a usage error.
+    after = run("check", str(path), "--method", "prove", "--budget", "5", "--depth", "4",
+                "--log", "debug")
+    assert kinds(after.stderr) == kinds(cli.stderr)
+    assert run("check", str(path), "--method", "prove", "--budget", "5", "--depth", "4").stderr == ""
+    bad = run("--log", "loud", "info", str(path))
+    assert bad.returncode == 2 and "--log" in bad.stderr, bad.stderr
+    expect_argument_error(lambda: hybrid.set_log_level("loud"), "level",
+                          "level must be 'debug', 'info', 'warning' or None, not 'loud'")
 
 
 def test_diagnose_is_the_command_lines():

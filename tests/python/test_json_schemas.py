@@ -29,7 +29,7 @@ except ImportError:  # Debian bookworm's jsonschema 4.10
     from jsonschema import RefResolver
 
 SOURCE = os.environ.get("HYBRID_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
-BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "tools", "hybrid"))
+BINARY = os.environ.get("HYBRID_BINARY", os.path.join(SOURCE, "build", "bin", "hybrid"))
 SCHEMA_DIR = os.path.join(SOURCE, "docs", "schemas")
 SPEC = os.path.join(SOURCE, "spec")
 sys.path.insert(0, os.path.join(SOURCE, "tests", "test_utilities"))

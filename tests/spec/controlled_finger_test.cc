@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/verification/property_prover.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/verification/property_prover.h"
+#include "hybrid/checking/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/robotiq_rig.h"

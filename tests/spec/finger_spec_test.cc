@@ -9,9 +9,9 @@
 #include <sstream>
 #include <string>
 
-#include "automaton/compiled_expression.h"
-#include "automaton/mode_graph.h"
-#include "automaton/parser.h"
+#include "hybrid/automaton/compiled_expression.h"
+#include "hybrid/automaton/mode_graph.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid {
 namespace {

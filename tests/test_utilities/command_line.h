@@ -1,6 +1,9 @@
 #pragma once
 
 // Shared helpers for tests that write files and run the `hybrid` binary (HYBRID_BINARY).
+// RunHybrid and RunHybridJson exist only in the tests that tests/CMakeLists.txt lists in
+// HYBRID_PROGRAM_TESTS: those are built after the program and given its path; elsewhere a call
+// is a compile error saying so.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -94,6 +97,7 @@ struct Result {
   std::string err;
 };
 
+#ifdef HYBRID_BINARY
 /// Runs `hybrid ARGS` through the shell (arguments as written: quote them), with standard output
 /// redirected to `stdout_target` when given. A run that does not exit normally is a test failure.
 /// `shell_prefix` (e.g. "ulimit -v 100000; ") runs before the command in the same shell.
@@ -115,6 +119,27 @@ inline Result RunHybrid(const std::string& args, const std::string& stdout_targe
   r.err = ReadAll(err);
   return r;
 }
+
+#else
+/// Without HYBRID_BINARY (a test not in HYBRID_PROGRAM_TESTS), calling these fails to compile.
+template <typename... Args>
+inline constexpr bool kRunsTheProgram = false;
+#define HYBRID_NOT_A_PROGRAM_TEST                                                       \
+  static_assert(kRunsTheProgram<Args...>,                                               \
+                "this test runs the hybrid program: add it to HYBRID_PROGRAM_TESTS in " \
+                "tests/CMakeLists.txt (built after `hybrid`, given HYBRID_BINARY)")
+template <typename... Args>
+Result RunHybrid(const Args&...) {
+  HYBRID_NOT_A_PROGRAM_TEST;
+  return {};
+}
+template <typename... Args>
+nlohmann::json RunHybridJson(const Args&...) {
+  HYBRID_NOT_A_PROGRAM_TEST;
+  return {};
+}
+#undef HYBRID_NOT_A_PROGRAM_TEST
+#endif
 
 /// The value of `key` in the JSON object `j`. Throws std::out_of_range with a message naming the
 /// key and the keys there are when `j` is not an object or has no such key, so that a test
@@ -151,6 +176,7 @@ const nlohmann::json& Field(const nlohmann::json& j, const K1& k1, const K2& k2,
   return Field(Field(j, k1), k2, rest...);
 }
 
+#ifdef HYBRID_BINARY
 /// Runs `hybrid ARGS --json`, expects exit code `expected_exit`, and parses standard output (an
 /// output that is not JSON is a test failure and gives an empty object).
 inline nlohmann::json RunHybridJson(const std::string& args, int expected_exit = 0) {
@@ -163,5 +189,6 @@ inline nlohmann::json RunHybridJson(const std::string& args, int expected_exit =
     return nlohmann::json::object();
   }
 }
+#endif
 
 }  // namespace hybrid::testing

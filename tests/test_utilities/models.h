@@ -1,7 +1,7 @@
 #pragma once
 
 // Small hand-written models and model-text helpers shared by the simulation tests
-// (tests/solvers/simulation/simulator_test.cc, tests/tools/simulate_command_test.cc).
+// (tests/solvers/simulation/simulator_test.cc, tests/commands/simulate_command_test.cc).
 
 #include <fstream>
 #include <regex>

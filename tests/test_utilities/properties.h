@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "automaton/system.h"
+#include "hybrid/automaton/system.h"
 
 namespace hybrid::testing {
 

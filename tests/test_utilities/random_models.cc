@@ -7,7 +7,7 @@
 #include <string_view>
 #include <utility>
 
-#include "automaton/printer.h"
+#include "hybrid/automaton/printer.h"
 
 namespace hybrid {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "automaton/automaton.h"
-#include "automaton/expression.h"
-#include "automaton/interval.h"
+#include "hybrid/automaton/automaton.h"
+#include "hybrid/automaton/expression.h"
+#include "hybrid/automaton/interval.h"
 
 namespace hybrid {
 

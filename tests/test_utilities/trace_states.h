@@ -1,6 +1,6 @@
 #pragma once
 
-// Simulating a verifier's trace again, apart from ReplayTrace (solvers/checking/trace.h), for
+// Simulating a verifier's trace again, apart from ReplayTrace (include/hybrid/checking/trace.h), for
 // tests that judge the states it reaches themselves (shared by the verification tests).
 
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 #include <functional>
 #include <string>
 
-#include "automaton/system.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/checking/check_result.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/automaton/system.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/checking/check_result.h"
+#include "hybrid/checking/trace.h"
 
 namespace hybrid::testing {
 

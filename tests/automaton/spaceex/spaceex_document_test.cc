@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid::spaceex {
 namespace {

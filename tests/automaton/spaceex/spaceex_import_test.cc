@@ -1,4 +1,4 @@
-#include "automaton/spaceex/spaceex_import.h"
+#include "hybrid/spaceex/spaceex_import.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/reachability/polyhedral_reachability.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
 #include "tests/test_utilities/command_line.h"
 
 namespace hybrid::spaceex {

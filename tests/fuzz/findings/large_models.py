@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes two models just under the model size limit (automaton/parser.h kMaxModelFileBytes,
+"""Writes two models just under the model size limit (include/hybrid/automaton/parser.h kMaxModelFileBytes,
 4 MiB; another limit in bytes may be given) that stress the parser's memory
 (tests/fuzz/findings/README.md).
 

@@ -11,12 +11,12 @@
 #include <string>
 #include <vector>
 
-#include "automaton/spaceex/spaceex_import.h"
-#include "gripper/finger_closed_form.h"
-#include "plotting/svg_plot.h"
+#include "hybrid/spaceex/spaceex_import.h"
+#include "hybrid/gripper/finger_closed_form.h"
+#include "hybrid/plotting/svg_plot.h"
 #include "solvers/diagnosis/parallel_for.h"
-#include "solvers/reachability/polyhedral_reachability.h"
-#include "solvers/verification/property_prover.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
+#include "hybrid/verification/property_prover.h"
 
 namespace {
 

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/reachability/polyhedral_reachability.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/verification/property_prover.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/verification/property_prover.h"
 
 namespace {
 

@@ -1,8 +1,8 @@
-// Tests of the verdict names (solvers/checking/check_result.h): every verdict has its own
+// Tests of the verdict names (include/hybrid/checking/check_result.h): every verdict has its own
 // documented name, and a default CheckResult is an undecided `always` property; ConfirmTrace lets a
 // `violated` or `reachable` verdict through only with a trace that replays.
 
-#include "solvers/checking/check_result.h"
+#include "hybrid/checking/check_result.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 #include <string>
 #include <string_view>
 
-#include "automaton/parser.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
 #include "tests/test_utilities/properties.h"
 
 namespace hybrid {

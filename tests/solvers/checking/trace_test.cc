@@ -1,9 +1,9 @@
-// Tests of traces (solvers/checking/trace.h): the uncertain parameters of automata and systems;
+// Tests of traces (include/hybrid/checking/trace.h): the uncertain parameters of automata and systems;
 // replaying a trace finds the first recorded state that violates (`always`, `never`) or satisfies
 // (`reach`) a property, within a `within T` horizon, with the documented tolerance; the trace's
 // parameter and initial values are applied; misuse throws.
 
-#include "solvers/checking/trace.h"
+#include "hybrid/checking/trace.h"
 
 #include <gtest/gtest.h>
 
@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/properties.h"
 
 namespace hybrid {

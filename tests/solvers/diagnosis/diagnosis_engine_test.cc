@@ -3,7 +3,7 @@
 // above 50). Data are drawn from known truths with Gaussian noise, so
 // the right answer is known independently of the engine.
 
-#include "solvers/diagnosis/diagnosis_engine.h"
+#include "hybrid/diagnosis/diagnosis_engine.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-// Tests of exact polyhedral reachability (solvers/reachability/polyhedral_reachability.h) on small
+// Tests of exact polyhedral reachability (include/hybrid/reachability/polyhedral_reachability.h) on small
 // models whose verdicts are known analytically: proved bounds, violations and witnesses whose
 // traces the simulator replays, a rectangular rate, an uncertain parameter, a simultaneous swap
 // and a long chain of jumps; and its deterministic budget: models whose reachable set never
 // converges stop at the budget, with the same verdict, reason and state count on every run, also
 // while other threads load the machine (ConvexPolyhedron: convex_polyhedron_test.cc).
 
-#include "solvers/reachability/polyhedral_reachability.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
 
 #include <gtest/gtest.h>
 
@@ -20,9 +20,9 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/checking/trace.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"
 

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/reachability/polyhedral_reachability.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
 #include "tests/test_utilities/properties.h"
 
 namespace hybrid {

@@ -1,9 +1,9 @@
-// Tests of the simulator (solvers/simulation/simulator.h): event times against analytic solutions
-// of the bundled models, every special case of the event semantics on small hand-written models,
-// misuse, and rapidcheck properties (invariants hold, crossing events sit on a guard boundary, runs
-// are deterministic) on random initial states, parameters and input signals.
+// Tests of the simulator (include/hybrid/simulation/simulator.h): event times against analytic
+// solutions of the bundled models, every special case of the event semantics on small hand-written
+// models, misuse, and rapidcheck properties (invariants hold, crossing events sit on a guard
+// boundary, runs are deterministic) on random initial states, parameters and input signals.
 
-#include "solvers/simulation/simulator.h"
+#include "hybrid/simulation/simulator.h"
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
@@ -23,7 +23,7 @@
 #include <string_view>
 #include <vector>
 
-#include "automaton/parser.h"
+#include "hybrid/automaton/parser.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/random_models.h"
 
@@ -1754,7 +1754,10 @@ TEST(SimulatorTest, TooManySamplesAreRefusedBeforeTheRun) {
     ADD_FAILURE() << "accepted";
   } catch (const std::invalid_argument& e) {
     const std::string message = e.what();
-    EXPECT_NE(message.find("--sample"), std::string::npos) << message;
+    // In the words of the API: the fields of SimulationOptions, never a command-line flag.
+    EXPECT_NE(message.find("`sample_step`"), std::string::npos) << message;
+    EXPECT_NE(message.find("`until`"), std::string::npos) << message;
+    EXPECT_EQ(message.find("--"), std::string::npos) << message;
     EXPECT_NE(message.find("1e-09"), std::string::npos) << message;
     EXPECT_NE(message.find("1000000"), std::string::npos) << message;
     ExpectUserMessage(message);
@@ -1882,7 +1885,8 @@ automaton plain { var x; mode a { x' = 1; } init a { x = 0; } }
   } catch (const std::invalid_argument& e) {
     // A message for the user: what is missing and how to give it, no C++ names.
     EXPECT_NE(std::string(e.what()).find("no horizon"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("--until"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("`until`"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
     EXPECT_EQ(std::string(e.what()).find("::"), std::string::npos) << e.what();
   }
   EXPECT_EQ(no_scenario.Run(Until(1.0)).status, SimulationStatus::kCompleted);

@@ -41,12 +41,12 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/checking/trace.h"
-#include "solvers/reachability/polyhedral_reachability.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/verification/property_prover.h"
-#include "solvers/verification/property_sampler.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/verification/property_prover.h"
+#include "hybrid/verification/property_sampler.h"
 #include "tests/test_utilities/random_hybrid_automata.h"
 
 namespace hybrid {

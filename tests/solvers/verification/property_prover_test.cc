@@ -1,17 +1,21 @@
-// Tests of the SMT prover (solvers/verification/property_prover.h) on small models: invariants kept
-// by an urgent transition are proved and broken ones violated with a trace the simulator replays;
-// reachable targets get replayed witnesses and impossible ones are proved unreachable; uncertain
-// parameters are covered over their ranges; instances of one automaton share the proof; misuse
-// throws; and the finger model (spec/finger.ha): its invariants are proved and its modes'
-// reachability is decided with witnesses.
+// Tests of the SMT prover (include/hybrid/verification/property_prover.h) on small models:
+// invariants kept by an urgent transition are proved and broken ones violated with a trace the
+// simulator replays; reachable targets get replayed witnesses and impossible ones are proved
+// unreachable; uncertain parameters are covered over their ranges; instances of one automaton share
+// the proof; misuse throws; queries are dumped and logged on request without changing any result;
+// and the finger model (spec/finger.ha): its invariants are proved and its modes' reachability is
+// decided with witnesses.
 
-#include "solvers/verification/property_prover.h"
+#include "hybrid/verification/property_prover.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -19,9 +23,10 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/automaton/log.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"
@@ -590,24 +595,72 @@ TEST(PropertyProverBudget, SharedBudgetIsDrawnDown) {
   EXPECT_GT(budget.used(), after_first);
   ASSERT_EQ(modes.size(), 1u);
   EXPECT_EQ(modes[0].verdict, Verdict::kReachable) << modes[0].reason;
-  EXPECT_THROW(SolverBudget(0.0), std::invalid_argument);
-  EXPECT_THROW(SolverBudget(-1.0), std::invalid_argument);
-  EXPECT_THROW(SolverBudget(std::nan("")), std::invalid_argument);
-  EXPECT_THROW(SolverBudget(1e7), std::invalid_argument);
 }
 
-// The safety net's CPU-time limits: 10 s per budget second of a query's units, at least 10 s,
-// at most T = max(60 s, 10 s per budget second).
-TEST(PropertyProverBudget, SafetyLimitsFollowTheUnits) {
-  const SolverBudget small(1.0);
-  EXPECT_EQ(small.SafetySeconds(), 60.0);
-  EXPECT_EQ(small.SafetyCpuSeconds(0), 10.0);
-  EXPECT_EQ(small.SafetyCpuSeconds(3 * kResourceUnitsPerBudgetSecond), 30.0);
-  EXPECT_EQ(small.SafetyCpuSeconds(100 * kResourceUnitsPerBudgetSecond), 60.0);
-  const SolverBudget large(60.0);
-  EXPECT_EQ(large.SafetySeconds(), 600.0);
-  EXPECT_EQ(large.SafetyCpuSeconds(25'000'000), 100.0);
-  EXPECT_FALSE(large.SafetyExpired());
+// Options::query_dump_directory: every query is written there (q0.smt2, ...), with its resource
+// limit, and the results are those of a check without it; a path that is no directory throws.
+TEST(PropertyProverOptions, QueriesAreDumpedWithoutChangingResults) {
+  const System system = Parse(kLimitedModel);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("hybrid_prover_dump_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  PropertyProver::Options dumping = Small();
+  dumping.query_dump_directory = dir.string();
+  SolverBudget plain_budget(5.0), dump_budget(5.0);
+  const auto plain = PropertyProver(Small()).Check(system, system.properties(), plain_budget);
+  const auto dumped = PropertyProver(dumping).Check(system, system.properties(), dump_budget);
+  ASSERT_EQ(plain.size(), dumped.size());
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(plain[i].verdict, dumped[i].verdict) << plain[i].property;
+    EXPECT_EQ(plain[i].reason, dumped[i].reason) << plain[i].property;
+  }
+  EXPECT_EQ(plain_budget.used(), dump_budget.used());
+  std::ifstream first(dir / "q0.smt2");
+  ASSERT_TRUE(first.good());
+  std::string line;
+  std::getline(first, line);
+  EXPECT_EQ(line.rfind("; rlimit ", 0), 0u) << line;
+  EXPECT_TRUE(std::filesystem::exists(dir / "q1.smt2"));
+  std::filesystem::remove_all(dir);
+  dumping.query_dump_directory = (dir / "missing").string();
+  EXPECT_THROW(PropertyProver(dumping).Check(system, system.properties()), std::invalid_argument);
+}
+
+// What the prover logs (topic "prove"): one kInfo line per automaton and per query, kDebug lines
+// only with a kDebug sink; logging changes no result and no budget.
+TEST(PropertyProverLogging, QueriesAreLoggedWithoutChangingResults) {
+  const System system = Parse(kLimitedModel);
+  SolverBudget quiet_budget(5.0);
+  const auto quiet = PropertyProver(Small()).Check(system, system.properties(), quiet_budget);
+  for (const LogLevel level : {LogLevel::kInfo, LogLevel::kDebug}) {
+    std::vector<std::pair<LogLevel, std::string>> lines;
+    SetLogSink(
+        [&lines](LogLevel l, std::string_view topic, std::string_view message) {
+          EXPECT_EQ(topic, "prove");
+          lines.emplace_back(l, std::string(message));
+        },
+        level);
+    SolverBudget budget(5.0);
+    const auto logged = PropertyProver(Small()).Check(system, system.properties(), budget);
+    SetLogSink(nullptr);
+    ASSERT_EQ(quiet.size(), logged.size());
+    for (std::size_t i = 0; i < quiet.size(); ++i) {
+      EXPECT_EQ(quiet[i].verdict, logged[i].verdict) << quiet[i].property;
+      EXPECT_EQ(quiet[i].reason, logged[i].reason) << quiet[i].property;
+    }
+    EXPECT_EQ(quiet_budget.used(), budget.used());
+    int automata = 0, queries = 0, debug = 0;
+    for (const auto& [l, message] : lines) {
+      automata += message.rfind("checking automaton limited", 0) == 0 ? 1 : 0;
+      queries += message.rfind("query (", 0) == 0 && l == LogLevel::kInfo ? 1 : 0;
+      debug += l == LogLevel::kDebug ? 1 : 0;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+    EXPECT_EQ(automata, 1);
+    EXPECT_GT(queries, 0);
+    EXPECT_EQ(debug > 0, level == LogLevel::kDebug);
+  }
 }
 
 System Finger() { return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha"); }

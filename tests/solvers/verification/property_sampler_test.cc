@@ -1,9 +1,9 @@
-// Tests of the sampling checker (solvers/verification/property_sampler.h): counterexamples and
-// witnesses found on small models, shrunk to minimal input schedules, parameter values and initial
-// values; true invariants stay unknown; results are repeatable for a seed; misuse throws; and a
-// broken copy of the finger model (spec/finger.ha) is caught.
+// Tests of the sampling checker (include/hybrid/verification/property_sampler.h): counterexamples
+// and witnesses found on small models, shrunk to minimal input schedules, parameter values and
+// initial values; true invariants stay unknown; results are repeatable for a seed; misuse throws;
+// and a broken copy of the finger model (spec/finger.ha) is caught.
 
-#include "solvers/verification/property_sampler.h"
+#include "hybrid/verification/property_sampler.h"
 
 #include <gtest/gtest.h>
 
@@ -14,9 +14,9 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/checking/trace.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"

@@ -20,8 +20,8 @@
 #include <utility>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/simulation/simulator.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {

@@ -1,8 +1,8 @@
 // Differential soundness test of `hybrid check --method prove`
-// (solvers/verification/property_prover.h), see docs/soundness.md. Random automata are generated as
-// model-language text (tests/test_utilities/random_hybrid_automata.h) and checked by PropertyProver
-// exactly as the command does (every declared property). Then every verdict is put to the
-// simulator:
+// (include/hybrid/verification/property_prover.h), see docs/soundness.md. Random automata are
+// generated as model-language text (tests/test_utilities/random_hybrid_automata.h) and checked by
+// PropertyProver exactly as the command does (every declared property). Then every verdict is put
+// to the simulator:
 // - every `proved` invariant and every `unreachable` target is attacked by many simulations with
 //   random piecewise-constant inputs within their bounds, random values of the uncertain
 //   parameters, random initial values and initial modes, and random times for lazy transitions;
@@ -36,10 +36,10 @@
 #include <string>
 #include <vector>
 
-#include "automaton/parser.h"
-#include "solvers/reachability/polyhedral_reachability.h"
-#include "solvers/simulation/simulator.h"
-#include "solvers/verification/property_prover.h"
+#include "hybrid/automaton/parser.h"
+#include "hybrid/reachability/polyhedral_reachability.h"
+#include "hybrid/simulation/simulator.h"
+#include "hybrid/verification/property_prover.h"
 #include "tests/test_utilities/random_hybrid_automata.h"
 
 namespace hybrid {

@@ -1,0 +1,168 @@
+#include "solvers/verification/induction_round.h"
+
+#include <string>
+#include <utility>
+
+#include "automaton/internal_assert.h"
+#include "hybrid/automaton/log.h"
+
+namespace hybrid {
+
+InductionRound::InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigned resource_limit,
+                               int k, std::vector<ProofCandidate*> candidates,
+                               std::uint64_t ceiling)
+    : enc_(encoding),
+      meter_(meter),
+      ctx_(encoding.context()),
+      resource_limit_(resource_limit),
+      k_(k),
+      ceiling_(ceiling),
+      set_(std::move(candidates)) {
+  HYBRID_ASSERT(k >= 1, "k-induction starts at k = 1");
+  for (const ProofCandidate* c : set_) {
+    HYBRID_ASSERT(c != nullptr && c->invariant, "induction candidates are invariants");
+  }
+  alive_.assign(set_.size(), true);
+  path_from_.resize(enc_.automaton().num_modes());
+}
+
+void InductionRound::Run() {
+  // First the step from any mode in one query (cheap where the flows are simple, however many
+  // modes), while it decides; then per mode.
+  bool whole = true;
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    hypotheses_.reset();
+    if (whole && !Living().empty() && meter_.budget().used() < ceiling_ &&
+        !meter_.budget().SafetyExpired()) {
+      std::vector<std::size_t> failed;
+      const z3::check_result r = StepQuery(-1, Living(), resource_limit_ / 25, failed);
+      if (r == z3::unsat) break;
+      if (r == z3::sat) {
+        changed = Drop(failed);
+        continue;
+      }
+      whole = false;
+    }
+    changed = StepPerMode() || changed;
+  }
+}
+
+std::vector<ProofCandidate*> InductionRound::Inductive() const {
+  std::vector<ProofCandidate*> out;
+  for (std::size_t j = 0; j < set_.size(); ++j) {
+    if (alive_[j]) out.push_back(set_[j]);
+  }
+  return out;
+}
+
+std::vector<std::size_t> InductionRound::Living() const {
+  std::vector<std::size_t> goals;
+  for (std::size_t j = 0; j < set_.size(); ++j) {
+    if (alive_[j]) goals.push_back(j);
+  }
+  return goals;
+}
+
+bool InductionRound::Drop(const std::vector<std::size_t>& failed) {
+  bool changed = false;
+  for (std::size_t j : failed) {
+    HYBRID_ASSERT(j < alive_.size(), "a dropped candidate is one of the round's");
+    changed = changed || alive_[j];
+    alive_[j] = false;
+  }
+  if (changed) hypotheses_.reset();  // weaker now: modes already passed are checked again
+  return changed;
+}
+
+bool InductionRound::StepPerMode() {
+  bool changed = false;
+  for (int m = 0; m < enc_.automaton().num_modes(); ++m) {
+    std::vector<std::size_t> goals = Living(), failed;
+    if (goals.empty()) break;
+    if (meter_.budget().used() >= ceiling_ || meter_.budget().SafetyExpired()) {
+      cut_ = true;  // nothing left to prove with: every candidate is dropped
+      failed = goals;
+    } else if (StepQuery(m, goals, resource_limit_ / 25, failed) == z3::unknown) {
+      // Split per candidate with a larger limit, then the full one (a candidate dropped for
+      // want of resources takes with it every candidate that needs it as a lemma).
+      for (std::size_t j : goals) {
+        std::vector<std::size_t> f;
+        if (StepQuery(m, {j}, resource_limit_ / 5, f) == z3::unknown &&
+            StepQuery(m, {j}, resource_limit_, f) == z3::unknown) {
+          f.push_back(j);
+        }
+        failed.insert(failed.end(), f.begin(), f.end());
+      }
+    }
+    changed = Drop(failed) || changed;
+  }
+  return changed;
+}
+
+z3::check_result InductionRound::StepQuery(int m, const std::vector<std::size_t>& goals,
+                                           unsigned limit, std::vector<std::size_t>& failed) {
+  const int k = k_;
+  // A path of k steps (k + 1 states) asserted in a new solver.
+  if (!meter_.Afford(PathUnits(enc_.automaton(), k, m), ceiling_)) return z3::unknown;
+  z3::solver s = m < 0 ? MakeIncremental(ctx_) : MakeSolver(ctx_);
+  s.add(StepPath(m));
+  s.add(Hypotheses());
+  z3::expr_vector bad(ctx_);
+  std::vector<z3::expr> at_k;
+  for (std::size_t j : goals) {
+    at_k.push_back(enc_.Holds(set_[j]->bad, k, 0.0));
+    bad.push_back(at_k.back());
+  }
+  AddWithDefinitions(s, enc_, z3::mk_or(bad));
+  const z3::check_result r =
+      meter_.Check(s, limit, ceiling_, m < 0 ? "induction" : "induction, one mode");
+  if (r == z3::sat) {
+    const z3::model model = s.get_model();
+    for (std::size_t g = 0; g < goals.size(); ++g) {
+      if (model.eval(at_k[g], true).is_true()) failed.push_back(goals[g]);
+    }
+    if (failed.empty()) failed = goals;  // cannot tell which: drop all (sound)
+    if (LogEnabled(LogLevel::kDebug)) LogFailedStep(m, failed);
+  }
+  return r;
+}
+
+void InductionRound::LogFailedStep(int m, const std::vector<std::size_t>& failed) const {
+  std::string names;
+  for (std::size_t j : failed) names += (names.empty() ? "" : ", ") + set_[j]->goal->property.name;
+  Log(LogLevel::kDebug, "prove",
+      std::to_string(k_) + "-induction step from " +
+          (m < 0 ? std::string("any mode") : "mode " + enc_.automaton().modes()[m].name) +
+          " fails for " + names);
+}
+
+const z3::expr& InductionRound::StepPath(int m) {
+  const int k = k_;
+  std::optional<z3::expr>& path = m < 0 ? path_any_ : path_from_[m];
+  if (!path) {
+    z3::expr_vector e(ctx_);
+    for (int i = 0; i <= k; ++i) e.push_back(enc_.State(i));
+    for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
+    e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
+    e.push_back(enc_.TakeDefinitions());
+    path = z3::mk_and(e);
+  }
+  return *path;
+}
+
+const z3::expr& InductionRound::Hypotheses() {
+  if (!hypotheses_) {
+    z3::expr_vector e(ctx_);
+    for (std::size_t j = 0; j < set_.size(); ++j) {
+      if (!alive_[j]) continue;
+      for (int i = 0; i < k_; ++i) e.push_back(!enc_.Holds(set_[j]->bad, i, 0.0));
+    }
+    e.push_back(enc_.TakeDefinitions());
+    hypotheses_ = z3::mk_and(e);
+  }
+  return *hypotheses_;
+}
+
+}  // namespace hybrid

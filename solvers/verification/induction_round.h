@@ -1,0 +1,92 @@
+#pragma once
+
+// Internal to hybrid::verification: includes Z3's C++ API, which no public header exposes.
+
+#include <z3++.h>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "solvers/verification/proof_candidate.h"
+#include "solvers/verification/query_meter.h"
+#include "solvers/verification/smt_encoding.h"
+
+namespace hybrid {
+
+/// One round of k-induction with Houdini over candidate invariants: finds the largest subset of
+/// the candidates that is inductive together, i.e. no path of k steps of the encoding on which
+/// all of them hold at s_0 .. s_k-1 breaks one of them at s_k (the step query). Together with a
+/// base case (no violation on paths of fewer than k steps from an initial state, which the
+/// caller checks), the survivors are invariants of every run.
+///
+/// The step query is asked first from any mode in one query (Z3's default solver; cheap where
+/// the flows are simple, however many modes) while it decides, then split on the mode of
+/// s_k-1 (nlsat: one small nonlinear problem per mode is far easier than their disjunction).
+/// Per query, all living candidates at once: a model names those it breaks, which are dropped
+/// (all of them when it cannot tell), and the rest are checked again; a per-mode query that runs
+/// out is split per candidate with a larger limit (resource_limit / 5, then resource_limit), and
+/// a candidate that runs out alone is dropped. Dropping is always sound: what survives is
+/// inductive whatever was dropped. Once the budget reaches `ceiling`, every living candidate is
+/// dropped (cut()).
+///
+/// Formulas are built once per round (the path per last mode, the hypotheses after each drop).
+/// Logs (topic "prove") at kDebug each failed step: k, the mode, the candidates it breaks (not
+/// the path: reading it from the model would use the context, and so change what later queries
+/// are charged).
+class InductionRound {
+ public:
+  /// A round of `k`-induction (k >= 1) over `candidates` (invariants; borrowed, as are
+  /// `encoding` and `meter`, which must be of one context: all must outlive the round), its
+  /// queries drawing from `meter` up to `ceiling`, each at most `resource_limit` units.
+  InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigned resource_limit, int k,
+                 std::vector<ProofCandidate*> candidates, std::uint64_t ceiling);
+
+  InductionRound(const InductionRound&) = delete;
+  InductionRound& operator=(const InductionRound&) = delete;
+
+  /// Drops candidates until those left are inductive together (or none is left).
+  void Run();
+
+  /// The candidates still alive, in the order given: after Run(), inductive together.
+  std::vector<ProofCandidate*> Inductive() const;
+
+  /// Whether the budget dropped candidates (the ceiling was reached or the safety deadline
+  /// passed before a per-mode step), rather than the step queries.
+  bool cut() const { return cut_; }
+
+ private:
+  // The indices of the candidates still alive.
+  std::vector<std::size_t> Living() const;
+  // Drops the candidates `failed`; whether any was alive (then the hypotheses are rebuilt).
+  bool Drop(const std::vector<std::size_t>& failed);
+  // The step from each mode in turn for the living candidates (split per candidate where a
+  // query runs out); drops those that fail and returns whether any was dropped.
+  bool StepPerMode();
+  // The step query from mode m, or from any mode (m = -1, with Z3's default solver): a path of k
+  // steps on which the living candidates hold before s_k and one of `goals` fails at s_k. On sat,
+  // `failed` gets the goals the model breaks (all of them when it cannot tell).
+  z3::check_result StepQuery(int m, const std::vector<std::size_t>& goals, unsigned limit,
+                             std::vector<std::size_t>& failed);
+  // Logs (kDebug) that the step from mode m (any: m < 0) fails for the candidates `failed`.
+  void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
+  // The path of the step query from mode m (any: m < 0), built on first use.
+  const z3::expr& StepPath(int m);
+  // The living candidates hold at s_0 .. s_k-1: built on first use after each drop.
+  const z3::expr& Hypotheses();
+
+  SmtEncoding& enc_;
+  QueryMeter& meter_;
+  z3::context& ctx_;
+  unsigned resource_limit_;
+  int k_;
+  std::uint64_t ceiling_;
+  std::vector<ProofCandidate*> set_;
+  std::vector<bool> alive_;
+  std::vector<std::optional<z3::expr>> path_from_;  // the path of k steps, per last mode
+  std::optional<z3::expr> hypotheses_;              // of the alive candidates
+  std::optional<z3::expr> path_any_;                // the path of k steps, any last mode
+  bool cut_ = false;
+};
+
+}  // namespace hybrid
