@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
+#include "hybrid/automaton/parser.h"
 #include "hybrid/gripper/finger_diagnosis.h"
 #include "hybrid/gripper/synthetic_data.h"
 

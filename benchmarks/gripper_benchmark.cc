@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
+#include "hybrid/automaton/parser.h"
 #include "hybrid/gripper/finger_closed_form.h"
 #include "hybrid/gripper/geometric_finger.h"
 #include "hybrid/gripper/hand.h"

@@ -12,8 +12,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
+#include "hybrid/automaton/parser.h"
 #include "hybrid/simulation/simulator.h"
 
 namespace {

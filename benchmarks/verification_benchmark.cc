@@ -7,8 +7,8 @@
 
 #include <string>
 
-#include "hybrid/automaton/parser.h"
 #include "benchmarks/bundled_model.h"
+#include "hybrid/automaton/parser.h"
 #include "hybrid/verification/property_prover.h"
 
 namespace {

@@ -3,10 +3,10 @@
 #include <sstream>
 #include <vector>
 
+#include "automaton/rectangular_rate.h"
 #include "hybrid/automaton/expression.h"
 #include "hybrid/automaton/mode_graph.h"
 #include "hybrid/automaton/printer.h"
-#include "automaton/rectangular_rate.h"
 
 namespace hybrid::cli {
 namespace {

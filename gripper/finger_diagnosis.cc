@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "hybrid/diagnosis/parallel_for.h"
 #include "hybrid/gripper/finger_diagnosis_model.h"
-#include "solvers/diagnosis/parallel_for.h"
 
 namespace hybrid {
 namespace {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "hybrid/automaton/expression.h"
 #include "automaton/number_syntax.h"
+#include "hybrid/automaton/expression.h"
 
 namespace hybrid::gripper {
 namespace {

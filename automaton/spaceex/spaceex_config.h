@@ -21,9 +21,9 @@ class SpaceExConfig {
     std::size_t offset = 0;
   };
 
-  /// Parses `text`, named `file` in messages. Throws ParseError (include/hybrid/automaton/parser.h) at the line
-  /// and column of a line that is not `option = value`, an unterminated quote or an option
-  /// given twice.
+  /// Parses `text`, named `file` in messages. Throws ParseError (include/hybrid/automaton/parser.h)
+  /// at the line and column of a line that is not `option = value`, an unterminated quote or an
+  /// option given twice.
   SpaceExConfig(std::string_view text, std::string file);
 
   const std::string& file() const { return file_; }

@@ -8,11 +8,11 @@
 #include <set>
 #include <utility>
 
-#include "hybrid/automaton/parser.h"
 #include "automaton/quoted_text.h"
 #include "automaton/spaceex/spaceex_config.h"
 #include "automaton/spaceex/spaceex_document.h"
 #include "automaton/spaceex/sx_formula.h"
+#include "hybrid/automaton/parser.h"
 
 namespace hybrid::spaceex {
 namespace {

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "solvers/diagnosis/parallel_for.h"
+#include "hybrid/diagnosis/parallel_for.h"
 
 namespace hybrid {
 namespace {

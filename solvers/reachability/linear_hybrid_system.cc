@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hybrid/automaton/interval.h"
 #include "automaton/rectangular_rate.h"
+#include "hybrid/automaton/interval.h"
 #include "hybrid/checking/trace.h"
 
 namespace hybrid {

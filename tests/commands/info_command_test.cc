@@ -1,5 +1,5 @@
-// Tests of `hybrid info`'s text form (commands/info_command.h): the model in its own language, which
-// the parser (written apart from the printer) reads back to an equal System for every bundled
+// Tests of `hybrid info`'s text form (commands/info_command.h): the model in its own language,
+// which the parser (written apart from the printer) reads back to an equal System for every bundled
 // model, with units, `within` horizons and the scenario kept; the analysis as comments; and the
 // scenario's command-line form, which `hybrid simulate` runs to the same result as the scenario.
 

@@ -1,7 +1,7 @@
 // libFuzzer harness: the measured-data CSV reader of `hybrid diagnose` (ReadMeasuredData in
-// include/hybrid/gripper/measured_data.h), then the outlier cleaning and noise estimate applied to what it
-// reads. Every input either throws DataError (line and column not negative, a message about the
-// data) or gives runs that keep the documented invariants: a non-empty label, at least
+// include/hybrid/gripper/measured_data.h), then the outlier cleaning and noise estimate applied to
+// what it reads. Every input either throws DataError (line and column not negative, a message about
+// the data) or gives runs that keep the documented invariants: a non-empty label, at least
 // kMinRunSamples samples, g finite in [0, 255], angles finite or NaN (missing), gob and
 // contact_link set together with gob in [0, 255] and contact_link 1 or 2, increasing lines,
 // positions (when the file has the column) one per sample, missing or in [0, 255] and at most half

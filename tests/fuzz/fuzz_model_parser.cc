@@ -1,8 +1,8 @@
 // libFuzzer harness: the model-language parser (ParseModel) on arbitrary bytes.
-// Contract checked (include/hybrid/automaton/parser.h): every input either gives a System or throws ParseError,
-// never anything else; the error's position lies in the input when it concerns the input's own
-// file; messages speak of the model, not of C++. ASan and UBSan check memory and undefined
-// behaviour; libFuzzer's -timeout and -rss_limit_mb bound time and memory per input.
+// Contract checked (include/hybrid/automaton/parser.h): every input either gives a System or throws
+// ParseError, never anything else; the error's position lies in the input when it concerns the
+// input's own file; messages speak of the model, not of C++. ASan and UBSan check memory and
+// undefined behaviour; libFuzzer's -timeout and -rss_limit_mb bound time and memory per input.
 
 #include <cstdint>
 #include <string>

@@ -1,8 +1,9 @@
 // libFuzzer harness: object descriptions (`--object circle:X,Y,R` or segment:X1,Y1,X2,Y2[,R],
-// gripper::Obstacle::Parse in include/hybrid/gripper/obstacle.h). Every input either throws ObstacleParseError
-// with a column of the text, or gives an object with finite coordinates and a finite radius of
-// at least kMinimumRadius whose description (ToString) parses back to the same object, from a
-// text in the documented syntax (decimal numbers, automaton/number_syntax.h) with those numbers.
+// gripper::Obstacle::Parse in include/hybrid/gripper/obstacle.h). Every input either throws
+// ObstacleParseError with a column of the text, or gives an object with finite coordinates and a
+// finite radius of at least kMinimumRadius whose description (ToString) parses back to the same
+// object, from a text in the documented syntax (decimal numbers, automaton/number_syntax.h) with
+// those numbers.
 
 #include <algorithm>
 #include <cmath>

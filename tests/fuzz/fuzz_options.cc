@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
+#include "cli/options.h"
 #include "tests/fuzz/fuzz_utilities.h"
 #include "tests/fuzz/number_oracle.h"
-#include "cli/options.h"
 
 namespace {
 

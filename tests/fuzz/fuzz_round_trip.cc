@@ -1,6 +1,6 @@
-// libFuzzer harness: parse, print, parse again (include/hybrid/automaton/printer.h). For every input the parser
-// accepts, the printed model must parse back (no ParseError) into an equal System (operator==),
-// and printing that gives the same text again.
+// libFuzzer harness: parse, print, parse again (include/hybrid/automaton/printer.h). For every
+// input the parser accepts, the printed model must parse back (no ParseError) into an equal System
+// (operator==), and printing that gives the same text again.
 
 #include <cstdint>
 #include <optional>

@@ -1,6 +1,6 @@
 // libFuzzer harness: signals as given on the command line (`--input 'u=step(0: 5, 30: 15)'`,
-// ParseSignal in include/hybrid/automaton/parser.h). Every input either throws ParseError at a position of the
-// text, or gives a signal whose times strictly increase and whose numbers are
+// ParseSignal in include/hybrid/automaton/parser.h). Every input either throws ParseError at a
+// position of the text, or gives a signal whose times strictly increase and whose numbers are
 // finite; writing that signal back (shortest round-trip numbers) and parsing it gives it again.
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// The closed form of section 4 (include/hybrid/gripper/finger_closed_form.h): the report's tables, the clashes
-// found in them (docs/finger_model.md), and one truth with the simulated automaton
+// The closed form of section 4 (include/hybrid/gripper/finger_closed_form.h): the report's tables,
+// the clashes found in them (docs/finger_model.md), and one truth with the simulated automaton
 // spec/finger.ha.
 #include "hybrid/gripper/finger_closed_form.h"
 

@@ -1,5 +1,5 @@
-// The finger as a DiagnosisModel (include/hybrid/gripper/finger_diagnosis_model.h): its candidates, its
-// shortcut for sensor biases and its pruning of runs a parameter cannot change, checked against
+// The finger as a DiagnosisModel (include/hybrid/gripper/finger_diagnosis_model.h): its candidates,
+// its shortcut for sensor biases and its pruning of runs a parameter cannot change, checked against
 // FingerPredictor itself (whose own tests check it against the closed form).
 
 #include "hybrid/gripper/finger_diagnosis_model.h"

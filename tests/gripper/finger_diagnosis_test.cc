@@ -1,7 +1,8 @@
-// Tests of Diagnose (include/hybrid/gripper/finger_diagnosis.h) on data that hide an effect: synthetic runs of the
-// finger model (include/hybrid/gripper/synthetic_data.h) with the report's measurement noise (0.7 deg on theta1
-// and theta2, 1.2 deg on theta3, outliers on theta3, missing samples), written to CSV and read
-// back, so that the diagnosis sees only what `hybrid diagnose DATA.csv` sees.
+// Tests of Diagnose (include/hybrid/gripper/finger_diagnosis.h) on data that hide an effect:
+// synthetic runs of the finger model (include/hybrid/gripper/synthetic_data.h) with the report's
+// measurement noise (0.7 deg on theta1 and theta2, 1.2 deg on theta3, outliers on theta3, missing
+// samples), written to CSV and read back, so that the diagnosis sees only what `hybrid diagnose
+// DATA.csv` sees.
 //
 // - Deterministic cases: `none` on clean data, one cause, two causes, the effects outside the
 //   list (`unexplained` with `where`), bad input.

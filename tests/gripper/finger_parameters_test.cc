@@ -1,5 +1,5 @@
-// FingerParametersOf (include/hybrid/gripper/finger_parameters.h): the closed form's constants read from a
-// finger automaton, as declared or as changed.
+// FingerParametersOf (include/hybrid/gripper/finger_parameters.h): the closed form's constants read
+// from a finger automaton, as declared or as changed.
 
 #include "hybrid/gripper/finger_parameters.h"
 

@@ -1,8 +1,8 @@
-// Tests of measured data (include/hybrid/gripper/measured_data.h): reading the CSV of runs (comments, blank
-// lines, CRLF, missing samples, optional columns, any column order) and every error it reports
-// with its line and column; the report's outlier rule (spikes clamped, ramps and genuine steps
-// kept, missing samples skipped); the noise floor from repeated runs and from second differences
-// on synthetic data with known noise.
+// Tests of measured data (include/hybrid/gripper/measured_data.h): reading the CSV of runs
+// (comments, blank lines, CRLF, missing samples, optional columns, any column order) and every
+// error it reports with its line and column; the report's outlier rule (spikes clamped, ramps and
+// genuine steps kept, missing samples skipped); the noise floor from repeated runs and from second
+// differences on synthetic data with known noise.
 
 #include "hybrid/gripper/measured_data.h"
 

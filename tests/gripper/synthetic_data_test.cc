@@ -1,6 +1,6 @@
-// Tests of synthetic measured data (include/hybrid/gripper/synthetic_data.h): the written CSV reads back to the
-// same runs; the seed decides the data; noiseless data equal the predictor's angles; noise,
-// outliers and missing samples follow the design; the hidden effects outside FingerEffects
+// Tests of synthetic measured data (include/hybrid/gripper/synthetic_data.h): the written CSV reads
+// back to the same runs; the seed decides the data; noiseless data equal the predictor's angles;
+// noise, outliers and missing samples follow the design; the hidden effects outside FingerEffects
 // (ripple, theta3 hysteresis) change the angles as documented; bad designs are rejected.
 
 #include "hybrid/gripper/synthetic_data.h"

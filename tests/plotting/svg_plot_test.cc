@@ -1,8 +1,8 @@
-// The SVG plotting module (include/hybrid/plotting/svg_plot.h) against expectations worked out by hand: XML
-// escaping, number formats, the 1-2-5 rule of tick steps and scale bars, ticks, the plot area's
-// mapping, the exact markup of every element helper in both attribute placements, series split at
-// missing values, legends, axes, and well-formed documents (checked by a small tag parser: no
-// std::regex, whose recursion overflows the stack under AddressSanitizer).
+// The SVG plotting module (include/hybrid/plotting/svg_plot.h) against expectations worked out by
+// hand: XML escaping, number formats, the 1-2-5 rule of tick steps and scale bars, ticks, the plot
+// area's mapping, the exact markup of every element helper in both attribute placements, series
+// split at missing values, legends, axes, and well-formed documents (checked by a small tag parser:
+// no std::regex, whose recursion overflows the stack under AddressSanitizer).
 #include "hybrid/plotting/svg_plot.h"
 
 #include <gtest/gtest.h>

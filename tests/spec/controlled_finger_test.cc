@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
 #include "hybrid/simulation/simulator.h"
 #include "hybrid/verification/property_prover.h"
-#include "hybrid/checking/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/robotiq_rig.h"

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "hybrid/automaton/parser.h"
+#include "hybrid/checking/trace.h"
 #include "hybrid/simulation/simulator.h"
 #include "hybrid/verification/property_prover.h"
-#include "hybrid/checking/trace.h"
 #include "tests/test_utilities/models.h"
 #include "tests/test_utilities/properties.h"
 #include "tests/test_utilities/trace_states.h"

@@ -100,10 +100,11 @@ std::vector<double> RigProtocol(double top, RigStepping stepping, std::uint64_t 
                                 std::optional<double> reverse_at = std::nullopt,
                                 double reverse_depth = 20.0);
 
-/// The rows of `samples` as CSV lines of the measured-data format (include/hybrid/gripper/measured_data.h)
-/// with the optional `position` column: run,g,position,theta1,theta2,theta3[,gob,contact_link]
-/// (gob and contact_link when `contact_link` is 1 or 2; `gob` is then the object's position for
-/// that link; two empty cells for a free run when `contact_columns`). No header.
+/// The rows of `samples` as CSV lines of the measured-data format
+/// (include/hybrid/gripper/measured_data.h) with the optional `position` column:
+/// run,g,position,theta1,theta2,theta3[,gob,contact_link] (gob and contact_link when `contact_link`
+/// is 1 or 2; `gob` is then the object's position for that link; two empty cells for a free run
+/// when `contact_columns`). No header.
 std::string RigCsvRows(const std::string& run, const std::vector<RigSample>& samples,
                        const RigObject& object, int contact_link, bool contact_columns = false);
 

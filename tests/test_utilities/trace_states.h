@@ -1,7 +1,7 @@
 #pragma once
 
-// Simulating a verifier's trace again, apart from ReplayTrace (include/hybrid/checking/trace.h), for
-// tests that judge the states it reaches themselves (shared by the verification tests).
+// Simulating a verifier's trace again, apart from ReplayTrace (include/hybrid/checking/trace.h),
+// for tests that judge the states it reaches themselves (shared by the verification tests).
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <string>
 
 #include "hybrid/automaton/system.h"
-#include "hybrid/simulation/simulator.h"
 #include "hybrid/checking/check_result.h"
 #include "hybrid/checking/trace.h"
+#include "hybrid/simulation/simulator.h"
 
 namespace hybrid::testing {
 

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "hybrid/diagnosis/diagnosis_model.h"
 #include "hybrid/gripper/finger_effects.h"
 #include "hybrid/gripper/finger_predictor.h"
 #include "hybrid/gripper/measured_data.h"
-#include "hybrid/diagnosis/diagnosis_model.h"
 
 namespace hybrid {
 

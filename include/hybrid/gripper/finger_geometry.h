@@ -23,10 +23,10 @@ struct FingerLengths {
 
 /// Where a finger stands in the plane its objects are described in: a point at finger coordinates
 /// (x, y) is at (origin_x + x_scale * x, y). The identity (the default) is the finger's own frame.
-/// In the hand (include/hybrid/gripper/hand.h) objects are described in the palm's x-y plane and extruded along
-/// z; a finger whose plane is turned by the spread angle phi about the vertical axis sees them
-/// through x_scale = -cos(phi) (facing -x): contact with an extruded object happens exactly when
-/// the link's projection onto the x-y plane touches the object's section.
+/// In the hand (include/hybrid/gripper/hand.h) objects are described in the palm's x-y plane and
+/// extruded along z; a finger whose plane is turned by the spread angle phi about the vertical axis
+/// sees them through x_scale = -cos(phi) (facing -x): contact with an extruded object happens
+/// exactly when the link's projection onto the x-y plane touches the object's section.
 struct FingerPlacement {
   double origin_x = 0.0;
   double x_scale = 1.0;

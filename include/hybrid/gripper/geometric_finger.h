@@ -32,9 +32,9 @@ class GeometricFinger {
   static constexpr double kResolution = 0.05;
 
   /// `imposed`: contacts found outside this finger (another finger touching link i at
-  /// imposed.gob[i], see include/hybrid/gripper/hand.h); each competes with the geometric contacts (the first
-  /// one blocks the link). `up_to`: contacts are searched for motor positions up to this one
-  /// (the motor command; the closed form beyond it assumes no further contact). Throws
+  /// imposed.gob[i], see include/hybrid/gripper/hand.h); each competes with the geometric contacts
+  /// (the first one blocks the link). `up_to`: contacts are searched for motor positions up to this
+  /// one (the motor command; the closed form beyond it assumes no further contact). Throws
   /// std::invalid_argument ("object ... overlaps the palm ...") if an object overlaps the palm or
   /// the open finger (g = 0).
   explicit GeometricFinger(std::vector<Obstacle> objects,

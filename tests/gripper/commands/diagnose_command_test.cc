@@ -1,7 +1,8 @@
-// Tests of `hybrid diagnose` and `hybrid synthesize` (HYBRID_BINARY, gripper/commands/diagnose_command.h):
-// synthetic data with hidden effects (deterministic per seed, marked SYNTHETIC); the diagnosis of
-// backlash plus a theta3 sensor bias (cause, parameters, held-out errors, noise floor); the
-// extended model (`--out-model`) accepted by info, simulate, dot and check; the report directory
+// Tests of `hybrid diagnose` and `hybrid synthesize` (HYBRID_BINARY,
+// gripper/commands/diagnose_command.h): synthetic data with hidden effects (deterministic per seed,
+// marked SYNTHETIC); the diagnosis of backlash plus a theta3 sensor bias (cause, parameters,
+// held-out errors, noise floor); the extended model (`--out-model`) accepted by info, simulate, dot
+// and check; the report directory
 // (`--report`); clean data ("none") and an effect outside the diagnosable list ("unexplained"
 // with `where`); bad data (exit 1, FILE:LINE:COL, no output files), bad options and outputs
 // naming an input or one another (exit 2), caps on synthetic sizes, and an unwritable output

@@ -1,8 +1,8 @@
-// Tests of the SVG files of `hybrid diagnose --report DIR` (gripper/commands/diagnosis_report.h): file names
-// (sanitised, unique run labels), a naive well-formedness check (root element, balanced groups,
-// no "nan"/"inf"), one polyline per stretch of finite model values, one dot per finite measured
-// sample or residual, XML escaping of labels and causes, the noise lines and ticks, the size of a
-// long run's file, and the empty directory.
+// Tests of the SVG files of `hybrid diagnose --report DIR` (gripper/commands/diagnosis_report.h):
+// file names (sanitised, unique run labels), a naive well-formedness check (root element, balanced
+// groups, no "nan"/"inf"), one polyline per stretch of finite model values, one dot per finite
+// measured sample or residual, XML escaping of labels and causes, the noise lines and ticks, the
+// size of a long run's file, and the empty directory.
 
 #include "gripper/commands/diagnosis_report.h"
 

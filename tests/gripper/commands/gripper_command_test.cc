@@ -1,10 +1,11 @@
-// End-to-end tests of `hybrid finger` and `hybrid hand` (HYBRID_BINARY; gripper/commands/gripper_command.cc,
-// docs/finger_model.md): the closed form of section 4 through the command line (free-space table
-// 4.1, a link-1 contact given as gob1), objects given by geometry (the analytic contact position
-// of a circle), --simulate agreeing with the closed form, the SVG outputs, the hand's three
-// fingers, and every kind of bad input (exit 2 for bad options, malformed numbers and object
-// descriptions and outputs naming one file, 1 for objects the gripper cannot hold, 3 for
-// unwritable outputs; a message on stderr, nothing on stdout, no file left behind or changed).
+// End-to-end tests of `hybrid finger` and `hybrid hand` (HYBRID_BINARY;
+// gripper/commands/gripper_command.cc, docs/finger_model.md): the closed form of section 4 through
+// the command line (free-space table 4.1, a link-1 contact given as gob1), objects given by
+// geometry (the analytic contact position of a circle), --simulate agreeing with the closed form,
+// the SVG outputs, the hand's three fingers, and every kind of bad input (exit 2 for bad options,
+// malformed numbers and object descriptions and outputs naming one file, 1 for objects the gripper
+// cannot hold, 3 for unwritable outputs; a message on stderr, nothing on stdout, no file left
+// behind or changed).
 
 #include <gtest/gtest.h>
 

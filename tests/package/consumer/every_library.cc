@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "hybrid/spaceex/spaceex_import.h"
+#include "hybrid/diagnosis/parallel_for.h"
 #include "hybrid/gripper/finger_closed_form.h"
 #include "hybrid/plotting/svg_plot.h"
-#include "solvers/diagnosis/parallel_for.h"
 #include "hybrid/reachability/polyhedral_reachability.h"
+#include "hybrid/spaceex/spaceex_import.h"
 #include "hybrid/verification/property_prover.h"
 
 namespace {

@@ -1,7 +1,7 @@
-// Tests of the checking layer (include/hybrid/checking/property_checker.h): the registry makes checkers
-// by name and names the methods in its errors; a fallback asks each later checker only what the
-// earlier ones left unknown, and skips checkers that do not apply. The checkers here are scripted
-// fakes (a verdict per property name), so what is tested is the layer's bookkeeping alone.
+// Tests of the checking layer (include/hybrid/checking/property_checker.h): the registry makes
+// checkers by name and names the methods in its errors; a fallback asks each later checker only
+// what the earlier ones left unknown, and skips checkers that do not apply. The checkers here are
+// scripted fakes (a verdict per property name), so what is tested is the layer's bookkeeping alone.
 
 #include "hybrid/checking/property_checker.h"
 

@@ -1,5 +1,6 @@
-// Tests of traces (include/hybrid/checking/trace.h): the uncertain parameters of automata and systems;
-// replaying a trace finds the first recorded state that violates (`always`, `never`) or satisfies
+// Tests of traces (include/hybrid/checking/trace.h): the uncertain parameters of automata and
+// systems; replaying a trace finds the first recorded state that violates (`always`, `never`) or
+// satisfies
 // (`reach`) a property, within a `within T` horizon, with the documented tolerance; the trace's
 // parameter and initial values are applied; misuse throws.
 

@@ -1,4 +1,4 @@
-#include "solvers/diagnosis/parallel_for.h"
+#include "hybrid/diagnosis/parallel_for.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-// Tests of exact polyhedral reachability (include/hybrid/reachability/polyhedral_reachability.h) on small
-// models whose verdicts are known analytically: proved bounds, violations and witnesses whose
+// Tests of exact polyhedral reachability (include/hybrid/reachability/polyhedral_reachability.h) on
+// small models whose verdicts are known analytically: proved bounds, violations and witnesses whose
 // traces the simulator replays, a rectangular rate, an uncertain parameter, a simultaneous swap
 // and a long chain of jumps; and its deterministic budget: models whose reachable set never
 // converges stop at the budget, with the same verdict, reason and state count on every run, also
