@@ -7,18 +7,24 @@
 // The mutated finger's proofs can take tens of seconds when every property is checked: its tests
 // always name one property and give a small --budget.
 
+#include "commands/check_command.h"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
+#include "commands/simulate_command.h"
 #include "tests/test_utilities/command_line.h"
 
 namespace hybrid {
@@ -31,10 +37,23 @@ using testing::Quote;
 using testing::ReadAll;
 using testing::Result;
 using testing::RunHybrid;
-using testing::RunHybridJson;
 using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
+
+// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
+template <typename T>
+T ArgsOf(const std::string& model) {
+  T a;
+  a.model = model;
+  return a;
+}
+template <typename T, typename Set>
+T ArgsOf(const std::string& model, Set set) {
+  T a = ArgsOf<T>(model);
+  set(a);
+  return a;
+}
 const std::string kFinger = (kSourceDir / "spec" / "finger.ha").string();
 const std::string kHand = (kSourceDir / "spec" / "hand.ha").string();
 
@@ -89,22 +108,65 @@ std::string Number(double x) {
   return out.str();
 }
 
-// `hybrid simulate` arguments that replay `trace` (from `hybrid check --json`) up to `until`:
-// every input as a step signal, every parameter set.
-std::string ReplayArguments(const json& trace, double until) {
-  std::string args;
+// The arguments of `hybrid simulate MODEL` that replay `trace` (from `hybrid check --json`) up to
+// `until`: every input as a step signal, every parameter set.
+cli::SimulateArgs Replay(const std::string& model, const json& trace, double until) {
+  cli::SimulateArgs args = ArgsOf<cli::SimulateArgs>(model, [&](cli::SimulateArgs& a) {
+    a.until = until;
+    a.json = true;
+  });
   for (const auto& [name, points] : Field(trace, "inputs").items()) {
     std::string signal = name + "=step(";
     for (std::size_t i = 0; i < points.size(); ++i) {
       signal += (i ? ", " : "") + Number(points[i][0].get<double>()) + ": " +
                 Number(points[i][1].get<double>());
     }
-    args += " --input " + Quote(signal + ")");
+    args.inputs.push_back(signal + ")");
   }
   for (const auto& [name, value] : Field(trace, "parameters").items()) {
-    args += " --set " + Quote(name + "=" + Number(value.get<double>()));
+    args.parameters.push_back(name + "=" + Number(value.get<double>()));
   }
-  return args + " --until " + Number(until);
+  return args;
+}
+
+// A command run in this process (cli::RunCheck, cli::RunSimulate): its exit code and what it
+// writes on standard output (std::cout). For what the commands compute and write; the tests of
+// the command line (its options, messages on standard error, exit codes of errors, the process's
+// memory) run the program.
+struct InProcess {
+  int exit_code = -1;
+  std::string out;
+};
+
+template <typename Args>
+InProcess Here(const Args& args) {
+  std::ostringstream out;
+  struct Restore {
+    std::streambuf* buffer;
+    ~Restore() { std::cout.rdbuf(buffer); }
+  } restore{std::cout.rdbuf(out.rdbuf())};
+  int exit_code = -1;
+  if constexpr (std::is_same_v<Args, cli::CheckArgs>) {
+    exit_code = cli::ExitStatus(cli::RunCheck(args));
+  } else {
+    exit_code = cli::ExitStatus(cli::RunSimulate(args));
+  }
+  return {exit_code, out.str()};
+}
+
+// A command in this process (Here) with `json` set: expects `expected_exit` and parses standard
+// output (an output that is not JSON is a test failure and gives an empty object).
+template <typename Args>
+json JsonHere(Args args, int expected_exit) {
+  args.json = true;
+  const InProcess r = Here(args);
+  EXPECT_EQ(r.exit_code, expected_exit) << args.model;
+  try {
+    return json::parse(r.out);
+  } catch (const json::exception& e) {
+    ADD_FAILURE() << args.model << ": not JSON (" << e.what() << "):\n" << r.out;
+    return json::object();
+  }
 }
 
 // A small model: x rises at rate u in mode a, jumps to b at x >= 1 and falls there; mode c
@@ -127,7 +189,7 @@ std::string SmallModel(const std::string& properties) {
 // The finger.
 
 TEST(CheckCommand, ProvesEveryInvariantOfTheFingerAndReachesFullClosure) {
-  const json report = RunHybridJson("check " + Quote(kFinger), 0);
+  const json report = JsonHere(ArgsOf<cli::CheckArgs>(kFinger), 0);
   EXPECT_EQ(report.value("model", ""), kFinger);
   EXPECT_EQ(report.value("method", ""), "auto");  // the finger is not linear: k-induction
   for (const json& p : Field(report, "properties")) EXPECT_EQ(p.value("method", ""), "prove");
@@ -169,9 +231,10 @@ TEST(CheckCommand, ProvesEveryInvariantOfTheFingerAndReachesFullClosure) {
 }
 
 TEST(CheckCommand, TextOutputNamesTheModelAndTheVerdicts) {
-  const Result r =
-      RunHybrid("check " + Quote(kFinger) + " --property theta1_range --property can_close_fully");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const InProcess r = Here(ArgsOf<cli::CheckArgs>(kFinger, [&](cli::CheckArgs& a) {
+    a.properties = {"theta1_range", "can_close_fully"};
+  }));
+  ASSERT_EQ(r.exit_code, 0);
   EXPECT_TRUE(r.out.starts_with(kFinger + ": 2 properties, method auto, ")) << r.out;
   EXPECT_NE(r.out.find("\n  proved  theta1_range (always, "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\n  reachable  can_close_fully (reach, "), std::string::npos) << r.out;
@@ -182,7 +245,9 @@ TEST(CheckCommand, TextOutputNamesTheModelAndTheVerdicts) {
 }
 
 TEST(CheckCommand, HandSpreadIsProved) {
-  const json report = RunHybridJson("check " + Quote(kHand) + " --property spread_in_range", 0);
+  const json report = JsonHere(
+      ArgsOf<cli::CheckArgs>(kHand, [&](cli::CheckArgs& a) { a.properties = {"spread_in_range"}; }),
+      0);
   ASSERT_EQ(report.value("properties", json::array()).size(), 1u) << report.dump(2);
   const json p = Property(report, "spread_in_range");
   EXPECT_EQ(p.value("kind", ""), "always");
@@ -197,8 +262,12 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   TempDir dir;
   const std::string model = MutatedFinger(dir);
   ASSERT_FALSE(model.empty());
-  const json report =
-      RunHybridJson("check " + Quote(model) + " --property theta1_range --budget 20", 6);
+  const json report = JsonHere(ArgsOf<cli::CheckArgs>(model,
+                                                      [&](cli::CheckArgs& a) {
+                                                        a.properties = {"theta1_range"};
+                                                        a.budget = 20;
+                                                      }),
+                               6);
   ASSERT_EQ(report.value("properties", json::array()).size(), 1u) << report.dump(2);
   const json p = Property(report, "theta1_range");
   EXPECT_EQ(p.value("verdict", ""), "violated") << p.dump(2);
@@ -218,16 +287,15 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
   // Replayed by `hybrid simulate` to the trace's horizon, theta1 is past its limit...
   // The run may go on to stop at the motor's range (exit 5, invariant_violated) after the
   // violating state; what matters is the state, compared below.
-  const Result replay =
-      RunHybrid("simulate " + Quote(model) + ReplayArguments(trace, until) + " --json");
-  ASSERT_TRUE(replay.exit_code == 0 || replay.exit_code == 5) << replay.err;
+  const InProcess replay = Here(Replay(model, trace, until));
+  ASSERT_TRUE(replay.exit_code == 0 || replay.exit_code == 5) << replay.exit_code;
   const json run = json::parse(replay.out);
   ASSERT_TRUE(run.contains("final")) << run.dump(2);
   EXPECT_GT(Field(run, "final", "values").value("theta1", 0.0), 70.0) << run.dump(2);
 
   // ... and at the violating state's time it is in the same mode with the same values, after
   // the same events.
-  const json at = RunHybridJson("simulate " + Quote(model) + ReplayArguments(trace, state_time), 0);
+  const json at = JsonHere(Replay(model, trace, state_time), 0);
   ASSERT_TRUE(at.contains("final")) << at.dump(2);
   EXPECT_EQ(Field(at, "final").value("mode", ""), Field(trace, "state").value("mode", "?"));
   for (const auto& [name, value] : Field(trace, "state", "values").items()) {
@@ -243,8 +311,16 @@ TEST(CheckCommand, MutatedFingerCounterexampleReplaysInTheSimulator) {
 }
 
 TEST(CheckCommand, SamplingFindsTheMutationButNeverProves) {
-  const std::string options = " --method sample --property theta1_range --runs 20 --seed 3";
-  const json sound = RunHybridJson("check " + Quote(kFinger) + options, 7);
+  // --method sample --property theta1_range --runs 20 --seed 3
+  const auto options = [](const std::string& model) {
+    return ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) {
+      a.properties = {"theta1_range"};
+      a.method = "sample";
+      a.runs = 20;
+      a.seed = 3;
+    });
+  };
+  const json sound = JsonHere(options(kFinger), 7);
   EXPECT_EQ(sound.value("method", ""), "sample");
   const json unknown = Property(sound, "theta1_range");
   EXPECT_EQ(unknown.value("verdict", ""), "unknown") << unknown.dump(2);
@@ -254,7 +330,7 @@ TEST(CheckCommand, SamplingFindsTheMutationButNeverProves) {
   TempDir dir;
   const std::string model = MutatedFinger(dir);
   ASSERT_FALSE(model.empty());
-  const json broken = RunHybridJson("check " + Quote(model) + options, 6);
+  const json broken = JsonHere(options(model), 6);
   const json violated = Property(broken, "theta1_range");
   EXPECT_EQ(violated.value("verdict", ""), "violated") << violated.dump(2);
   EXPECT_EQ(violated.value("method", ""), "sample");
@@ -263,8 +339,8 @@ TEST(CheckCommand, SamplingFindsTheMutationButNeverProves) {
       << violated.dump(2);
 
   // The text output says so too, with the same exit codes.
-  const Result text = RunHybrid("check " + Quote(kFinger) + options);
-  EXPECT_EQ(text.exit_code, 7) << text.err;
+  const InProcess text = Here(options(kFinger));
+  EXPECT_EQ(text.exit_code, 7);
   EXPECT_NE(text.out.find("  unknown  theta1_range (always, "), std::string::npos) << text.out;
 }
 
@@ -273,14 +349,20 @@ TEST(CheckCommand, SamplingFindsTheMutationButNeverProves) {
 
 TEST(CheckCommand, ExitCodesFollowTheVerdicts) {
   TempDir dir;
-  const std::string model =
-      Quote(dir.Write("two.ha", SmallModel("  property safe: always x >= 0;\n"
-                                           "  property low: always x <= 0.5;\n"
-                                           "  property never_b: never in b;\n"
-                                           "  property to_c: reach in c;\n"
-                                           "  property to_one: reach x >= 1;"))
-                .string());
-  const json all = RunHybridJson("check " + model, 6);
+  const std::string model = dir.Write("two.ha", SmallModel("  property safe: always x >= 0;\n"
+                                                           "  property low: always x <= 0.5;\n"
+                                                           "  property never_b: never in b;\n"
+                                                           "  property to_c: reach in c;\n"
+                                                           "  property to_one: reach x >= 1;"))
+                                .string();
+  const auto check = [&](std::vector<std::string> properties, const std::string& method = "auto") {
+    return ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) {
+      a.properties = std::move(properties);
+      a.method = method;
+      a.runs = 50;
+    });
+  };
+  const json all = JsonHere(ArgsOf<cli::CheckArgs>(model), 6);
   ASSERT_EQ(all.value("properties", json::array()).size(), 5u) << all.dump(2);
   EXPECT_EQ(Property(all, "safe").value("verdict", ""), "proved");
   const json low = Property(all, "low");
@@ -297,19 +379,15 @@ TEST(CheckCommand, ExitCodesFollowTheVerdicts) {
   EXPECT_EQ(Property(all, "to_one").value("verdict", ""), "reachable");
 
   // Exit 0 only when every chosen property holds; an unreachable reach target is a failure.
-  EXPECT_EQ(RunHybrid("check " + model + " --property safe --property to_one").exit_code, 0);
-  EXPECT_EQ(RunHybrid("check " + model + " --property low").exit_code, 6);
-  EXPECT_EQ(RunHybrid("check " + model + " --property to_c").exit_code, 6);
+  EXPECT_EQ(Here(check({"safe", "to_one"})).exit_code, 0);
+  EXPECT_EQ(Here(check({"low"})).exit_code, 6);
+  EXPECT_EQ(Here(check({"to_c"})).exit_code, 6);
   // Violated wins over unknown.
-  EXPECT_EQ(RunHybrid("check " + model + " --method sample --runs 50 --property safe").exit_code,
-            7);
-  EXPECT_EQ(
-      RunHybrid("check " + model + " --method sample --runs 50 --property safe --property low")
-          .exit_code,
-      6);
+  EXPECT_EQ(Here(check({"safe"}, "sample")).exit_code, 7);
+  EXPECT_EQ(Here(check({"safe", "low"}, "sample")).exit_code, 6);
 
   // Properties come out in the order asked, each with its own predicate.
-  const json some = RunHybridJson("check " + model + " --property to_one --property low", 6);
+  const json some = JsonHere(check({"to_one", "low"}), 6);
   ASSERT_EQ(some.value("properties", json::array()).size(), 2u) << some.dump(2);
   EXPECT_EQ(Field(some, "properties", 0).value("name", ""), "to_one");
   EXPECT_EQ(Field(some, "properties", 0).value("predicate", ""), "x >= 1");
@@ -320,8 +398,9 @@ TEST(CheckCommand, ExitCodesFollowTheVerdicts) {
 TEST(CheckCommand, ModesListsEveryModeWithAVerdict) {
   TempDir dir;
   const std::string model =
-      Quote(dir.Write("two.ha", SmallModel("  property safe: always x >= 0;")).string());
-  const json report = RunHybridJson("check " + model + " --modes", 0);
+      dir.Write("two.ha", SmallModel("  property safe: always x >= 0;")).string();
+  const json report =
+      JsonHere(ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) { a.modes = true; }), 0);
   ASSERT_TRUE(report.contains("modes")) << report.dump(2);
   ASSERT_EQ(Field(report, "modes").size(), 3u) << report.dump(2);
   for (const std::string name : {"a", "b"}) {
@@ -336,8 +415,9 @@ TEST(CheckCommand, ModesListsEveryModeWithAVerdict) {
   // The properties are still checked.
   EXPECT_EQ(Property(report, "safe").value("verdict", ""), "proved");
 
-  const Result text = RunHybrid("check " + model + " --modes");
-  EXPECT_EQ(text.exit_code, 0) << text.err;
+  const InProcess text =
+      Here(ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) { a.modes = true; }));
+  EXPECT_EQ(text.exit_code, 0);
   EXPECT_NE(text.out.find("modes (discrete states):\n"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("  reachable  a ("), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("  reachable  b ("), std::string::npos) << text.out;
@@ -363,7 +443,8 @@ TEST(CheckCommand, TankOfTheIssueIsViolatedAndReachableByBothMethods) {
   TempDir dir;
   const std::string model = dir.Write("tank.ha", kTank).string();
   for (const std::string method : {"prove", "sample"}) {
-    const json report = RunHybridJson("check " + Quote(model) + " --method " + method, 6);
+    const json report =
+        JsonHere(ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) { a.method = method; }), 6);
     const json below = Property(report, "stays_below_6");
     const json reach = Property(report, "reaches_7");
     EXPECT_EQ(below.value("verdict", ""), "violated") << method << below.dump(2);
@@ -373,10 +454,10 @@ TEST(CheckCommand, TankOfTheIssueIsViolatedAndReachableByBothMethods) {
     const json& trace = Field(below, "trace");
     const double at = Field(trace, "state").value("time", -1.0);
     ASSERT_GT(at, 0.0) << trace.dump(2);
-    const json sim = RunHybridJson("simulate " + Quote(model) + ReplayArguments(trace, at), 0);
+    const json sim = JsonHere(Replay(model, trace, at), 0);
     EXPECT_GT(Field(sim, "final", "values").value("h", 0.0), 6.0) << sim.dump(2);
   }
-  const Result text = RunHybrid("check " + Quote(model));
+  const InProcess text = Here(ArgsOf<cli::CheckArgs>(model));
   EXPECT_EQ(text.out.find("proved"), std::string::npos) << text.out;
   EXPECT_EQ(text.out.find("unreachable"), std::string::npos) << text.out;
 }
@@ -415,7 +496,12 @@ void ExpectChainVerdicts(const json& report) {
 TEST(CheckCommand, BudgetFiveStopsAThreeHundredModeChain) {
   TempDir dir;
   const std::string model = dir.Write("chain300.ha", Chain(300)).string();
-  const json report = RunHybridJson("check " + Quote(model) + " --method prove --budget 5", 7);
+  const json report = JsonHere(ArgsOf<cli::CheckArgs>(model,
+                                                      [&](cli::CheckArgs& a) {
+                                                        a.method = "prove";
+                                                        a.budget = 5;
+                                                      }),
+                               7);
   ExpectChainVerdicts(report);
   EXPECT_NE(Property(report, "far").value("reason", "").find("budget"), std::string::npos)
       << report.dump(2);
@@ -426,7 +512,7 @@ TEST(CheckCommand, BudgetFiveStopsAThreeHundredModeChain) {
 TEST(CheckCommand, AutoSettlesTheChainByPolyhedralReachability) {
   TempDir dir;
   const std::string model = dir.Write("chain300.ha", Chain(300)).string();
-  const json report = RunHybridJson("check " + Quote(model), 0);
+  const json report = JsonHere(ArgsOf<cli::CheckArgs>(model), 0);
   EXPECT_EQ(Property(report, "bounded").value("verdict", ""), "proved") << report.dump(2);
   EXPECT_EQ(Property(report, "bounded").value("method", ""), "reach");
   EXPECT_EQ(Property(report, "far").value("verdict", ""), "reachable") << report.dump(2);
@@ -458,8 +544,15 @@ TEST(CheckCommand, SameCommandSameVerdicts) {
   const std::string model = dir.Write("chain60.ha", Chain(60)).string();
   for (const std::string budget : {"0.2", "1.5"}) {
     auto verdicts = [&] {
-      const json report = RunHybridJson(
-          "check " + Quote(model) + " --method prove --modes --depth 4 --budget " + budget, 7);
+      // --method prove --modes --depth 4 --budget BUDGET
+      const json report = JsonHere(ArgsOf<cli::CheckArgs>(model,
+                                                          [&](cli::CheckArgs& a) {
+                                                            a.method = "prove";
+                                                            a.modes = true;
+                                                            a.depth = 4;
+                                                            a.budget = std::stod(budget);
+                                                          }),
+                                   7);
       std::vector<std::string> out;
       for (const json& p : Field(report, "properties")) {
         out.push_back(p.value("verdict", "") + ": " + p.value("reason", ""));
@@ -523,7 +616,10 @@ TEST(CheckCommand, BadOptionsExitTwo) {
 // The verdicts of `hybrid check MODEL --method METHOD --json`, by property name (the exit code is
 // the verdicts', not checked here).
 std::map<std::string, std::string> Verdicts(const std::string& model, const std::string& method) {
-  const Result r = RunHybrid("check " + Quote(model) + " --method " + method + " --json");
+  const InProcess r = Here(ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) {
+    a.method = method;
+    a.json = true;
+  }));
   std::map<std::string, std::string> out;
   try {
     const json report = json::parse(r.out);
@@ -531,7 +627,7 @@ std::map<std::string, std::string> Verdicts(const std::string& model, const std:
       out[Field(p, "name").get<std::string>()] = Field(p, "verdict").get<std::string>();
     }
   } catch (const std::exception& e) {
-    ADD_FAILURE() << model << " --method " << method << ": " << e.what() << "\n" << r.err;
+    ADD_FAILURE() << model << " --method " << method << ": " << e.what() << "\n" << r.out;
   }
   return out;
 }
@@ -606,14 +702,16 @@ TEST(CheckCommand, EveryMethodGivesTheIssueModelsOneMeaning) {
 TEST(CheckCommand, ATraceNamesTheInitItStartsFrom) {
   TempDir dir;
   const std::string path = dir.Write("m.ha", OneMeaningCases().back().text).string();
-  const json report = RunHybridJson("check " + Quote(path) + " --method prove", 6);
+  const json report =
+      JsonHere(ArgsOf<cli::CheckArgs>(path, [&](cli::CheckArgs& a) { a.method = "prove"; }), 6);
   const json& trace = Field(report, "properties", 0, "trace");
   EXPECT_EQ(Field(trace, "initial_states", 0, "component"), "A");
   EXPECT_EQ(Field(trace, "initial_states", 0, "init"), 1);  // the second declaration
   EXPECT_EQ(Field(trace, "initial_states", 0, "mode"), "A.n");
   EXPECT_EQ(Field(trace, "start", "values", "x"), 10.0);
   EXPECT_EQ(Field(trace, "start", "mode"), "A.n|B.p");
-  const Result text = RunHybrid("check " + Quote(path) + " --method prove");
+  const InProcess text =
+      Here(ArgsOf<cli::CheckArgs>(path, [&](cli::CheckArgs& a) { a.method = "prove"; }));
   EXPECT_NE(text.out.find("start in A.n|B.p: x = 10; B.y = 0; (init 2 of 2 of A)"),
             std::string::npos)
       << text.out;
@@ -625,7 +723,10 @@ TEST(CheckCommand, AVacuousVerdictSaysSo) {
   init m { x = 2; } property small: always x <= 0; })")
                                .string();
   for (const std::string method : {"auto", "reach", "prove"}) {
-    const Result r = RunHybrid("check " + Quote(path) + " --method " + method + " --json");
+    const InProcess r = Here(ArgsOf<cli::CheckArgs>(path, [&](cli::CheckArgs& a) {
+      a.method = method;
+      a.json = true;
+    }));
     const json report = json::parse(r.out);
     EXPECT_TRUE(Field(report, "properties", 0, "reason")
                     .get<std::string>()

@@ -8,9 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "commands/simulate_command.h"
 #include "hybrid/automaton/parser.h"
 #include "hybrid/spaceex/spaceex_import.h"
 #include "tests/test_utilities/command_line.h"
@@ -26,6 +29,20 @@ using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
+// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
+template <typename T>
+T ArgsOf(const std::string& model) {
+  T a;
+  a.model = model;
+  return a;
+}
+template <typename T, typename Set>
+T ArgsOf(const std::string& model, Set set) {
+  T a = ArgsOf<T>(model);
+  set(a);
+  return a;
+}
+
 std::vector<fs::path> BundledModels() {
   std::vector<fs::path> out;
   for (const char* folder : {"spec", "spec/benchmarks", "spec/spaceex"}) {
@@ -39,6 +56,18 @@ std::vector<fs::path> BundledModels() {
 
 std::string InfoTextOf(const System& system, const std::string& file) {
   return cli::InfoText(cli::InfoJson(system, file), system);
+}
+
+// What `hybrid simulate` with `args` writes on standard output (std::cout), run in this process;
+// its exit code in `exit_code`.
+std::string SimulateOut(const cli::SimulateArgs& args, cli::ExitCode* exit_code) {
+  std::ostringstream out;
+  struct Restore {
+    std::streambuf* buffer;
+    ~Restore() { std::cout.rdbuf(buffer); }
+  } restore{std::cout.rdbuf(out.rdbuf())};
+  *exit_code = cli::RunSimulate(args);
+  return out.str();
 }
 
 TEST(InfoText, ParsesBackToTheSameModelForEveryBundledModel) {
@@ -86,25 +115,36 @@ TEST(InfoText, ShowsEveryDeclarationInTheLanguage) {
   EXPECT_TRUE(ParseModel(text, "again.ha") == s);
 }
 
-// The scenario's command-line form runs as the scenario itself does.
+// The scenario's command-line form runs as the scenario itself does. The program runs only the
+// options (their command-line form is the point); the rest runs in this process.
 TEST(InfoText, TheScenarioOptionsSimulateAsTheScenario) {
   TempDir dir;
   const fs::path model = dir.Write("tank.ha", kDeclarations);
-  const Result info = RunHybrid("info " + Quote(model));
-  ASSERT_EQ(info.exit_code, 0) << info.err;
+  // What `hybrid info MODEL` writes.
+  const std::string info = InfoTextOf(spaceex::ReadModelFile(model.string()), model.string());
   const std::string marker = "hybrid simulate MODEL ";
-  const size_t at = info.out.find(marker);
-  ASSERT_NE(at, std::string::npos) << info.out;
+  const size_t at = info.find(marker);
+  ASSERT_NE(at, std::string::npos) << info;
   const std::string options =
-      info.out.substr(at + marker.size(), info.out.find('\n', at) - at - marker.size());
-  const Result by_scenario = RunHybrid("simulate " + Quote(model) + " --json");
+      info.substr(at + marker.size(), info.find('\n', at) - at - marker.size());
+  cli::ExitCode by_scenario_exit = cli::ExitCode::kInternal;
+  const std::string by_scenario = SimulateOut(
+      ArgsOf<cli::SimulateArgs>(model.string(), [&](cli::SimulateArgs& a) { a.json = true; }),
+      &by_scenario_exit);
   const Result by_options = RunHybrid("simulate " + Quote(model) + " " + options + " --json");
-  ASSERT_EQ(by_scenario.exit_code, 0) << by_scenario.err;
+  ASSERT_EQ(cli::ExitStatus(by_scenario_exit), 0);
   ASSERT_EQ(by_options.exit_code, 0) << by_options.err << options;
-  EXPECT_EQ(by_options.out, by_scenario.out);
+  EXPECT_EQ(by_options.out, by_scenario);
   // A different input gives a different run (the options are not ignored).
-  const Result other = RunHybrid("simulate " + Quote(model) + " --until 4 --input d=0 --json");
-  EXPECT_NE(other.out, by_scenario.out);
+  cli::ExitCode other_exit = cli::ExitCode::kInternal;
+  const std::string other = SimulateOut(ArgsOf<cli::SimulateArgs>(model.string(),
+                                                                  [&](cli::SimulateArgs& a) {
+                                                                    a.inputs = {"d=0"};
+                                                                    a.until = 4.0;
+                                                                    a.json = true;
+                                                                  }),
+                                        &other_exit);
+  EXPECT_NE(other, by_scenario);
 }
 
 }  // namespace

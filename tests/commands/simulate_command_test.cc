@@ -4,6 +4,8 @@
 // message, no output file), outputs that name one file or an input, outputs written all or
 // nothing, and runs that stop early (exit 5, outputs still written).
 
+#include "commands/simulate_command.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -12,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -35,6 +38,20 @@ using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
+// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
+template <typename T>
+T ArgsOf(const std::string& model) {
+  T a;
+  a.model = model;
+  return a;
+}
+template <typename T, typename Set>
+T ArgsOf(const std::string& model, Set set) {
+  T a = ArgsOf<T>(model);
+  set(a);
+  return a;
+}
+
 std::string Spec(const std::string& name) {
   return (kSourceDir / "spec" / (name + ".ha")).string();
 }
@@ -44,6 +61,38 @@ Result Simulate(const std::string& args) { return RunHybrid("simulate " + args);
 
 json SimulateJson(const std::string& args, int expected_exit = 0) {
   return testing::RunHybridJson("simulate " + args, expected_exit);
+}
+
+// The exit code of `hybrid simulate` run in this process (cli::RunSimulate) and what it writes on
+// standard output (std::cout). For what the command computes and writes; the tests of the command
+// line (its options, its messages naming them, the exit codes of errors) run the program.
+struct InProcess {
+  int exit_code = -1;
+  std::string out;
+};
+
+InProcess SimulateHere(const cli::SimulateArgs& args) {
+  std::ostringstream out;
+  struct Restore {
+    std::streambuf* buffer;
+    ~Restore() { std::cout.rdbuf(buffer); }
+  } restore{std::cout.rdbuf(out.rdbuf())};
+  const int exit_code = cli::ExitStatus(cli::RunSimulate(args));
+  return {exit_code, out.str()};
+}
+
+// SimulateHere with `json` set: expects `expected_exit` and parses standard output (an output
+// that is not JSON is a test failure and gives an empty object).
+json SimulateJsonHere(cli::SimulateArgs args, int expected_exit = 0) {
+  args.json = true;
+  const InProcess r = SimulateHere(args);
+  EXPECT_EQ(r.exit_code, expected_exit) << "simulate " << args.model;
+  try {
+    return json::parse(r.out);
+  } catch (const json::exception& e) {
+    ADD_FAILURE() << "simulate " << args.model << ": not JSON (" << e.what() << "):\n" << r.out;
+    return json::object();
+  }
 }
 
 // Rows of a CSV file, split at commas.
@@ -66,15 +115,15 @@ std::vector<std::vector<std::string>> ReadCsv(const std::string& path) {
 
 TEST(HybridSimulate, BundledModelsComplete) {
   for (const std::string name : {"bouncing_ball", "thermostat", "finger", "hand"}) {
-    const Result r = Simulate(Quote(Spec(name)));
-    EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.err << r.out;
+    const InProcess r = SimulateHere(ArgsOf<cli::SimulateArgs>(Spec(name)));
+    EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.out;
     EXPECT_NE(r.out.find("status: completed"), std::string::npos) << name << "\n" << r.out;
     EXPECT_NE(r.out.find("final state:"), std::string::npos) << r.out;
   }
 }
 
 TEST(HybridSimulate, JsonHasStatusEventsAndStatesByName) {
-  const json j = SimulateJson(Quote(Spec("finger")));
+  const json j = SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger")));
   EXPECT_EQ(Field(j, "status"), "completed");
   EXPECT_EQ(Field(j, "message"), "");
   EXPECT_EQ(Field(j, "until"), 530.0);
@@ -98,7 +147,7 @@ TEST(HybridSimulate, JsonHasStatusEventsAndStatesByName) {
   EXPECT_GE(Field(j, "steps").get<long>(), 0);  // CVODE steps: none for constant-rate modes
   EXPECT_FALSE(j.contains("zeno"));
   // A composed model: qualified variable and mode names.
-  const json hand = SimulateJson(Quote(Spec("hand")));
+  const json hand = SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("hand")));
   EXPECT_EQ(Field(hand, "status"), "completed");
   EXPECT_TRUE(Field(hand, "final", "values").contains("B.theta2"));
   EXPECT_EQ(Field(hand, "events", 0, "transitions"), json::array({"A.t5_c000_l000_to_c000_l00n"}));
@@ -107,8 +156,12 @@ TEST(HybridSimulate, JsonHasStatusEventsAndStatesByName) {
 TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   TempDir dir;
   const std::string trace = dir.File("trace.csv"), events = dir.File("events.csv");
-  const json j = SimulateJson(Quote(Spec("thermostat")) + " --sample 2.5 --out " + Quote(trace) +
-                              " --events " + Quote(events));
+  const json j =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("thermostat"), [&](cli::SimulateArgs& a) {
+        a.sample = 2.5;
+        a.out = trace;
+        a.events = events;
+      }));
   ASSERT_EQ(Field(j, "status"), "completed");
   const auto rows = ReadCsv(trace);
   ASSERT_GT(rows.size(), 2u);
@@ -159,7 +212,11 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
 // closed form's events: contact at 80, theta3 at its minimum at 80 + (55 - 40) / 0.9, link 2 at
 // its limit at 180, theta3 at its maximum half way to 255 (217.5).
 TEST(HybridSimulate, SetOverridesAParameter) {
-  const json j = SimulateJson(Quote(Spec("finger")) + " --set gob1=80 --until 255");
+  const json j =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.parameters = {"gob1=80"};
+        a.until = 255.0;
+      }));
   EXPECT_EQ(Field(j, "status"), "completed");
   ASSERT_EQ(Field(j, "events").size(), 4u) << j.dump(2);
   const std::vector<double> times = {80.0, 80.0 + 15.0 / 0.9, 180.0, 217.5};
@@ -180,8 +237,11 @@ TEST(HybridSimulate, SetOverridesAParameter) {
 
 TEST(HybridSimulate, InputOverridesTheScenario) {
   // Close for 10 s only: no joint reaches a limit.
-  const json j = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=step(0: 1, 10: 0)") +
-                              " --until 50");
+  const json j =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.inputs = {"u=step(0: 1, 10: 0)"};
+        a.until = 50.0;
+      }));
   ASSERT_EQ(Field(j, "status"), "completed");
   EXPECT_TRUE(Field(j, "events").empty());
   EXPECT_EQ(Field(j, "until"), 50.0);
@@ -189,13 +249,24 @@ TEST(HybridSimulate, InputOverridesTheScenario) {
   EXPECT_NEAR(Field(j, "final", "values", "theta1").get<double>(), 5.0, 1e-9);
   EXPECT_NEAR(Field(j, "final", "values", "theta3").get<double>(), -5.0, 1e-9);
   // A constant and a linear signal.
-  const json c = SimulateJson(Quote(Spec("finger")) + " --input u=0.5 --until 20");
+  const json c =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.inputs = {"u=0.5"};
+        a.until = 20.0;
+      }));
   EXPECT_NEAR(Field(c, "final", "values", "g").get<double>(), 10.0, 1e-9);
-  const json l = SimulateJson(Quote(Spec("finger")) + " --input " + Quote("u=linear(0: 0, 10: 1)") +
-                              " --until 20");
+  const json l =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.inputs = {"u=linear(0: 0, 10: 1)"};
+        a.until = 20.0;
+      }));
   EXPECT_NEAR(Field(l, "final", "values", "g").get<double>(), 5.0 + 10.0, 1e-9);  // t^2/20, then t
   // The last --input for a name wins.
-  const json last = SimulateJson(Quote(Spec("finger")) + " --input u=1 --input u=0.25 --until 20");
+  const json last =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.inputs = {"u=1", "u=0.25"};
+        a.until = 20.0;
+      }));
   EXPECT_NEAR(Field(last, "final", "values", "g").get<double>(), 5.0, 1e-9);
 }
 
@@ -203,16 +274,27 @@ TEST(HybridSimulate, InputCsvDrivesTheInputs) {
   TempDir dir;
   const std::string steps = dir.Write("steps.csv", "# close, then hold\ntime,u\n0,1\n10,0\n");
   const json j =
-      SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) + " --until 50");
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.input_csv = steps;
+        a.until = 50.0;
+      }));
   ASSERT_EQ(Field(j, "status"), "completed");
   EXPECT_NEAR(Field(j, "final", "values", "g").get<double>(), 10.0, 1e-9);
   const std::string ramp = dir.Write("ramp.csv", "time, u\n0, 0\n10, 1\n");
-  const json l = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(ramp) +
-                              " --csv-shape linear --until 20");
+  const json l =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.input_csv = ramp;
+        a.csv_shape = "linear";
+        a.until = 20.0;
+      }));
   EXPECT_NEAR(Field(l, "final", "values", "g").get<double>(), 15.0, 1e-9);
   // --input overrides the CSV.
-  const json o = SimulateJson(Quote(Spec("finger")) + " --input-csv " + Quote(steps) +
-                              " --input u=0.5 --until 20");
+  const json o =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("finger"), [&](cli::SimulateArgs& a) {
+        a.inputs = {"u=0.5"};
+        a.input_csv = steps;
+        a.until = 20.0;
+      }));
   EXPECT_NEAR(Field(o, "final", "values", "g").get<double>(), 10.0, 1e-9);
 }
 
@@ -314,7 +396,11 @@ TEST(HybridSimulate, RefusesBadCsvFiles) {
     ExpectRefused(thermostat + " --input-csv " + Quote(file), file + ":3:2:");
   }
   const std::string signs = inputs.Write("signs.csv", "time,u\n+0,+1\n5.,-1e0\n");
-  const json ok = SimulateJson(thermostat + " --input-csv " + Quote(signs) + " --until 10");
+  const json ok =
+      SimulateJsonHere(ArgsOf<cli::SimulateArgs>(Spec("thermostat"), [&](cli::SimulateArgs& a) {
+        a.input_csv = signs;
+        a.until = 10.0;
+      }));
   EXPECT_EQ(Field(ok, "status"), "completed");
   const std::string missing = (inputs.path() / "missing.csv").string();
   ExpectRefused(thermostat + " --input-csv " + Quote(missing), "cannot open input CSV");
@@ -408,8 +494,12 @@ TEST(HybridSimulate, ZenoRunExitsFiveAndWritesItsOutputs) {
   const std::string model = dir.Write(
       "zeno.ha", testing::WithParameter(testing::SpecText("bouncing_ball"), "v_rest", "0"));
   const std::string trace = dir.File("trace.csv"), events = dir.File("events.csv");
-  const json j =
-      SimulateJson(Quote(model) + " --out " + Quote(trace) + " --events " + Quote(events), 5);
+  const json j = SimulateJsonHere(ArgsOf<cli::SimulateArgs>(model,
+                                                            [&](cli::SimulateArgs& a) {
+                                                              a.out = trace;
+                                                              a.events = events;
+                                                            }),
+                                  5);
   EXPECT_EQ(Field(j, "status"), "zeno");
   EXPECT_NE(Field(j, "message").get<std::string>().find("accumulate"), std::string::npos);
   ASSERT_TRUE(j.contains("zeno"));
@@ -422,7 +512,7 @@ TEST(HybridSimulate, ZenoRunExitsFiveAndWritesItsOutputs) {
   EXPECT_LT(std::stod(rows.back()[0]), tz);
   EXPECT_EQ(ReadCsv(events).size(), Field(j, "events").size() + 1);
   // The text summary says so too.
-  const Result text = Simulate(Quote(model));
+  const InProcess text = SimulateHere(ArgsOf<cli::SimulateArgs>(model));
   EXPECT_EQ(text.exit_code, 5);
   EXPECT_NE(text.out.find("status: zeno"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("zeno: events accumulate at t = "), std::string::npos) << text.out;
@@ -432,7 +522,12 @@ TEST(HybridSimulate, InvariantViolationExitsFiveAndWritesItsOutputs) {
   TempDir dir;
   const std::string model = dir.Write("stuck.ha", std::string(testing::kInvariantViolationModel));
   const std::string trace = dir.File("trace.csv");
-  const json j = SimulateJson(Quote(model) + " --sample 0.25 --out " + Quote(trace), 5);
+  const json j = SimulateJsonHere(ArgsOf<cli::SimulateArgs>(model,
+                                                            [&](cli::SimulateArgs& a) {
+                                                              a.sample = 0.25;
+                                                              a.out = trace;
+                                                            }),
+                                  5);
   EXPECT_EQ(Field(j, "status"), "invariant_violated");
   EXPECT_NE(Field(j, "message").get<std::string>().find("x <= 1"), std::string::npos)
       << Field(j, "message");
@@ -444,7 +539,7 @@ TEST(HybridSimulate, InvariantViolationExitsFiveAndWritesItsOutputs) {
   EXPECT_EQ(rows.back()[1], "end");
   // Endless event iteration is Zeno too.
   const std::string ping = dir.Write("ping.ha", std::string(testing::kPingPongModel));
-  const json z = SimulateJson(Quote(ping), 5);
+  const json z = SimulateJsonHere(ArgsOf<cli::SimulateArgs>(ping), 5);
   EXPECT_EQ(Field(z, "status"), "zeno");
   EXPECT_EQ(Field(z, "events").size(), 100u);
 }
