@@ -26,6 +26,7 @@
 
 #include "commands/simulate_command.h"
 #include "tests/test_utilities/command_line.h"
+#include "tests/test_utilities/in_process.h"
 
 namespace hybrid {
 namespace {
@@ -41,19 +42,8 @@ using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
-// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
-template <typename T>
-T ArgsOf(const std::string& model) {
-  T a;
-  a.model = model;
-  return a;
-}
-template <typename T, typename Set>
-T ArgsOf(const std::string& model, Set set) {
-  T a = ArgsOf<T>(model);
-  set(a);
-  return a;
-}
+using testing::ArgsOf;
+using testing::InProcess;
 const std::string kFinger = (kSourceDir / "spec" / "finger.ha").string();
 const std::string kHand = (kSourceDir / "spec" / "hand.ha").string();
 
@@ -130,28 +120,16 @@ cli::SimulateArgs Replay(const std::string& model, const json& trace, double unt
 }
 
 // A command run in this process (cli::RunCheck, cli::RunSimulate): its exit code and what it
-// writes on standard output (std::cout). For what the commands compute and write; the tests of
-// the command line (its options, messages on standard error, exit codes of errors, the process's
-// memory) run the program.
-struct InProcess {
-  int exit_code = -1;
-  std::string out;
-};
-
+// writes on standard output.
 template <typename Args>
 InProcess Here(const Args& args) {
-  std::ostringstream out;
-  struct Restore {
-    std::streambuf* buffer;
-    ~Restore() { std::cout.rdbuf(buffer); }
-  } restore{std::cout.rdbuf(out.rdbuf())};
-  int exit_code = -1;
-  if constexpr (std::is_same_v<Args, cli::CheckArgs>) {
-    exit_code = cli::ExitStatus(cli::RunCheck(args));
-  } else {
-    exit_code = cli::ExitStatus(cli::RunSimulate(args));
-  }
-  return {exit_code, out.str()};
+  return testing::RunInProcess([&] {
+    if constexpr (std::is_same_v<Args, cli::CheckArgs>) {
+      return cli::RunCheck(args);
+    } else {
+      return cli::RunSimulate(args);
+    }
+  });
 }
 
 // A command in this process (Here) with `json` set: expects `expected_exit` and parses standard

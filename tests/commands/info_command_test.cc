@@ -17,6 +17,7 @@
 #include "hybrid/automaton/parser.h"
 #include "hybrid/spaceex/spaceex_import.h"
 #include "tests/test_utilities/command_line.h"
+#include "tests/test_utilities/in_process.h"
 
 namespace hybrid {
 namespace {
@@ -29,19 +30,9 @@ using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
-// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
-template <typename T>
-T ArgsOf(const std::string& model) {
-  T a;
-  a.model = model;
-  return a;
-}
-template <typename T, typename Set>
-T ArgsOf(const std::string& model, Set set) {
-  T a = ArgsOf<T>(model);
-  set(a);
-  return a;
-}
+using testing::ArgsOf;
+using testing::InProcess;
+using testing::RunInProcess;
 
 std::vector<fs::path> BundledModels() {
   std::vector<fs::path> out;
@@ -56,18 +47,6 @@ std::vector<fs::path> BundledModels() {
 
 std::string InfoTextOf(const System& system, const std::string& file) {
   return cli::InfoText(cli::InfoJson(system, file), system);
-}
-
-// What `hybrid simulate` with `args` writes on standard output (std::cout), run in this process;
-// its exit code in `exit_code`.
-std::string SimulateOut(const cli::SimulateArgs& args, cli::ExitCode* exit_code) {
-  std::ostringstream out;
-  struct Restore {
-    std::streambuf* buffer;
-    ~Restore() { std::cout.rdbuf(buffer); }
-  } restore{std::cout.rdbuf(out.rdbuf())};
-  *exit_code = cli::RunSimulate(args);
-  return out.str();
 }
 
 TEST(InfoText, ParsesBackToTheSameModelForEveryBundledModel) {
@@ -127,24 +106,22 @@ TEST(InfoText, TheScenarioOptionsSimulateAsTheScenario) {
   ASSERT_NE(at, std::string::npos) << info;
   const std::string options =
       info.substr(at + marker.size(), info.find('\n', at) - at - marker.size());
-  cli::ExitCode by_scenario_exit = cli::ExitCode::kInternal;
-  const std::string by_scenario = SimulateOut(
-      ArgsOf<cli::SimulateArgs>(model.string(), [&](cli::SimulateArgs& a) { a.json = true; }),
-      &by_scenario_exit);
+  const cli::SimulateArgs scenario_args =
+      ArgsOf<cli::SimulateArgs>(model.string(), [&](cli::SimulateArgs& a) { a.json = true; });
+  const InProcess by_scenario = RunInProcess([&] { return cli::RunSimulate(scenario_args); });
   const Result by_options = RunHybrid("simulate " + Quote(model) + " " + options + " --json");
-  ASSERT_EQ(cli::ExitStatus(by_scenario_exit), 0);
+  ASSERT_EQ(by_scenario.exit_code, 0);
   ASSERT_EQ(by_options.exit_code, 0) << by_options.err << options;
-  EXPECT_EQ(by_options.out, by_scenario);
+  EXPECT_EQ(by_options.out, by_scenario.out);
   // A different input gives a different run (the options are not ignored).
-  cli::ExitCode other_exit = cli::ExitCode::kInternal;
-  const std::string other = SimulateOut(ArgsOf<cli::SimulateArgs>(model.string(),
-                                                                  [&](cli::SimulateArgs& a) {
-                                                                    a.inputs = {"d=0"};
-                                                                    a.until = 4.0;
-                                                                    a.json = true;
-                                                                  }),
-                                        &other_exit);
-  EXPECT_NE(other, by_scenario);
+  const cli::SimulateArgs other_args =
+      ArgsOf<cli::SimulateArgs>(model.string(), [&](cli::SimulateArgs& a) {
+        a.inputs = {"d=0"};
+        a.until = 4.0;
+        a.json = true;
+      });
+  const InProcess other = RunInProcess([&] { return cli::RunSimulate(other_args); });
+  EXPECT_NE(other.out, by_scenario.out);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "tests/test_utilities/command_line.h"
+#include "tests/test_utilities/in_process.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {
@@ -38,19 +39,8 @@ using testing::TempDir;
 
 const fs::path kSourceDir = HYBRID_SOURCE_DIR;
 
-// A command's arguments: `model`, and the fields `set` sets (the others their defaults).
-template <typename T>
-T ArgsOf(const std::string& model) {
-  T a;
-  a.model = model;
-  return a;
-}
-template <typename T, typename Set>
-T ArgsOf(const std::string& model, Set set) {
-  T a = ArgsOf<T>(model);
-  set(a);
-  return a;
-}
+using testing::ArgsOf;
+using testing::InProcess;
 
 std::string Spec(const std::string& name) {
   return (kSourceDir / "spec" / (name + ".ha")).string();
@@ -63,22 +53,9 @@ json SimulateJson(const std::string& args, int expected_exit = 0) {
   return testing::RunHybridJson("simulate " + args, expected_exit);
 }
 
-// The exit code of `hybrid simulate` run in this process (cli::RunSimulate) and what it writes on
-// standard output (std::cout). For what the command computes and writes; the tests of the command
-// line (its options, its messages naming them, the exit codes of errors) run the program.
-struct InProcess {
-  int exit_code = -1;
-  std::string out;
-};
-
+// `hybrid simulate` run in this process (cli::RunSimulate): its exit code and standard output.
 InProcess SimulateHere(const cli::SimulateArgs& args) {
-  std::ostringstream out;
-  struct Restore {
-    std::streambuf* buffer;
-    ~Restore() { std::cout.rdbuf(buffer); }
-  } restore{std::cout.rdbuf(out.rdbuf())};
-  const int exit_code = cli::ExitStatus(cli::RunSimulate(args));
-  return {exit_code, out.str()};
+  return testing::RunInProcess([&] { return cli::RunSimulate(args); });
 }
 
 // SimulateHere with `json` set: expects `expected_exit` and parses standard output (an output
