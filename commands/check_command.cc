@@ -14,6 +14,8 @@
 #include "commands/progress.h"
 #include "hybrid/automaton/parser.h"
 #include "hybrid/checking/property_checker.h"
+#include "hybrid/flowpipe/flowpipe_checker.h"
+#include "hybrid/flowpipe/flowpipe_reachability.h"
 #include "hybrid/reachability/polyhedral_reachability.h"
 #include "hybrid/reachability/reach_checker.h"
 #include "hybrid/simulation/simulator.h"
@@ -165,6 +167,7 @@ struct MethodContext {
   SolverBudget* budget = nullptr;
   ProgressLine* progress = nullptr;
   std::optional<PolyhedralReachability::Usage>* usage = nullptr;
+  FlowpipeReachability::ReachSet* reach_set = nullptr;
 };
 
 CheckerRegistry Methods(MethodContext& context);
@@ -253,6 +256,23 @@ std::unique_ptr<PropertyChecker> MakeProve(MethodContext& c) {
   return std::make_unique<ProveChecker>(c.prove, *c.budget);
 }
 
+// The bounds of the flowpipe engine: --budget budget seconds of its deterministic Taylor steps
+// (kFlowpipeStepsPerBudgetSecond each), the Taylor order and the step.
+std::unique_ptr<PropertyChecker> MakeFlowpipe(MethodContext& c) {
+  FlowpipeReachability::Options options;
+  options.max_steps = static_cast<std::int64_t>(std::ceil(c.args.budget * kFlowpipeStepsPerBudgetSecond));
+  options.order = c.args.order;
+  options.step = c.args.step;
+  if (c.progress && c.progress->enabled()) {
+    ProgressLine& progress = *c.progress;
+    options.progress = [&progress](std::int64_t steps, int queued) {
+      progress.Report("flowpipe: " + std::to_string(steps) + " Taylor steps, " + std::to_string(queued) +
+                      " sets queued");
+    };
+  }
+  return std::make_unique<FlowpipeChecker>(options, c.reach_set);
+}
+
 std::unique_ptr<PropertyChecker> MakeSample(MethodContext& c) {
   PropertySampler::Options options;
   options.runs = c.args.runs;
@@ -271,15 +291,21 @@ std::unique_ptr<PropertyChecker> MakeSample(MethodContext& c) {
 // prover alone otherwise). `context` must outlive the registry.
 CheckerRegistry Methods(MethodContext& context) {
   CheckerRegistry r;
-  r.Add("auto", "reach for a linear hybrid automaton, then prove on what it leaves unknown",
+  r.Add("auto",
+        "reach for a linear hybrid automaton, then flowpipe, prove, and sample to falsify what is "
+        "left unknown",
         [&context] {
           std::vector<std::unique_ptr<PropertyChecker>> checkers;
           checkers.push_back(MakeReach(context));
+          checkers.push_back(MakeFlowpipe(context));
           checkers.push_back(MakeProve(context));
+          checkers.push_back(MakeSample(context));
           return std::make_unique<FallbackChecker>("auto", std::move(checkers));
         });
   r.Add("reach", "exact polyhedral reachability (linear hybrid automata)",
         [&context] { return MakeReach(context); });
+  r.Add("flowpipe", "Taylor flowpipes (affine and polynomial dynamics)",
+        [&context] { return MakeFlowpipe(context); });
   r.Add("prove", "SMT bounded model checking and k-induction",
         [&context] { return MakeProve(context); });
   r.Add("sample", "random simulations, shrunk counterexamples (never proves)",

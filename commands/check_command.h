@@ -24,6 +24,8 @@ struct CheckArgs {
   int induction = 1;       ///< prove: largest k of k-induction
   int runs = 200;          ///< sample: random runs per property
   std::uint64_t seed = 1;  ///< sample: seed
+  int order = 6;           ///< flowpipe: Taylor order (1 to 12)
+  double step = 0.0;       ///< flowpipe: step (0: automatic)
   /// Progress on standard error (the command line: kAuto, --quiet, --progress).
   ProgressMode progress = ProgressMode::kOff;
 };

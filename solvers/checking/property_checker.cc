@@ -5,6 +5,20 @@
 #include <utility>
 
 namespace hybrid {
+namespace {
+
+// Still worth asking a later engine: undecided, or decided only up to a time (`within`).
+bool IsOpen(const CheckResult& r) { return r.verdict == Verdict::kUnknown || r.within.has_value(); }
+
+// Whether `later` says more than `earlier`: a decision where there was none, a decision for
+// all time where there was one up to a time, or one up to a later time.
+bool Improves(const CheckResult& later, const CheckResult& earlier) {
+  if (later.verdict == Verdict::kUnknown) return false;
+  if (earlier.verdict == Verdict::kUnknown || !later.within) return true;
+  return earlier.within && *later.within > *earlier.within;
+}
+
+}  // namespace
 
 bool PropertyChecker::Handles(const System&, std::span<const Property>, std::string*) const {
   return true;
@@ -43,7 +57,7 @@ std::vector<CheckResult> FallbackChecker::Check(const System& system,
     std::vector<Property> left;
     std::vector<std::size_t> where;
     for (std::size_t i = 0; i < results.size(); ++i) {
-      if (results[i].verdict != Verdict::kUnknown) continue;
+      if (!IsOpen(results[i])) continue;
       left.push_back(properties[i]);
       where.push_back(i);
     }
@@ -51,9 +65,9 @@ std::vector<CheckResult> FallbackChecker::Check(const System& system,
     const std::vector<CheckResult> later = checker->Check(system, left);
     for (std::size_t k = 0; k < later.size() && k < where.size(); ++k) {
       CheckResult& r = results[where[k]];
-      if (later[k].verdict != Verdict::kUnknown) {
+      if (Improves(later[k], r)) {
         r = later[k];
-      } else {
+      } else if (r.verdict == Verdict::kUnknown) {
         r.reason += "; " + std::string(checker->name()) + ": " + later[k].reason;
         r.seconds += later[k].seconds;
       }

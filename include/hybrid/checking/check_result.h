@@ -38,6 +38,10 @@ struct CheckResult {
   std::string reason;
   /// For `violated` and `reachable`: the counterexample or witness, replayed by the simulator.
   std::optional<Trace> trace;
+  /// For `proved` and `unreachable` of a property without `within`: set when the verdict covers
+  /// only the runs up to this model time (an engine that explored the reachable states that far
+  /// and no farther: "proved within T"); absent for a verdict that holds for all time.
+  std::optional<double> within;
 };
 
 /// The gate every verdict that rests on a trace passes before it is reported. For `violated`

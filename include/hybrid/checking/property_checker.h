@@ -38,8 +38,11 @@ class PropertyChecker {
 };
 
 /// Checkers in order: the first that handles the properties decides what it can, and each later
-/// one is asked what is still `unknown` (its reason appended to the earlier ones' as
-/// "; NAME: reason", its time added) and, where it decides, its result replaces the earlier one.
+/// one is asked what is still open: `unknown` (its reason appended to the earlier ones' as
+/// "; NAME: reason", its time added), or decided only up to a time (CheckResult::within, a
+/// bounded answer to an unbounded question). A later result replaces the earlier one where it
+/// decides and the earlier did not, or decides for all time (a violation found by simulation, a
+/// proof without a bound), or up to a later time.
 /// The method of `hybrid check --method auto` (reachability, then the prover).
 class FallbackChecker : public PropertyChecker {
  public:

@@ -1,0 +1,317 @@
+#include "solvers/flowpipe/exploration.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hybrid::flowpipe_internal {
+namespace {
+
+constexpr double kSmallestStep = 1.0 / (1 << 20);
+constexpr int kInvariantBoxEvery = 32;  // steps between tries of a positively invariant box (and
+                                        // after 1, 2, 4, 8 and 16 steps)
+constexpr std::size_t kMaxRecordedBoxes = 400000;
+
+// The largest power of two <= x (x > 0).
+double PowerOfTwoBelow(double x) {
+  int e = 0;
+  const double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)
+  return m == 0.5 ? x : std::ldexp(1.0, e - 1);
+}
+
+Segment BoxSegment(std::vector<TightInterval> box) {
+  Segment s;
+  s.box = std::move(box);
+  return s;
+}
+
+}  // namespace
+
+Exploration::Exploration(FlowpipeModel& model, std::span<const Property> properties,
+                         const FlowpipeReachability::Options& options, double time_cap,
+                         FlowpipeReachability::ReachSet* reach_set)
+    : model_(model),
+      properties_(properties),
+      options_(options),
+      time_cap_(time_cap),
+      reach_set_(reach_set),
+      findings_(properties.size()) {
+  if (reach_set_) {
+    reach_set_->variables.clear();
+    reach_set_->boxes.clear();
+    for (int i = 0; i < model_.num_variables(); ++i)
+      reach_set_->variables.push_back(model_.ComponentName(i));
+  }
+}
+
+void Exploration::StopAt(double t, const std::string& why) {
+  frontier_ = std::min(frontier_, t);
+  if (stop_reason_.empty()) stop_reason_ = why;
+}
+
+void Exploration::Run() {
+  for (FlowpipeModel::Initial& init : model_.Initials())
+    Push({init.mode, std::move(init.box), 0.0});
+  while (!queue_.empty()) {
+    const Entry entry = queue_.top();
+    queue_.pop();
+    if (AlreadyExplored(entry)) continue;
+    if (entry.t0 > time_cap_) {
+      frontier_ = std::min(frontier_, entry.t0);
+      continue;
+    }
+    if (steps_ >= options_.max_steps) {
+      StopAt(entry.t0, "the step budget (" + std::to_string(options_.max_steps) +
+                           " Taylor steps) was used up");
+      break;
+    }
+    if (entries_ >= options_.max_entries) {
+      StopAt(entry.t0,
+             "the bound of " + std::to_string(options_.max_entries) + " mode entries was reached");
+      break;
+    }
+    explored_[entry.mode].push_back(entry);
+    ++entries_;
+    Explore(entry);
+    if (options_.progress && entries_ % 16 == 0)
+      options_.progress(steps_, static_cast<int>(queue_.size()));
+  }
+  for (; !queue_.empty(); queue_.pop()) frontier_ = std::min(frontier_, queue_.top().t0);
+}
+
+bool Exploration::AlreadyExplored(const Entry& entry) const {
+  const auto it = explored_.find(entry.mode);
+  if (it == explored_.end()) return false;
+  for (const Entry& old : it->second) {
+    if (old.t0 > entry.t0) continue;
+    bool inside = true;
+    for (std::size_t i = 0; i < entry.box.size() && inside; ++i)
+      inside = old.box[i].Contains(entry.box[i]);
+    if (inside) return true;
+  }
+  return false;
+}
+
+void Exploration::Push(Entry entry) {
+  if (!AlreadyExplored(entry)) queue_.push(std::move(entry));
+}
+
+bool Exploration::InsideUrgentGuard(const Segment& segment,
+                                    const FlowpipeModel::CompiledMode& mode) const {
+  for (const FlowpipeModel::Jump& jump : mode.jumps) {
+    if (!jump.urgent) continue;
+    // Read exactly: a state on the boundary of a strict guard does not jump at once.
+    bool all = true;
+    for (const Residual& r : jump.guard) {
+      if (model_.Holds(r, segment, mode.env, /*closure=*/false) != Truth::kTrue) {
+        all = false;
+        break;
+      }
+    }
+    if (all) return true;
+  }
+  return false;
+}
+
+bool Exploration::MayMeetUrgentGuard(const Segment& segment,
+                                     const FlowpipeModel::CompiledMode& mode) const {
+  for (const FlowpipeModel::Jump& jump : mode.jumps) {
+    if (jump.urgent && model_.HoldsAll(jump.guard, segment, mode.env) == Truth::kMaybe) return true;
+  }
+  return false;
+}
+
+void Exploration::Explore(const Entry& entry) {
+  model_.MakeJumps(entry.mode);
+  const FlowpipeModel::CompiledMode& mode = model_.Mode(entry.mode);
+  if (!mode.tape) {
+    StopAt(entry.t0, "mode " + mode.name + ": " + mode.unsupported);
+    return;
+  }
+  std::vector<TightInterval> box = entry.box;
+  if (!model_.Contract(mode.invariant, box, mode.env)) return;
+  const std::size_t dim = box.size();
+  std::vector<AffineForm> x(dim);
+  std::vector<char> protect(dim, 0);
+  for (std::size_t i = 0; i < dim; ++i) {
+    if (!box[i].IsFinite()) {
+      StopAt(entry.t0, "the set entering mode " + mode.name + " is unbounded in '" +
+                           model_.ComponentName(static_cast<int>(i)) + "'");
+      return;
+    }
+    x[i] = box[i].lo == box[i].hi
+               ? AffineForm(box[i].lo)
+               : AffineForm::Symbol(box[i].Mid(), static_cast<int>(i), box[i].RadiusUp());
+    protect[i] = static_cast<int>(i) >= model_.num_variables();
+  }
+  const int max_symbols =
+      options_.max_symbols > 0 ? options_.max_symbols : 10 * static_cast<int>(dim);
+  const FlowpipeStep stepper(*mode.tape, model_.input_box(), options_.order, protect, max_symbols);
+  const double h0 = options_.step > 0 ? PowerOfTwoBelow(options_.step) : stepper.SuggestedStep(box);
+  double h = h0, t = 0.0;
+  std::vector<Crossing> crossings(mode.jumps.size());
+  std::vector<TightInterval> hull;
+  int local_steps = 0;
+  while (true) {
+    if (steps_ >= options_.max_steps) {
+      StopAt(entry.t0 + t, "the step budget (" + std::to_string(options_.max_steps) +
+                               " Taylor steps) was used up");
+      break;
+    }
+    if (entry.t0 + t > time_cap_) {
+      frontier_ = std::min(frontier_, entry.t0 + t);
+      break;
+    }
+    Segment start;
+    start.series = {x};
+    start.remainder.assign(dim, TightInterval(0.0));
+    start.ComputeBox(std::vector<TightInterval>(dim, TightInterval::Entire()));
+    if (model_.HoldsAll(mode.invariant, start, mode.env) == Truth::kFalse) break;
+    if (InsideUrgentGuard(start, mode)) {
+      if (local_steps == 0) Visit(start, entry.mode, entry.t0, entry.t0, crossings, &hull);
+      break;
+    }
+    std::optional<StepResult> step = stepper.Take(x, h);
+    if (!step) {
+      if (h > kSmallestStep) {
+        h /= 2;
+        continue;
+      }
+      StopAt(entry.t0 + t, "no enclosure of the flow of mode " + mode.name +
+                               " was found at t = " + std::to_string(entry.t0 + t));
+      break;
+    }
+    const bool near_guard = MayMeetUrgentGuard(step->segment, mode);
+    if (near_guard && h > h0 / 8) {
+      h = std::max(h0 / 8, kSmallestStep);  // refine the crossing
+      continue;
+    }
+    ++steps_;
+    ++local_steps;
+    if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + h, crossings, &hull)) break;
+    x = std::move(step->end);
+    t += h;
+    if (!near_guard && h < h0) h *= 2;
+    if (local_steps % kInvariantBoxEvery == 0 || (local_steps & (local_steps - 1)) == 0) {
+      std::vector<TightInterval> invariant_box = hull;
+      if (InvariantBox(entry.mode, invariant_box)) {
+        Visit(BoxSegment(invariant_box), entry.mode, entry.t0 + t,
+              std::numeric_limits<double>::infinity(), crossings, nullptr);
+        break;
+      }
+    }
+  }
+  for (std::size_t j = 0; j < crossings.size(); ++j) {
+    if (crossings[j].open) CloseCrossing(entry.mode, static_cast<int>(j), crossings[j]);
+  }
+}
+
+bool Exploration::Visit(const Segment& segment, int mode_index, double t, double t_end,
+                        std::vector<Crossing>& crossings, std::vector<TightInterval>* hull) {
+  const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
+  Segment s = segment;
+  const Truth inside = model_.HoldsAll(mode.invariant, s, mode.env);
+  if (inside == Truth::kFalse) return false;
+  if (inside == Truth::kMaybe && !model_.ContractSegment(mode.invariant, s, s.box, mode.env))
+    return false;
+  CheckProperties(s, mode, t);
+  Record(s, mode, t, t_end);
+  if (hull) {
+    if (hull->empty()) *hull = s.box;
+    for (std::size_t i = 0; i < s.box.size(); ++i) (*hull)[i] = Hull((*hull)[i], s.box[i]);
+  }
+  for (std::size_t j = 0; j < mode.jumps.size(); ++j) {
+    const FlowpipeModel::Jump& jump = mode.jumps[j];
+    Crossing& c = crossings[j];
+    std::vector<TightInterval> box = s.box;
+    const bool meets = model_.HoldsAll(jump.guard, s, mode.env) != Truth::kFalse &&
+                       model_.ContractSegment(jump.guard, s, box, mode.env);
+    if (!meets) {
+      if (c.open) CloseCrossing(mode_index, static_cast<int>(j), c);
+      continue;
+    }
+    if (!c.open) {
+      c.open = true;
+      c.box = box;
+      c.t0 = t;
+    } else {
+      for (std::size_t i = 0; i < box.size(); ++i) c.box[i] = Hull(c.box[i], box[i]);
+    }
+  }
+  return true;
+}
+
+void Exploration::CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode,
+                                  double t) {
+  for (std::size_t k = 0; k < properties_.size(); ++k) {
+    const Property& p = properties_[k];
+    if (p.horizon && t > *p.horizon) continue;
+    const Truth holds = model_.Evaluate(p.predicate, segment, mode);
+    const bool bad =
+        p.kind == Property::Kind::kAlways ? holds != Truth::kTrue : holds != Truth::kFalse;
+    Finding& f = findings_[k];
+    if (bad && (!f.met || t < f.met_time)) {
+      f.met = true;
+      f.met_time = t;
+      f.met_mode = mode.name;
+    }
+  }
+}
+
+void Exploration::CloseCrossing(int mode_index, int jump_index, Crossing& crossing) {
+  crossing.open = false;
+  const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
+  const FlowpipeModel::Jump& jump = mode.jumps[static_cast<std::size_t>(jump_index)];
+  std::vector<TightInterval> next = crossing.box;
+  for (const auto& [component, value] : jump.resets) {
+    if (component >= 0)
+      next[static_cast<std::size_t>(component)] = model_.Value(value, crossing.box, mode.env);
+  }
+  const FlowpipeModel::CompiledMode& target = model_.Mode(jump.target);
+  if (!model_.Contract(target.invariant, next, target.env)) return;
+  Push({jump.target, std::move(next), crossing.t0});
+}
+
+bool Exploration::InvariantBox(int mode_index, std::vector<TightInterval>& box) const {
+  const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
+  if (box.empty()) return false;
+  for (double widen : {0.02, 0.1, 0.3}) {
+    std::vector<TightInterval> b = box;
+    for (TightInterval& x : b) {
+      const double pad = widen * (x.hi - x.lo) + 1e-9 * (1.0 + x.MagnitudeUp());
+      x = {SubDown(x.lo, pad), AddUp(x.hi, pad)};
+    }
+    bool inward = true;
+    for (int i = 0; i < model_.num_variables() && inward; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      for (int side = 0; side < 2 && inward; ++side) {
+        std::vector<TightInterval> face = b;
+        face[k] = TightInterval(side == 0 ? b[k].lo : b[k].hi);
+        // A face the invariant excludes is never reached in this mode.
+        if (model_.HoldsAll(mode.invariant, BoxSegment(face), mode.env) == Truth::kFalse) continue;
+        const TightInterval f = mode.tape->Evaluate(face, model_.input_box())[k];
+        inward = side == 0 ? f.lo >= 0 : f.hi <= 0;
+      }
+    }
+    if (inward) {
+      box = b;
+      return true;
+    }
+  }
+  return false;
+}
+
+void Exploration::Record(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t,
+                         double t_end) {
+  if (!reach_set_ || reach_set_->boxes.size() >= kMaxRecordedBoxes) return;
+  FlowpipeReachability::ReachBox box;
+  box.mode = mode.name;
+  box.t_lo = t;
+  box.t_hi = t_end;
+  for (int i = 0; i < model_.num_variables(); ++i) {
+    const TightInterval& x = segment.box[static_cast<std::size_t>(i)];
+    box.box.emplace_back(x.lo, x.hi);
+  }
+  reach_set_->boxes.push_back(std::move(box));
+}
+
+}  // namespace hybrid::flowpipe_internal

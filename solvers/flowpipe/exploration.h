@@ -1,0 +1,90 @@
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <queue>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "hybrid/automaton/property.h"
+#include "hybrid/flowpipe/flowpipe_reachability.h"
+#include "solvers/flowpipe/flowpipe_model.h"
+#include "solvers/flowpipe/flowpipe_step.h"
+
+namespace hybrid::flowpipe_internal {
+
+/// The discrete loop of FlowpipeReachability (see its class comment): a worklist of mode entries
+/// (a mode and a box, from their earliest time), each let flow step by step, its segments checked
+/// against the properties and the guards, its crossings turned into new entries.
+class Exploration {
+ public:
+  /// What the exploration learnt about one property.
+  struct Finding {
+    bool met = false;       ///< some segment may meet the bad (target) states
+    double met_time = 0.0;  ///< the earliest time of such a segment
+    std::string met_mode;
+  };
+
+  Exploration(FlowpipeModel& model, std::span<const Property> properties,
+              const FlowpipeReachability::Options& options, double time_cap,
+              FlowpipeReachability::ReachSet* reach_set);
+
+  /// Runs to completion or to the budget.
+  void Run();
+
+  const std::vector<Finding>& findings() const { return findings_; }
+  /// The earliest time not explored (infinity when complete).
+  double frontier() const { return frontier_; }
+  std::int64_t steps() const { return steps_; }
+  int entries() const { return entries_; }
+  /// Why the exploration stopped before its end ("" when complete or cut at the time cap only).
+  const std::string& stop_reason() const { return stop_reason_; }
+
+ private:
+  struct Entry {
+    int mode = -1;
+    std::vector<TightInterval> box;
+    double t0 = 0.0;
+  };
+  struct Later {
+    bool operator()(const Entry& a, const Entry& b) const { return a.t0 > b.t0; }
+  };
+  struct Crossing {
+    bool open = false;
+    std::vector<TightInterval> box;
+    double t0 = 0.0;
+  };
+
+  void Explore(const Entry& entry);
+  bool AlreadyExplored(const Entry& entry) const;
+  void Push(Entry entry);
+  // Checks a segment of mode `mode` from global time t against the properties, the guards and
+  // the reach set; false when the segment holds no state (outside the invariant).
+  bool Visit(const Segment& segment, int mode, double t, double t_end,
+             std::vector<Crossing>& crossings, std::vector<TightInterval>* hull);
+  void CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t);
+  void CloseCrossing(int mode, int jump, Crossing& crossing);
+  bool InvariantBox(int mode, std::vector<TightInterval>& box) const;
+  bool MayMeetUrgentGuard(const Segment& segment, const FlowpipeModel::CompiledMode& mode) const;
+  bool InsideUrgentGuard(const Segment& segment, const FlowpipeModel::CompiledMode& mode) const;
+  void Record(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t,
+              double t_end);
+  void StopAt(double t, const std::string& why);
+
+  FlowpipeModel& model_;
+  std::span<const Property> properties_;
+  FlowpipeReachability::Options options_;
+  double time_cap_;
+  FlowpipeReachability::ReachSet* reach_set_;
+  std::vector<Finding> findings_;
+  std::priority_queue<Entry, std::vector<Entry>, Later> queue_;
+  std::map<int, std::vector<Entry>> explored_;
+  double frontier_ = std::numeric_limits<double>::infinity();
+  std::int64_t steps_ = 0;
+  int entries_ = 0;
+  std::string stop_reason_;
+};
+
+}  // namespace hybrid::flowpipe_internal
