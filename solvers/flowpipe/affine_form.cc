@@ -49,8 +49,8 @@ bool AffineForm::IsPoint() const {
 
 double AffineForm::RadiusUp() const {
   double r = err_;
-  for (double g : g_) r = AddUp(r, std::fabs(g));
-  return r;
+  for (double g : g_) r += std::fabs(g);
+  return SumUp(r, g_.size() + 1);
 }
 
 TightInterval AffineForm::Range() const {
@@ -119,6 +119,25 @@ AffineForm AffineForm::operator*(const AffineForm& b) const {
   z.err_ = AddUp(z.err_, MulUp(std::fabs(b.center_), err_));
   const double ra = RadiusUp(), rb = b.RadiusUp();
   if (ra != 0 && rb != 0) z.err_ = AddUp(z.err_, MulUp(ra, rb));
+  return z;
+}
+
+AffineForm AffineForm::Square() const {
+  // (c + X)^2 = c^2 + 2 c X + X^2 with X^2 in [0, R^2]: the affine part c^2 + 2 c g e, plus
+  // R^2 / 2 on the centre and +- R^2 / 2 as error (|2 c| err is in 2 c X's error).
+  AffineForm z = Scaled(2.0 * center_);  // 2 c (c + X)
+  z.center_ = 0.0;
+  AffineForm c2(center_ * center_);
+  AddError(c2.err_, ProductError(center_, center_, c2.center_));
+  z = z + c2;  // c^2 + 2 c X (2 c is exact)
+  const double r = RadiusUp();
+  if (r != 0) {
+    const double half = MulUp(MulUp(r, r), 0.5);
+    const double shifted = z.center_ + half;
+    AddError(z.err_, AdditionError(z.center_, half, shifted));
+    z.center_ = shifted;
+    z.err_ = AddUp(z.err_, half);
+  }
   return z;
 }
 

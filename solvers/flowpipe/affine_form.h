@@ -44,6 +44,9 @@ class AffineForm {
   AffineForm Scaled(const TightInterval& k) const;
   /// The product: affine part c_a b + c_b a, the rest bounded into err.
   AffineForm operator*(const AffineForm& b) const;
+  /// this * this, using that the square of the non-affine part lies in [0, R^2] (R its
+  /// radius): half the error of the general product.
+  AffineForm Square() const;
   /// this / b: this * (1/b) with 1/b taken as an interval over b's range (coarse; Entire when
   /// the range contains 0).
   AffineForm operator/(const AffineForm& b) const;

@@ -48,9 +48,8 @@ void Exploration::StopAt(double t, const std::string& why) {
   if (stop_reason_.empty()) stop_reason_ = why;
 }
 
-void Exploration::Run() {
-  for (FlowpipeModel::Initial& init : model_.Initials())
-    Push({init.mode, std::move(init.box), 0.0});
+void Exploration::Run(std::vector<FlowpipeModel::Initial> initials) {
+  for (FlowpipeModel::Initial& init : initials) Push({init.mode, std::move(init.box), 0.0});
   while (!queue_.empty()) {
     const Entry entry = queue_.top();
     queue_.pop();
@@ -211,8 +210,7 @@ bool Exploration::Visit(const Segment& segment, int mode_index, double t, double
   Segment s = segment;
   const Truth inside = model_.HoldsAll(mode.invariant, s, mode.env);
   if (inside == Truth::kFalse) return false;
-  if (inside == Truth::kMaybe && !model_.ContractSegment(mode.invariant, s, s.box, mode.env))
-    return false;
+  if (inside == Truth::kMaybe && !model_.Contract(mode.invariant, s.box, mode.env)) return false;
   CheckProperties(s, mode, t);
   Record(s, mode, t, t_end);
   if (hull) {
@@ -224,7 +222,7 @@ bool Exploration::Visit(const Segment& segment, int mode_index, double t, double
     Crossing& c = crossings[j];
     std::vector<TightInterval> box = s.box;
     const bool meets = model_.HoldsAll(jump.guard, s, mode.env) != Truth::kFalse &&
-                       model_.ContractSegment(jump.guard, s, box, mode.env);
+                       model_.ContractSegment(jump.guard_and_invariant, s, box, mode.env);
     if (!meets) {
       if (c.open) CloseCrossing(mode_index, static_cast<int>(j), c);
       continue;

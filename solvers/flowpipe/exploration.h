@@ -25,14 +25,17 @@ class Exploration {
     bool met = false;       ///< some segment may meet the bad (target) states
     double met_time = 0.0;  ///< the earliest time of such a segment
     std::string met_mode;
+    /// Some segment lies wholly in the bad (target) states: strong evidence that the property
+    /// is false (not a proof: the segment may hold no real state), so refining is not worth it.
+    bool met_wholly = false;
   };
 
   Exploration(FlowpipeModel& model, std::span<const Property> properties,
               const FlowpipeReachability::Options& options, double time_cap,
               FlowpipeReachability::ReachSet* reach_set);
 
-  /// Runs to completion or to the budget.
-  void Run();
+  /// Explores from `initials` to completion or to the budget.
+  void Run(std::vector<FlowpipeModel::Initial> initials);
 
   const std::vector<Finding>& findings() const { return findings_; }
   /// The earliest time not explored (infinity when complete).

@@ -186,6 +186,8 @@ void FlowpipeModel::MakeJumps(int index) {
     Jump j;
     j.name = step.transition.name;
     for (const Comparison& c : step.transition.guard.comparisons) j.guard.push_back(Compile(c));
+    j.guard_and_invariant = j.guard;
+    for (const Residual& r : Mode(index).invariant) j.guard_and_invariant.push_back(r);
     for (const Reset& r : step.transition.resets) {
       Residual value;
       value.expression = Resolve(r.value);
@@ -392,17 +394,17 @@ bool FlowpipeModel::Contract(const std::vector<Residual>& conjunction,
 
 namespace {
 
-// max over lambda in [0, top] of phi(lambda), phi concave (or close to it): golden-section search;
-// every value of phi is a sound bound, so the best one seen is returned.
+// max over lambda in [0, top] of phi(lambda), phi concave (or close to it), by a golden-section
+// search of `iterations` steps; every value of phi is a sound bound, so the best one seen is
+// returned.
 template <class F>
-double BestLowerBound(F phi, double top) {
-  double best = phi(0.0);
+double BestLowerBound(F phi, double top, int iterations) {
   const double r = 0.6180339887498949;
   double a = 0.0, b = top;
   double c = b - r * (b - a), d = a + r * (b - a);
   double fc = phi(c), fd = phi(d);
-  best = std::max({best, fc, fd});
-  for (int i = 0; i < 40; ++i) {
+  double best = std::max(fc, fd);
+  for (int i = 0; i < iterations; ++i) {
     if (fc >= fd) {
       b = d;
       d = c;
@@ -422,14 +424,75 @@ double BestLowerBound(F phi, double top) {
   return best;
 }
 
+// The lambda >= 0 that maximises, for the zonotope Z of the affine forms `x` (centre c,
+// generators g_s, error terms as one generator per component), the dual function
+//   phi(lambda) = min over Z of (sign e_i + lambda n).x - lambda d
+//              = (l + lambda n).c - lambda d - sum_s |alpha_s + lambda beta_s|,
+// alpha_s = l.g_s, beta_s = n.g_s: concave and piecewise linear, so its maximum is at 0 or at a
+// breakpoint -alpha_s / beta_s, found by walking the slope. Computed in plain floating point:
+// the caller evaluates the bound soundly at the lambda returned (any lambda >= 0 is valid).
+double BestMultiplier(const std::vector<AffineForm>& x, const std::vector<double>& n, double d,
+                      std::size_t i, double sign) {
+  std::size_t m = 0;
+  for (const AffineForm& f : x) m = std::max(m, f.coefficients().size());
+  std::vector<std::pair<double, double>> generators;  // (alpha, beta)
+  double slope = -d;
+  for (std::size_t j = 0; j < x.size(); ++j) slope += n[j] * x[j].center();
+  for (std::size_t s = 0; s < m; ++s) {
+    double alpha = sign * x[i].coefficient(s), beta = 0.0;
+    for (std::size_t j = 0; j < x.size(); ++j) beta += n[j] * x[j].coefficient(s);
+    generators.push_back({alpha, beta});
+  }
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    generators.push_back({j == i ? sign * x[j].err() : 0.0, n[j] * x[j].err()});
+  }
+  // Slope just right of 0: each |alpha + lambda beta| contributes -sign(alpha) beta (or -|beta|
+  // when alpha = 0).
+  std::vector<std::pair<double, double>> breaks;  // (lambda_s, 2 |beta_s|)
+  for (const auto& [alpha, beta] : generators) {
+    if (beta == 0) continue;
+    if (alpha == 0) {
+      slope -= std::fabs(beta);
+      continue;
+    }
+    slope -= (alpha > 0 ? 1.0 : -1.0) * beta;
+    const double at = -alpha / beta;
+    if (at > 0) breaks.push_back({at, 2 * std::fabs(beta)});
+  }
+  if (slope <= 0) return 0.0;
+  std::sort(breaks.begin(), breaks.end());
+  for (const auto& [at, drop] : breaks) {
+    slope -= drop;
+    if (slope <= 0) return at;
+  }
+  // Still rising: the snapshot misses the halfspace (phi is unbounded); a large multiplier.
+  double scale = 0.0;
+  for (double v : n) scale = std::max(scale, std::fabs(v));
+  return 1e6 / std::max(scale, 1e-300) + (breaks.empty() ? 0.0 : 2 * breaks.back().first);
+}
+
 }  // namespace
 
 bool FlowpipeModel::ContractSegment(const std::vector<Residual>& conjunction,
                                     const Segment& segment, std::vector<TightInterval>& box,
                                     const std::vector<TightInterval>& env) const {
   const std::size_t dim = component_slot_.size();
+  if (segment.series.empty()) return Contract(conjunction, box, env);
+  // The segment's set at its start, middle and end (plain floating point: they only choose the
+  // multipliers, each then evaluated soundly over the whole segment).
+  std::vector<std::vector<AffineForm>> snapshots = {segment.series[0]};
+  for (double fraction : {0.5, 1.0}) {
+    if (segment.h == 0) break;
+    std::vector<AffineForm> at = segment.series[0];
+    double tk = 1.0;
+    for (std::size_t k = 1; k < segment.series.size(); ++k) {
+      tk *= fraction * segment.h;
+      for (std::size_t j = 0; j < at.size(); ++j) at[j] = at[j] + segment.series[k][j].Scaled(tk);
+    }
+    snapshots.push_back(std::move(at));
+  }
   for (const Residual& r : conjunction) {
-    if (!r.affine || segment.series.empty()) continue;
+    if (!r.affine) continue;
     // r = c + a.x + (terms of other slots): as halfspaces n.x <= d (d an upper bound).
     std::vector<double> a(dim, 0.0);
     TightInterval rest(r.affine->constant);
@@ -478,7 +541,14 @@ bool FlowpipeModel::ContractSegment(const std::vector<Residual>& conjunction,
             const double bound = SubDown(SubDown(lx.lo, MulUp(lambda, d)), slack);
             return std::isfinite(bound) ? bound : -kInf;
           };
-          const double lower = BestLowerBound(phi, 1e3 / std::max(norm_n, 1e-300));
+          // The snapshots' best multipliers, then a short search around them.
+          double lower = phi(0.0), top = 0.0;
+          for (const std::vector<AffineForm>& at : snapshots) {
+            const double lambda = BestMultiplier(at, n, d, i, sign);
+            lower = std::max(lower, phi(lambda));
+            top = std::max(top, lambda);
+          }
+          if (top > 0) lower = std::max(lower, BestLowerBound(phi, 2 * top, 8));
           TightInterval& x = box[i];
           if (sign > 0) {
             x.lo = std::max(x.lo, lower);

@@ -35,6 +35,8 @@ class FlowpipeModel {
   struct Jump {
     std::string name;
     std::vector<Residual> guard;
+    /// The guard and the source mode's invariant: where the jump may be taken.
+    std::vector<Residual> guard_and_invariant;
     std::vector<std::pair<int, Residual>> resets;  ///< (state component, new value)
     bool urgent = true;
     int target = -1;  ///< mode index

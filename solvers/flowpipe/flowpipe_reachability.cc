@@ -43,6 +43,83 @@ double TimeCap(const System& system, std::span<const Property> properties) {
   return std::max(cap, system.scenario()->until);
 }
 
+// The result for property `k` (`p`) from one exploration from `pieces` initial boxes (see the
+// class comment).
+CheckResult Result(const Property& p, std::size_t k, const Exploration& ex, double cap,
+                   std::size_t pieces, double seconds) {
+  const Exploration::Finding& f = ex.findings()[k];
+  const double frontier = ex.frontier();
+  const std::string stop = ex.stop_reason().empty() ? "" : " (" + ex.stop_reason() + ")";
+  const std::string effort = std::to_string(pieces) + " initial box" + (pieces == 1 ? "" : "es") +
+                             ", " + std::to_string(ex.steps()) + " Taylor steps, " +
+                             std::to_string(ex.entries()) + " mode entries";
+  CheckResult r;
+  r.property = p.name;
+  r.kind = p.kind;
+  r.method = "flowpipe";
+  r.seconds = seconds;
+  const bool reach = p.kind == Property::Kind::kReach;
+  const Verdict decided = reach ? Verdict::kUnreachable : Verdict::kProved;
+  const std::string meets = reach ? "meets the target" : "violates it";
+  if (f.met) {
+    r.reason = std::string("the flowpipe (an over-approximation) may ") +
+               (reach ? "reach the target" : "meet a violation") + " in mode " + f.met_mode +
+               " from t = " + Number(f.met_time) + " (" + effort + ")";
+  } else if (p.horizon) {
+    if (frontier >= *p.horizon) {
+      r.verdict = decided;
+      r.reason =
+          "no state reachable within " + Number(*p.horizon) + " " + meets + " (" + effort + ")";
+    } else {
+      r.reason = "the flowpipe covers only t < " + Number(frontier) + stop;
+    }
+  } else if (std::isinf(frontier)) {
+    r.verdict = decided;
+    r.reason = "the flowpipe reached a fixpoint: no reachable state " + meets + ", for all time (" +
+               effort + ")";
+  } else if (frontier > 0) {
+    r.verdict = decided;
+    r.within = std::min(frontier, cap);
+    r.reason = "no state reachable within " + Number(*r.within) + " " + meets +
+               "; later times not covered" +
+               (frontier >= cap ? " (the scenario's horizon)" : stop) + " (" + effort + ")";
+  } else {
+    r.reason = "the flowpipe covers no time" + stop;
+  }
+  return r;
+}
+
+// Splits every box in two along its widest component (state components: variables and
+// uncertain parameters); false when no box has width left.
+bool SplitAll(std::vector<FlowpipeModel::Initial>& pieces, int) {
+  std::vector<FlowpipeModel::Initial> out;
+  bool split = false;
+  for (const FlowpipeModel::Initial& p : pieces) {
+    std::size_t widest = 0;
+    double width = 0.0;
+    for (std::size_t i = 0; i < p.box.size(); ++i) {
+      const double w = p.box[i].hi - p.box[i].lo;
+      if (w > width) {
+        width = w;
+        widest = i;
+      }
+    }
+    if (!(width > 0) || !std::isfinite(width)) {
+      out.push_back(p);
+      continue;
+    }
+    split = true;
+    const double mid = p.box[widest].Mid();
+    FlowpipeModel::Initial lower = p, upper = p;
+    lower.box[widest].hi = mid;
+    upper.box[widest].lo = mid;
+    out.push_back(std::move(lower));
+    out.push_back(std::move(upper));
+  }
+  pieces = std::move(out);
+  return split;
+}
+
 }  // namespace
 
 FlowpipeReachability::FlowpipeReachability() : FlowpipeReachability(Options()) {}
@@ -95,60 +172,42 @@ std::vector<CheckResult> FlowpipeReachability::Check(const System& system,
   flowpipe_internal::RoundingGuard rounding;
   FlowpipeModel model(system);
   const double cap = TimeCap(system, properties);
-  Exploration ex(model, properties, options_, cap, reach_set);
-  ex.Run();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double frontier = ex.frontier();
-  const std::string stop = ex.stop_reason().empty() ? "" : " (" + ex.stop_reason() + ")";
-  const std::string effort = std::to_string(ex.steps()) + " Taylor steps, " +
-                             std::to_string(ex.entries()) + " mode entries";
-  std::vector<CheckResult> results;
-  for (std::size_t k = 0; k < properties.size(); ++k) {
-    const Property& p = properties[k];
-    const Exploration::Finding& f = ex.findings()[k];
-    CheckResult r;
-    r.property = p.name;
-    r.kind = p.kind;
-    r.method = "flowpipe";
-    r.seconds = seconds;
-    const bool reach = p.kind == Property::Kind::kReach;
-    const Verdict decided = reach ? Verdict::kUnreachable : Verdict::kProved;
-    if (f.met) {
-      r.reason = std::string("the flowpipe (an over-approximation) may ") +
-                 (reach ? "reach the target" : "meet a violation") + " in mode " + f.met_mode +
-                 " from t = " + Number(f.met_time) + " (" + effort + ")";
-    } else if (p.horizon) {
-      if (frontier >= *p.horizon) {
-        r.verdict = decided;
-        r.reason = "no state reachable within " + Number(*p.horizon) + " " +
-                   (reach ? "meets the target" : "violates it") +
-                   ": flowpipe to t = " + Number(*p.horizon) + " (" + effort + ")";
-      } else {
-        r.reason = "the flowpipe covers only t < " + Number(frontier) + stop;
+  std::vector<std::optional<CheckResult>> decided(properties.size());
+  std::vector<CheckResult> last(properties.size());
+  std::vector<FlowpipeModel::Initial> pieces = model.Initials();
+  Usage total;
+  for (int level = 0;; ++level) {
+    FlowpipeReachability::Options options = options_;
+    options.max_steps = options_.max_steps - total.steps;
+    if (reach_set) *reach_set = {};
+    Exploration ex(model, properties, options, cap, reach_set);
+    ex.Run(pieces);
+    total.steps += ex.steps();
+    total.entries += ex.entries();
+    total.frontier = ex.frontier();
+    total.complete = std::isinf(ex.frontier());
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    bool open = false;
+    for (std::size_t k = 0; k < properties.size(); ++k) {
+      if (decided[k]) continue;
+      last[k] = Result(properties[k], k, ex, cap, pieces.size(), seconds);
+      if (last[k].verdict != Verdict::kUnknown) {
+        decided[k] = last[k];
+      } else if (!ex.findings()[k].met_wholly) {
+        open = true;
       }
-    } else if (std::isinf(frontier)) {
-      r.verdict = decided;
-      r.reason = "the flowpipe reached a fixpoint: no reachable state " +
-                 std::string(reach ? "meets the target" : "violates it") + ", for all time (" +
-                 effort + ")";
-    } else if (frontier > 0) {
-      r.verdict = decided;
-      r.within = std::min(frontier, cap);
-      r.reason = "no state reachable within " + Number(*r.within) + " " +
-                 (reach ? "meets the target" : "violates it") + "; later times not covered" +
-                 (frontier >= cap ? " (the scenario's horizon)" : stop) + " (" + effort + ")";
-    } else {
-      r.reason = "the flowpipe covers no time" + stop;
     }
-    results.push_back(std::move(r));
+    // Split the initial sets where a property is still open, while the budget lasts.
+    if (!open || total.steps >= options_.max_steps ||
+        static_cast<int>(pieces.size()) * 2 > options_.max_pieces)
+      break;
+    if (!SplitAll(pieces, model.num_variables())) break;
   }
-  if (usage) {
-    usage->steps = ex.steps();
-    usage->entries = ex.entries();
-    usage->frontier = frontier;
-    usage->complete = std::isinf(frontier);
-  }
+  std::vector<CheckResult> results;
+  for (std::size_t k = 0; k < properties.size(); ++k)
+    results.push_back(decided[k] ? *decided[k] : last[k]);
+  if (usage) *usage = total;
   return results;
 }
 

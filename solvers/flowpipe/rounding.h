@@ -2,6 +2,7 @@
 
 #include <cfenv>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 // Directed rounding for the flowpipe engine, tight where an operation is exact.
@@ -93,6 +94,16 @@ inline double DivDown(double a, double b) {
   if (std::fabs(q) < kTiny && a != 0) return NextDown(q);
   const double r = -std::fma(q, b, -a);
   return (r < 0) == (b > 0) && r != 0 ? NextDown(q) : q;
+}
+
+// An upper bound of a sum of `terms` non-negative numbers from their sum `s` computed in
+// round-to-nearest in any order: each addition errs by at most 2^-53 of its result, so the
+// computed sum is within (terms - 1) 2^-53 / (1 - (terms - 1) 2^-53) of the exact one (Higham,
+// Accuracy and Stability of Numerical Algorithms, 4.2); 2^-52 per term covers it for any
+// realistic count, and one step up covers the rounding of this product.
+inline double SumUp(double s, std::size_t terms) {
+  if (s == 0 || !std::isfinite(s)) return s;
+  return NextUp(s * (1.0 + static_cast<double>(terms + 1) * 0x1p-52)) + 1e-300;
 }
 
 // |a - b| rounded up.

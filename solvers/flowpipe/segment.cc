@@ -5,6 +5,48 @@
 
 namespace hybrid::flowpipe_internal {
 
+namespace {
+
+// An enclosure of sum_i a[i] forms[i] over the symbols' box: the centre and the coefficients of
+// the combination are accumulated with their exact rounding errors (fma, TwoSum), whose sum joins
+// the error terms; the radius is a sum of non-negative terms bounded by SumUp.
+TightInterval CombinationRange(const std::vector<AffineForm>& forms, const std::vector<double>& a,
+                               std::vector<double>& g) {
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] != 0) m = std::max(m, forms[i].coefficients().size());
+  }
+  g.assign(m, 0.0);
+  double c = 0.0, error = 0.0;
+  std::size_t terms = 1;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == 0) continue;
+    const AffineForm& f = forms[i];
+    const double p = a[i] * f.center();
+    const double s = c + p;
+    error += std::fabs(std::fma(a[i], f.center(), -p)) + std::fabs(SumError(c, p, s));
+    c = s;
+    const std::vector<double>& fg = f.coefficients();
+    for (std::size_t k = 0; k < fg.size(); ++k) {
+      if (fg[k] == 0) continue;
+      const double q = a[i] * fg[k];
+      const double t = g[k] + q;
+      error += std::fabs(std::fma(a[i], fg[k], -q)) + std::fabs(SumError(g[k], q, t));
+      g[k] = t;
+      terms += 2;
+    }
+    error += std::fabs(a[i]) * f.err();
+    terms += 3;
+  }
+  if (!std::isfinite(c) || !std::isfinite(error)) return TightInterval::Entire();
+  double r = error;
+  for (double v : g) r += std::fabs(v);
+  r = SumUp(r, terms + m);
+  return {SubDown(c, r), AddUp(c, r)};
+}
+
+}  // namespace
+
 TightInterval Segment::LinearBound(const std::vector<double>& a) const {
   if (series.empty()) {
     TightInterval sum(0.0);
@@ -13,23 +55,13 @@ TightInterval Segment::LinearBound(const std::vector<double>& a) const {
     }
     return sum;
   }
+  std::vector<double> scratch;
   TightInterval sum(0.0);
-  double hk = 1.0;  // h^k, exact for the steps the engine takes (powers of two)
+  double hk = 1.0;  // h^k rounded up (exact for the powers of two the engine uses)
   for (std::size_t k = 0; k < series.size(); ++k) {
-    AffineForm combination(0.0);
-    bool any = false;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      if (a[i] == 0) continue;
-      combination = any ? combination + series[k][i].Scaled(a[i]) : series[k][i].Scaled(a[i]);
-      any = true;
-    }
-    const TightInterval range = combination.Range();
-    if (k == 0) {
-      sum = range;
-    } else {
-      // s^k for s in [0, h] is [0, h^k].
-      sum = sum + TightInterval(0.0, MulUp(hk, 1.0)) * range;
-    }
+    const TightInterval range = CombinationRange(series[k], a, scratch);
+    // s^k for s in [0, h] is [0, h^k].
+    sum = k == 0 ? range : sum + TightInterval(0.0, hk) * range;
     hk = MulUp(hk, h);
   }
   for (std::size_t i = 0; i < a.size() && i < remainder.size(); ++i) {

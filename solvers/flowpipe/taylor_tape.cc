@@ -28,6 +28,9 @@ TightInterval Zero<TightInterval>() {
   return TightInterval(0.0);
 }
 
+AffineForm Square(const AffineForm& a) { return a.Square(); }
+TightInterval Square(const TightInterval& a) { return Power(a, 2); }
+
 struct BuildState {
   std::map<const void*, int> memo;
 };
@@ -188,6 +191,14 @@ T TaylorTape::Coefficient(const Node& node, int k, const std::vector<std::vector
     case Kind::kSub:
       return at(node.a, k) - at(node.b, k);
     case Kind::kMul: {
+      if (node.a == node.b) {  // a square: sum_i a_i a_{k-i}, the middle term squared once
+        T sum = k % 2 == 0 ? Square(at(node.a, k / 2)) : Zero<T>();
+        for (int i = 0; 2 * i < k; ++i) {
+          const T p = at(node.a, i) * at(node.a, k - i);
+          sum = sum + p + p;
+        }
+        return sum;
+      }
       T sum = at(node.a, 0) * at(node.b, k);
       for (int i = 1; i <= k; ++i) sum = sum + at(node.a, i) * at(node.b, k - i);
       return sum;

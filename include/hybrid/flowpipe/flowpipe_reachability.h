@@ -73,6 +73,11 @@ class FlowpipeReachability {
     std::int64_t max_steps = 200000;
     /// Mode entries explored (sets taken from the worklist).
     int max_entries = 5000;
+    /// Initial boxes at most: while a property is still open and the budget lasts, the whole
+    /// exploration is run again with every initial box split in two along its widest component
+    /// (variables and uncertain parameters), so the errors of the nonlinear terms, which grow
+    /// with the square of a set's width, shrink (at most 1 << 20).
+    int max_pieces = 16;
     /// Noise symbols kept per set before the smallest are boxed (Girard's reduction); 0:
     /// 10 per state component.
     int max_symbols = 0;
