@@ -260,14 +260,15 @@ std::unique_ptr<PropertyChecker> MakeProve(MethodContext& c) {
 // (kFlowpipeStepsPerBudgetSecond each), the Taylor order and the step.
 std::unique_ptr<PropertyChecker> MakeFlowpipe(MethodContext& c) {
   FlowpipeReachability::Options options;
-  options.max_steps = static_cast<std::int64_t>(std::ceil(c.args.budget * kFlowpipeStepsPerBudgetSecond));
+  options.max_steps =
+      static_cast<std::int64_t>(std::ceil(c.args.budget * kFlowpipeStepsPerBudgetSecond));
   options.order = c.args.order;
   options.step = c.args.step;
   if (c.progress && c.progress->enabled()) {
     ProgressLine& progress = *c.progress;
     options.progress = [&progress](std::int64_t steps, int queued) {
-      progress.Report("flowpipe: " + std::to_string(steps) + " Taylor steps, " + std::to_string(queued) +
-                      " sets queued");
+      progress.Report("flowpipe: " + std::to_string(steps) + " Taylor steps, " +
+                      std::to_string(queued) + " sets queued");
     };
   }
   return std::make_unique<FlowpipeChecker>(options, c.reach_set);
@@ -340,6 +341,7 @@ json PropertiesJson(const System& system, const Simulator& sim, const Findings& 
               {"predicate", found.chosen[i].predicate.ToString()}};
     if (found.chosen[i].horizon) j["within"] = *found.chosen[i].horizon;  // as info has it
     j["verdict"] = std::string(VerdictName(r.verdict));
+    if (r.within) j["verdict_within"] = *r.within;
     j["method"] = r.method;
     j["seconds"] = r.seconds;
     j["reason"] = r.reason;
@@ -406,8 +408,10 @@ std::string ReportText(const CheckArgs& args, const System& system, const Simula
   out << args.model << ": " << count << (count == 1 ? " property" : " properties") << ", method "
       << args.method << ", " << found.seconds << " s\n";
   for (const CheckResult& r : found.results) {
-    out << "  " << VerdictName(r.verdict) << "  " << r.property << " (" << KindKeyword(r.kind)
-        << ", " << r.seconds << " s): " << r.reason << "\n";
+    out << "  " << VerdictName(r.verdict);
+    if (r.within) out << " within " << *r.within;
+    out << "  " << r.property << " (" << KindKeyword(r.kind) << ", " << r.seconds
+        << " s): " << r.reason << "\n";
     if (r.trace) out << TraceText(system, sim, *r.trace);
   }
   if (args.modes) {

@@ -148,6 +148,7 @@ void Exploration::Explore(const Entry& entry) {
   const double h0 = options_.step > 0 ? PowerOfTwoBelow(options_.step) : stepper.SuggestedStep(box);
   double h = h0, t = 0.0;
   std::vector<Crossing> crossings(mode.jumps.size());
+  std::vector<TightInterval> known = box;  // holds the current start set
   std::vector<TightInterval> hull;
   int local_steps = 0;
   while (true) {
@@ -163,13 +164,13 @@ void Exploration::Explore(const Entry& entry) {
     Segment start;
     start.series = {x};
     start.remainder.assign(dim, TightInterval(0.0));
-    start.ComputeBox(std::vector<TightInterval>(dim, TightInterval::Entire()));
+    start.ComputeBox(known);
     if (model_.HoldsAll(mode.invariant, start, mode.env) == Truth::kFalse) break;
     if (InsideUrgentGuard(start, mode)) {
       if (local_steps == 0) Visit(start, entry.mode, entry.t0, entry.t0, crossings, &hull);
       break;
     }
-    std::optional<StepResult> step = stepper.Take(x, h);
+    std::optional<StepResult> step = stepper.Take(x, h, known);
     if (!step) {
       if (h > kSmallestStep) {
         h /= 2;
@@ -188,6 +189,7 @@ void Exploration::Explore(const Entry& entry) {
     ++local_steps;
     if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + h, crossings, &hull)) break;
     x = std::move(step->end);
+    known = std::move(step->segment.box);  // holds the next start set too
     t += h;
     if (!near_guard && h < h0) h *= 2;
     if (local_steps % kInvariantBoxEvery == 0 || (local_steps & (local_steps - 1)) == 0) {

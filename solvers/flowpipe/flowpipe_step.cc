@@ -54,7 +54,19 @@ std::optional<std::vector<TightInterval>> FlowpipeStep::Apriori(
       image[i] = box[i] + span * f[i];
       if (!(image[i].IsFinite() && b[i].Contains(image[i]))) inside = false;
     }
-    if (inside) return image;  // an enclosure too, and tighter
+    if (inside) {
+      // Every solution stays in B, so also in box + [0, h] f(B) = image, and so on: two more
+      // Picard iterations tighten the enclosure (an attained bound such as a drop height is
+      // then not exceeded by the guess's padding).
+      for (int refine = 0; refine < 2; ++refine) {
+        f = tape_.Evaluate(image, inputs_);
+        for (std::size_t i = 0; i < box.size(); ++i) {
+          const TightInterval next = box[i] + span * f[i];
+          image[i] = {std::max(image[i].lo, next.lo), std::min(image[i].hi, next.hi)};
+        }
+      }
+      return image;
+    }
     for (std::size_t i = 0; i < box.size(); ++i) b[i] = Hull(b[i], image[i]);
     if (std::any_of(b.begin(), b.end(), [](const TightInterval& x) { return !x.IsFinite(); }))
       break;
@@ -127,8 +139,13 @@ void FlowpipeStep::Reduce(std::vector<AffineForm>& x) const {
   for (AffineForm& f : x) f.Reindex(new_index, next);
 }
 
-std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, double h) const {
-  const std::vector<TightInterval> box = Ranges(x);
+std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, double h,
+                                             const std::vector<TightInterval>& known) const {
+  std::vector<TightInterval> box = Ranges(x);
+  for (std::size_t i = 0; i < known.size() && i < box.size(); ++i) {
+    const TightInterval both{std::max(box[i].lo, known[i].lo), std::min(box[i].hi, known[i].hi)};
+    if (both.lo <= both.hi) box[i] = both;
+  }
   const std::optional<std::vector<TightInterval>> apriori = Apriori(box, h);
   if (!apriori) return std::nullopt;
   const std::size_t n = x.size();

@@ -26,7 +26,12 @@ class FlowpipeStep {
 
   /// The step of length h (a power of two), or nullopt when no a-priori enclosure was found (the
   /// caller takes a shorter step).
-  std::optional<StepResult> Take(const std::vector<AffineForm>& x, double h) const;
+  /// `known` (if not empty) is a box known to hold the start set, intersected with its forms'
+  /// ranges (the entry box, or the previous segment's box): the forms' centre-and-radius
+  /// representation of a box can exceed it by rounding, and the a-priori enclosure starts from
+  /// the tighter box.
+  std::optional<StepResult> Take(const std::vector<AffineForm>& x, double h,
+                                 const std::vector<TightInterval>& known = {}) const;
 
   /// A step length for the start set `box`: the power of two nearest below 0.05 / |df/dx|,
   /// within [2^-14, 2^-1].

@@ -94,10 +94,10 @@ TEST(ProgressCli, CheckProveAndSampleReport) {
   EXPECT_NE(prove.err.find("hybrid check: prove: "), std::string::npos) << prove.err;
   EXPECT_NE(prove.err.find("% of the solver budget used"), std::string::npos) << prove.err;
   const Result sample = RunHybrid("check " + model + " --method sample --runs 5 --progress");
-  EXPECT_NE(sample.err.find("hybrid check: sample: property 1 of 2 (comfortable)"),
+  EXPECT_NE(sample.err.find("hybrid check: sample: property 1 of 3 (comfortable)"),
             std::string::npos)
       << sample.err;
-  EXPECT_NE(sample.err.find("property 2 of 2 (heats)"), std::string::npos) << sample.err;
+  EXPECT_NE(sample.err.find("property 2 of 3 (heats)"), std::string::npos) << sample.err;
 }
 
 TEST(ProgressCli, DiagnoseReportsEachCandidate) {
