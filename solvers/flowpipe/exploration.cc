@@ -166,11 +166,14 @@ void Exploration::Explore(const Entry& entry) {
     start.remainder.assign(dim, TightInterval(0.0));
     start.ComputeBox(known);
     if (model_.HoldsAll(mode.invariant, start, mode.env) == Truth::kFalse) break;
+    if (local_steps == 0) CheckProperties(start, mode, entry.t0, entry.t0);  // the entry itself
     if (InsideUrgentGuard(start, mode)) {
       if (local_steps == 0) Visit(start, entry.mode, entry.t0, entry.t0, crossings, &hull);
       break;
     }
-    std::optional<StepResult> step = stepper.Take(x, h, known);
+    // A step ends at the next horizon of a `within T` property, so that no segment reaches past it.
+    const double length = std::min(h, UntilNextHorizon(entry.t0 + t));
+    std::optional<StepResult> step = stepper.Take(x, length, known);
     if (!step) {
       if (h > kSmallestStep) {
         h /= 2;
@@ -187,14 +190,15 @@ void Exploration::Explore(const Entry& entry) {
     }
     ++steps_;
     ++local_steps;
-    if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + h, crossings, &hull)) break;
+    if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + length, crossings, &hull))
+      break;
     x = std::move(step->end);
     known = std::move(step->segment.box);  // holds the next start set too
-    t += h;
+    t += length;
     if (!near_guard && h < h0) h *= 2;
     if (local_steps % kInvariantBoxEvery == 0 || (local_steps & (local_steps - 1)) == 0) {
       std::vector<TightInterval> invariant_box = hull;
-      if (InvariantBox(entry.mode, invariant_box)) {
+      if (InvariantBox(entry.mode, invariant_box, entry.t0 + t)) {
         Visit(BoxSegment(invariant_box), entry.mode, entry.t0 + t,
               std::numeric_limits<double>::infinity(), crossings, nullptr);
         break;
@@ -212,8 +216,10 @@ bool Exploration::Visit(const Segment& segment, int mode_index, double t, double
   Segment s = segment;
   const Truth inside = model_.HoldsAll(mode.invariant, s, mode.env);
   if (inside == Truth::kFalse) return false;
-  if (inside == Truth::kMaybe && !model_.Contract(mode.invariant, s.box, mode.env)) return false;
-  CheckProperties(s, mode, t);
+  if (inside == Truth::kMaybe && !model_.ContractSegment(mode.invariant, s, s.box, mode.env)) {
+    return false;
+  }
+  CheckProperties(s, mode, t, t_end);
   Record(s, mode, t, t_end);
   if (hull) {
     if (hull->empty()) *hull = s.box;
@@ -240,11 +246,34 @@ bool Exploration::Visit(const Segment& segment, int mode_index, double t, double
   return true;
 }
 
-void Exploration::CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode,
-                                  double t) {
+double Exploration::UntilNextHorizon(double t) const {
+  double next = std::numeric_limits<double>::infinity();
+  for (const Property& p : properties_) {
+    if (p.horizon && *p.horizon > t) next = std::min(next, *p.horizon - t);
+  }
+  // A gap below a millionth of the horizon is not worth a step of its own.
+  return next > 1e-6 * (1.0 + t) ? next : std::numeric_limits<double>::infinity();
+}
+
+bool Exploration::WouldMeetNewly(const Segment& segment, const FlowpipeModel::CompiledMode& mode,
+                                 double t) const {
   for (std::size_t k = 0; k < properties_.size(); ++k) {
     const Property& p = properties_[k];
-    if (p.horizon && t > *p.horizon) continue;
+    if (findings_[k].met || (p.horizon && t >= *p.horizon)) continue;
+    const Truth holds = model_.Evaluate(p.predicate, segment, mode);
+    if (p.kind == Property::Kind::kAlways ? holds != Truth::kTrue : holds != Truth::kFalse)
+      return true;
+  }
+  return false;
+}
+
+void Exploration::CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode,
+                                  double t, double t_end) {
+  for (std::size_t k = 0; k < properties_.size(); ++k) {
+    const Property& p = properties_[k];
+    // A segment of positive length from T on holds only states after T, except its start, which
+    // the segment before it (or the entry's start set, checked at its own) holds.
+    if (p.horizon && (t > *p.horizon || (t == *p.horizon && t_end > t))) continue;
     const Truth holds = model_.Evaluate(p.predicate, segment, mode);
     const bool bad =
         p.kind == Property::Kind::kAlways ? holds != Truth::kTrue : holds != Truth::kFalse;
@@ -271,13 +300,13 @@ void Exploration::CloseCrossing(int mode_index, int jump_index, Crossing& crossi
   Push({jump.target, std::move(next), crossing.t0});
 }
 
-bool Exploration::InvariantBox(int mode_index, std::vector<TightInterval>& box) const {
+bool Exploration::InvariantBox(int mode_index, std::vector<TightInterval>& box, double t) const {
   const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
   if (box.empty()) return false;
-  for (double widen : {0.02, 0.1, 0.3}) {
+  for (double widen : {0.0, 0.001, 0.02, 0.1, 0.3}) {
     std::vector<TightInterval> b = box;
     for (TightInterval& x : b) {
-      const double pad = widen * (x.hi - x.lo) + 1e-9 * (1.0 + x.MagnitudeUp());
+      const double pad = widen == 0 ? 0.0 : widen * (x.hi - x.lo) + 1e-9 * (1.0 + x.MagnitudeUp());
       x = {SubDown(x.lo, pad), AddUp(x.hi, pad)};
     }
     bool inward = true;
@@ -292,7 +321,9 @@ bool Exploration::InvariantBox(int mode_index, std::vector<TightInterval>& box) 
         inward = side == 0 ? f.lo >= 0 : f.hi <= 0;
       }
     }
-    if (inward) {
+    // A box that would meet a property the flow so far does not meet is not worth taking: the
+    // flow goes on instead (always sound).
+    if (inward && !WouldMeetNewly(BoxSegment(b), mode, t)) {
       box = b;
       return true;
     }

@@ -67,14 +67,21 @@ class Exploration {
   // the reach set; false when the segment holds no state (outside the invariant).
   bool Visit(const Segment& segment, int mode, double t, double t_end,
              std::vector<Crossing>& crossings, std::vector<TightInterval>* hull);
-  void CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t);
+  void CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t,
+                       double t_end);
   void CloseCrossing(int mode, int jump, Crossing& crossing);
-  bool InvariantBox(int mode, std::vector<TightInterval>& box) const;
+  // A positively invariant box around `box` (the flow from time t on), if one is found.
+  bool InvariantBox(int mode, std::vector<TightInterval>& box, double t) const;
   bool MayMeetUrgentGuard(const Segment& segment, const FlowpipeModel::CompiledMode& mode) const;
   bool InsideUrgentGuard(const Segment& segment, const FlowpipeModel::CompiledMode& mode) const;
   void Record(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t,
               double t_end);
   void StopAt(double t, const std::string& why);
+  // Model time from t to the nearest property horizon after it (infinity when none).
+  double UntilNextHorizon(double t) const;
+  // Whether `segment` may meet the bad states of a property no segment has met so far.
+  bool WouldMeetNewly(const Segment& segment, const FlowpipeModel::CompiledMode& mode,
+                      double t) const;
 
   FlowpipeModel& model_;
   std::span<const Property> properties_;

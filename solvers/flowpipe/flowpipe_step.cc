@@ -89,19 +89,27 @@ std::vector<double> FlowpipeStep::InputDeviation(const std::vector<TightInterval
     w_max = std::max(w_max, w[i]);
   }
   if (w_max == 0) return d;
-  // |e_i|' <= sum_j |J_ij| |e_j| + w_i, e(0) = 0: |e| <= E = |w| h exp(L h) with L the row-sum
-  // norm of |J|, and per component |e_i| <= h (w_i + sum_j |J_ij| E).
-  const auto jac = tape_.JacobianMagnitude(apriori, inputs_);
-  double L = 0.0;
-  for (const auto& row : jac) {
-    double s = 0.0;
-    for (double v : row) s = AddUp(s, v);
-    L = std::max(L, s);
-  }
-  const double E = MulUp(MulUp(w_max, h), ExpUp(MulUp(L, h)));
+  // The difference e between a solution under any input signal in U and the one under the
+  // midpoint inputs obeys e' = J e + B (u - u_c) with J in the Jacobian's enclosure over the
+  // a-priori box: |e_i|' <= J_ii |e_i| + sum_{j != i} |J_ij| |e_j| + w_i. With mu the
+  // (infinity-norm) logarithmic norm bound max_i (sup J_ii + sum_{j != i} |J_ij|),
+  // |e| <= E = |w| (exp(mu h) - 1) / mu <= |w| h exp(max(mu, 0) h), and per component
+  // |e_i| <= h (w_i + max(sup J_ii, 0) E + sum_{j != i} |J_ij| E).
+  const auto jac = tape_.Jacobian(apriori, inputs_);
+  double mu = -kInf;
   for (std::size_t i = 0; i < n; ++i) {
-    double s = w[i];
-    for (double v : jac[i]) s = AddUp(s, MulUp(v, E));
+    double s = jac[i][i].hi;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i) s = AddUp(s, jac[i][j].MagnitudeUp());
+    }
+    mu = std::max(mu, s);
+  }
+  const double E = MulUp(MulUp(w_max, h), ExpUp(MulUp(std::max(mu, 0.0), h)));
+  for (std::size_t i = 0; i < n; ++i) {
+    double s = AddUp(w[i], MulUp(std::max(jac[i][i].hi, 0.0), E));
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i) s = AddUp(s, MulUp(jac[i][j].MagnitudeUp(), E));
+    }
     d[i] = MulUp(h, s);
   }
   return d;
@@ -154,15 +162,15 @@ std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, d
   out.segment.series = tape_.Series(x, input_centres_, order_);
   const std::vector<TightInterval> tail =
       tape_.Series(*apriori, input_centre_boxes_, order_ + 1)[static_cast<std::size_t>(order_) + 1];
-  double hk1 = 1.0;  // h^{K+1}, exact for a power of two
-  for (int k = 0; k <= order_; ++k) hk1 = MulUp(hk1, h);
+  TightInterval hk1(1.0);  // h^{K+1}
+  for (int k = 0; k <= order_; ++k) hk1 = hk1 * TightInterval(h);
   const std::vector<double> deviation = InputDeviation(*apriori, h);
   out.segment.remainder.resize(n);
   std::vector<TightInterval> end_remainder(n);
   for (std::size_t i = 0; i < n; ++i) {
     const TightInterval dev(-deviation[i], deviation[i]);
-    out.segment.remainder[i] = TightInterval(0.0, hk1) * tail[i] + dev;
-    end_remainder[i] = TightInterval(hk1) * tail[i] + dev;
+    out.segment.remainder[i] = TightInterval(0.0, hk1.hi) * tail[i] + dev;
+    end_remainder[i] = hk1 * tail[i] + dev;
   }
   out.segment.ComputeBox(*apriori);
   // The set at h: sum_k h^k x_k + the remainder; the error terms become new symbols.
@@ -170,10 +178,11 @@ std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, d
   std::size_t m = 0;
   for (std::size_t i = 0; i < n; ++i) {
     AffineForm sum = out.segment.series[0][i];
-    double hk = 1.0;
+    TightInterval hk(1.0);  // h^k (a point when h is a power of two)
     for (int k = 1; k <= order_; ++k) {
-      hk = MulUp(hk, h);
-      sum = sum + out.segment.series[static_cast<std::size_t>(k)][i].Scaled(hk);
+      hk = hk * TightInterval(h);
+      const AffineForm& xk = out.segment.series[static_cast<std::size_t>(k)][i];
+      sum = sum + (hk.lo == hk.hi ? xk.Scaled(hk.lo) : xk.Scaled(hk));
     }
     out.end[i] = sum.PlusInterval(end_remainder[i]);
     m = std::max(m, out.end[i].coefficients().size());
@@ -192,10 +201,10 @@ double FlowpipeStep::SuggestedStep(const std::vector<TightInterval>& box) const 
   }
   double L = 0.0;
   // |df/dx| at the box, from the Jacobian tape when there is one, else by the growth of f.
-  const auto jac = tape_.JacobianMagnitude(b, inputs_);
+  const auto jac = tape_.Jacobian(b, inputs_);
   for (const auto& row : jac) {
     double s = 0.0;
-    for (double v : row) s += v;
+    for (const TightInterval& v : row) s += v.MagnitudeUp();
     L = std::max(L, s);
   }
   double h = 0.5;

@@ -259,14 +259,15 @@ std::vector<TightInterval> TaylorTape::Evaluate(const std::vector<TightInterval>
   return f;
 }
 
-std::vector<std::vector<double>> TaylorTape::JacobianMagnitude(
+std::vector<std::vector<TightInterval>> TaylorTape::Jacobian(
     const std::vector<TightInterval>& x, const std::vector<TightInterval>& inputs) const {
   const std::vector<TightInterval> v = NodeValues(x, inputs, nodes_.size());
-  std::vector<std::vector<double>> out;
+  std::vector<std::vector<TightInterval>> out;
   for (const auto& row : jacobian_) {
     out.emplace_back();
-    for (int node : row)
-      out.back().push_back(node < 0 ? 0.0 : v[static_cast<std::size_t>(node)].MagnitudeUp());
+    for (int node : row) {
+      out.back().push_back(node < 0 ? TightInterval(0.0) : v[static_cast<std::size_t>(node)]);
+    }
   }
   return out;
 }

@@ -50,9 +50,9 @@ class TaylorTape {
   /// f over the box `x` and the input box `inputs`.
   std::vector<TightInterval> Evaluate(const std::vector<TightInterval>& x,
                                       const std::vector<TightInterval>& inputs) const;
-  /// Bounds of |df_i/dx_j| over the boxes (row i, column j).
-  std::vector<std::vector<double>> JacobianMagnitude(
-      const std::vector<TightInterval>& x, const std::vector<TightInterval>& inputs) const;
+  /// Enclosures of df_i/dx_j over the boxes (row i, column j).
+  std::vector<std::vector<TightInterval>> Jacobian(const std::vector<TightInterval>& x,
+                                                   const std::vector<TightInterval>& inputs) const;
   /// Bounds of |df_i/du_j| (f is affine in u; the coefficients read state components that are
   /// parameters only).
   std::vector<std::vector<double>> InputGainMagnitude(const std::vector<TightInterval>& x) const;
