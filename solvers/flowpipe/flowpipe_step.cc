@@ -208,7 +208,7 @@ double FlowpipeStep::SuggestedStep(const std::vector<TightInterval>& box) const 
     L = std::max(L, s);
   }
   double h = 0.5;
-  while (h > 1.0 / 16384 && h * L > 0.05) h /= 2;
+  while (h > 1.0 / 16384 && h * L > 0.2) h /= 2;
   return h;
 }
 

@@ -33,7 +33,7 @@ class FlowpipeStep {
   std::optional<StepResult> Take(const std::vector<AffineForm>& x, double h,
                                  const std::vector<TightInterval>& known = {}) const;
 
-  /// A step length for the start set `box`: the power of two nearest below 0.05 / |df/dx|,
+  /// A step length for the start set `box`: the power of two nearest below 0.2 / |df/dx|,
   /// within [2^-14, 2^-1].
   double SuggestedStep(const std::vector<TightInterval>& box) const;
 

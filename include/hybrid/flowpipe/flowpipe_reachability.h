@@ -67,7 +67,7 @@ class FlowpipeReachability {
     /// Taylor order K (1 to 12).
     int order = 6;
     /// The step in model time units; 0: automatic per mode entry (a power of two near
-    /// 0.05 / |df/dx|). Steps are powers of two, so that powers of h are exact.
+    /// 0.2 / |df/dx|). Steps are powers of two, so that powers of h are exact.
     double step = 0.0;
     /// Taylor steps over the whole exploration (the budget; positive).
     std::int64_t max_steps = 200000;

@@ -31,9 +31,31 @@ std::size_t Column(const FlowpipeReachability::ReachSet& set, const std::string&
   return 0;
 }
 
-// x' = -x from x0 in [1, 2]: x(t) = x0 exp(-t). Every box holds the solutions from both ends at
-// 9 times of its step, and is at most 2 h |x'| (h = 1/32, the automatic step; |x'| <= 2) wider
-// than their range: the time terms of a step are bounded apart from the start set's.
+// Whether some box of `set` whose time span holds t holds the point (x, y) (y ignored when
+// `ycol` is npos): the union of the boxes is what the engine claims to enclose.
+bool Covered(const FlowpipeReachability::ReachSet& set, double t, std::size_t xcol, double x,
+             std::size_t ycol = std::string::npos, double y = 0.0) {
+  for (const auto& b : set.boxes) {
+    if (t < b.t_lo || t > b.t_hi) continue;
+    if (x < b.box[xcol].first || x > b.box[xcol].second) continue;
+    if (ycol != std::string::npos && (y < b.box[ycol].first || y > b.box[ycol].second)) continue;
+    return true;
+  }
+  return false;
+}
+
+// The step these tests fix (the automatic one depends on |df/dx|), for bounds on precision.
+FlowpipeReachability::Options FixedStep() {
+  FlowpipeReachability::Options options;
+  options.step = 1.0 / 32;
+  options.max_pieces = 1;
+  return options;
+}
+
+// x' = -x from x0 in [1, 2]: x(t) = x0 exp(-t). The boxes cover the solutions from both ends at
+// every 1/100 of a time unit; every box is at most 2 h |x'| (h = 1/32, |x'| <= 2) wider than the
+// range of the solutions over its step (the time terms of a step are bounded apart from the start
+// set's).
 TEST(FlowpipeReachability, DecayBoxesHoldTheClosedForm) {
   const System s = Load(R"(automaton decay {
     var x;
@@ -44,25 +66,19 @@ TEST(FlowpipeReachability, DecayBoxesHoldTheClosedForm) {
     property below_start: always x <= 2;
   })");
   FlowpipeReachability::ReachSet set;
-  const std::vector<CheckResult> r = CheckAll(s, &set);
+  const std::vector<CheckResult> r = CheckAll(s, &set, FixedStep());
   ASSERT_EQ(r.size(), 2u);
   EXPECT_EQ(r[0].verdict, Verdict::kProved) << r[0].reason;
   EXPECT_EQ(r[1].verdict, Verdict::kProved) << r[1].reason;
   const std::size_t x = Column(set, "x");
+  for (int k = 0; k <= 500; ++k) {
+    const double t = k / 100.0;
+    for (double x0 : {1.0, 2.0}) EXPECT_TRUE(Covered(set, t, x, x0 * std::exp(-t))) << "t = " << t;
+  }
   int checked = 0;
   for (const auto& b : set.boxes) {
     if (!std::isfinite(b.t_hi) || b.t_lo > 5) continue;
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k <= 8; ++k) {
-      const double t = b.t_lo + (b.t_hi - b.t_lo) * k / 8.0;
-      for (double x0 : {1.0, 2.0}) {
-        const double exact = x0 * std::exp(-t);
-        EXPECT_LE(b.box[x].first, exact) << "t = " << t;
-        EXPECT_GE(b.box[x].second, exact) << "t = " << t;
-        lo = std::min(lo, exact);
-        hi = std::max(hi, exact);
-      }
-    }
+    const double lo = std::exp(-b.t_hi), hi = 2 * std::exp(-b.t_lo);
     EXPECT_LE(b.box[x].second - b.box[x].first, hi - lo + 2 * 2.0 / 32)
         << "t in [" << b.t_lo << ", " << b.t_hi << "]";
     ++checked;
@@ -71,9 +87,9 @@ TEST(FlowpipeReachability, DecayBoxesHoldTheClosedForm) {
 }
 
 // The harmonic oscillator x' = y, y' = -x rotates its start box: from [0.9, 1.1] x [-0.1, 0.1]
-// the exact solution x0 cos t + y0 sin t, y0 cos t - x0 sin t of the four corners lies in every
-// box for ten time units (a full turn and a half), and the boxes do not grow more than the
-// rotated box's hull (radius sqrt(0.1^2 + 0.1^2) around a point of the unit circle).
+// the exact solutions x0 cos t + y0 sin t, y0 cos t - x0 sin t of the four corners are covered
+// every 1/50 for ten time units (a full turn and a half), and no box grows much beyond the
+// rotated box's hull (width 0.2 sqrt 2 = 0.28).
 TEST(FlowpipeReachability, OscillatorBoxesHoldTheRotation) {
   const System s = Load(R"(automaton spin {
     var x; var y;
@@ -82,22 +98,20 @@ TEST(FlowpipeReachability, OscillatorBoxesHoldTheRotation) {
     property inside: always x^2 + y^2 <= 1.5 within 10;
   })");
   FlowpipeReachability::ReachSet set;
-  const std::vector<CheckResult> r = CheckAll(s, &set);
+  const std::vector<CheckResult> r = CheckAll(s, &set, FixedStep());
   EXPECT_EQ(r[0].verdict, Verdict::kProved) << r[0].reason;
   const std::size_t x = Column(set, "x"), y = Column(set, "y");
-  for (const auto& b : set.boxes) {
-    if (b.t_lo > 10) continue;
-    for (int k = 0; k <= 4; ++k) {
-      const double t = b.t_lo + (b.t_hi - b.t_lo) * k / 4.0;
-      for (double x0 : {0.9, 1.1}) {
-        for (double y0 : {-0.1, 0.1}) {
-          const double ex = x0 * std::cos(t) + y0 * std::sin(t);
-          const double ey = y0 * std::cos(t) - x0 * std::sin(t);
-          EXPECT_TRUE(b.box[x].first <= ex && ex <= b.box[x].second) << "x at t = " << t;
-          EXPECT_TRUE(b.box[y].first <= ey && ey <= b.box[y].second) << "y at t = " << t;
-        }
+  for (int k = 0; k <= 500; ++k) {
+    const double t = k / 50.0;
+    for (double x0 : {0.9, 1.1}) {
+      for (double y0 : {-0.1, 0.1}) {
+        const double ex = x0 * std::cos(t) + y0 * std::sin(t);
+        const double ey = y0 * std::cos(t) - x0 * std::sin(t);
+        EXPECT_TRUE(Covered(set, t, x, ex, y, ey)) << "t = " << t;
       }
     }
+  }
+  for (const auto& b : set.boxes) {
     EXPECT_LT(b.box[x].second - b.box[x].first, 0.45) << "t = " << b.t_lo;
   }
 }
@@ -119,7 +133,7 @@ TEST(FlowpipeReachability, BallNeverRisesAboveItsDropHeight) {
     property speed: always v <= 14.1 and v >= -14.1;
     property too_slow: always v <= 11;
   })");
-  const std::vector<CheckResult> r = CheckAll(s);
+  const std::vector<CheckResult> r = CheckAll(s, nullptr, FixedStep());
   EXPECT_EQ(r[0].verdict, Verdict::kProved) << r[0].reason;
   EXPECT_FALSE(r[0].within.has_value()) << r[0].reason;  // for all time
   EXPECT_EQ(r[1].verdict, Verdict::kProved) << r[1].reason;
@@ -154,7 +168,7 @@ TEST(FlowpipeReachability, InputsAreCoveredForAllTime) {
     property tight: always x <= 0.9;
     property early: always x <= 0.1 within 0.1;
   })");
-  const std::vector<CheckResult> r = CheckAll(s);
+  const std::vector<CheckResult> r = CheckAll(s, nullptr, FixedStep());
   EXPECT_EQ(r[0].verdict, Verdict::kProved) << r[0].reason;
   EXPECT_FALSE(r[0].within.has_value()) << r[0].reason;
   EXPECT_EQ(r[1].verdict, Verdict::kUnknown) << r[1].reason;
