@@ -165,18 +165,21 @@ void AddCheck(CLI::App& app, Commands& c) {
   CLI::App* check = c.check = app.add_subcommand(
       "check",
       "Prove a model's properties for every input (--method reach: exact polyhedral "
-      "reachability for linear hybrid automata; --method prove: SMT bounded model checking and "
-      "k-induction; --method auto, the default, picks by the model's class) or search for "
-      "counterexamples (--method sample); every trace found is replayed by the simulator");
+      "reachability for linear hybrid automata; --method flowpipe: Taylor flowpipes for affine "
+      "and polynomial dynamics; --method prove: SMT bounded model checking and k-induction; "
+      "--method auto, the default, tries them in that order and then samples for a "
+      "counterexample) or search for counterexamples (--method sample); every trace found is "
+      "replayed by the simulator");
   check->add_option("MODEL", a.model, kModelHelp)->required();
   check->add_option("--property", a.properties,
                     "Check only this property (repeatable; default: every declared property, "
                     "components' ones named INSTANCE.NAME)");
   check
       ->add_option("--method", a.method,
-                   "auto (reach for linear hybrid automata, then prove on what is left; prove "
-                   "otherwise), reach (exact polyhedral reachability), prove (SMT k-induction) "
-                   "or sample")
+                   "auto (reach for linear hybrid automata, then flowpipe, prove, and sample for "
+                   "counterexamples on what is left), reach (exact polyhedral reachability), "
+                   "flowpipe (Taylor flowpipes, affine and polynomial flows), prove (SMT "
+                   "k-induction) or sample")
       ->capture_default_str();
   check->add_flag("--json", a.json, "Machine-readable output");
   check->add_flag("--modes", a.modes, "Also report which modes (discrete states) some run reaches");
@@ -186,9 +189,17 @@ void AddCheck(CLI::App& app, Commands& c) {
                   "and jumps)");
   AddNumberOption(check, "--induction", &a.induction, "prove: largest k of k-induction");
   AddNumberOption(check, "--budget", &a.budget,
-                  "prove: one solver budget for the whole command (properties, then --modes), "
-                  "in budget seconds of Z3 resource units (docs/verification.md)");
+                  "prove, reach and flowpipe: each one's budget for the whole command (prove: "
+                  "properties, then --modes), in budget seconds (docs/verification.md)");
   AddNumberOption(check, "--runs", &a.runs, "sample: random runs per property");
+  AddNumberOption(check, "--order", &a.order, "flowpipe: Taylor order, 1 to 12");
+  AddNumberOption(check, "--step", &a.step,
+                  "flowpipe: time step (0, the default: automatic, 0.2 / |df/dx| rounded down to "
+                  "a power of two)");
+  check->add_option("--plot-reach", a.plot_reach,
+                    "Write an SVG of the flowpipe projected on --axes, with the property bounds "
+                    "and the traces found (docs/verification.md)");
+  check->add_option("--axes", a.axes, "The two variables of --plot-reach, as X,Y");
   AddNumberOption(check, "--seed", &a.seed, "sample: random seed");
 }
 

@@ -12,6 +12,7 @@
 #include "commands/command_error.h"
 #include "commands/output.h"
 #include "commands/progress.h"
+#include "commands/reach_plot.h"
 #include "hybrid/automaton/parser.h"
 #include "hybrid/checking/property_checker.h"
 #include "hybrid/flowpipe/flowpipe_checker.h"
@@ -172,6 +173,15 @@ struct MethodContext {
 
 CheckerRegistry Methods(MethodContext& context);
 
+// The two variables of --axes ("x,y"), or empty names when it is not two non-empty names.
+std::pair<std::string, std::string> AxesOf(const CheckArgs& args) {
+  const std::size_t comma = args.axes.find(',');
+  if (comma == std::string::npos || args.axes.find(',', comma + 1) != std::string::npos) return {};
+  std::string x = args.axes.substr(0, comma), y = args.axes.substr(comma + 1);
+  if (x.empty() || y.empty()) return {};
+  return {x, y};
+}
+
 // Throws OptionError for an argument value out of its range (in the order of the checks: method,
 // depth, induction, runs, budget), in the command's name on the command line.
 void CheckOptions(const CheckArgs& args) {
@@ -194,6 +204,18 @@ void CheckOptions(const CheckArgs& args) {
     throw OptionError("induction", Arg("induction") + " must be in [1, 100]", kCommand);
   }
   if (args.runs < 1) throw OptionError("runs", Arg("runs") + " must be positive", kCommand);
+  if (args.order < 1 || args.order > 12) {
+    throw OptionError("order", Arg("order") + " must be in [1, 12]", kCommand);
+  }
+  if (!(args.step >= 0) || !std::isfinite(args.step)) {
+    throw OptionError("step", Arg("step") + " must be a non-negative number (0: automatic)",
+                      kCommand);
+  }
+  if (!args.plot_reach.empty() && AxesOf(args).first.empty()) {
+    throw OptionError(
+        "axes", Arg("axes") + " must name two variables as X,Y (with " + Arg("plot_reach") + ")",
+        kCommand);
+  }
   if (!(args.budget > 0) || !(args.budget <= 1e6)) {
     throw OptionError("budget", Arg("budget") + " must be a number of budget seconds in (0, 1e6]",
                       kCommand);
@@ -231,6 +253,7 @@ struct Findings {
   std::vector<std::vector<PropertyProver::ModeReachability>> modes;
   double seconds = 0.0;
   std::optional<PolyhedralReachability::Usage> reach;
+  FlowpipeReachability::ReachSet reach_set;  ///< with --plot-reach
 };
 
 // The bounds of polyhedral reachability: --budget budget seconds of its deterministic reach
@@ -433,6 +456,36 @@ std::string ReportText(const CheckArgs& args, const System& system, const Simula
 
 namespace {
 
+// --plot-reach: the flowpipe on --axes, the property bounds and the traces found.
+void WriteReachPlot(const CheckArgs& args, const Simulator& sim, const Findings& found) {
+  const auto [x, y] = AxesOf(args);
+  const std::vector<std::string>& names = sim.variable_names();
+  const auto column = [&](const std::string& v) {
+    return static_cast<long>(std::find(names.begin(), names.end(), v) - names.begin());
+  };
+  std::vector<ReachPlotTrace> traces;
+  for (const CheckResult& r : found.results) {
+    if (!r.trace || column(x) >= static_cast<long>(names.size()) ||
+        column(y) >= static_cast<long>(names.size())) {
+      continue;
+    }
+    ReachPlotTrace t{r.property + " (" + std::string(VerdictName(r.verdict)) + ")", {}, {}};
+    for (int i = 0; i <= r.trace->state_index && i < static_cast<int>(r.trace->run.samples.size());
+         ++i) {
+      t.xs.push_back(r.trace->run.samples[static_cast<std::size_t>(i)].x[column(x)]);
+      t.ys.push_back(r.trace->run.samples[static_cast<std::size_t>(i)].x[column(y)]);
+    }
+    traces.push_back(std::move(t));
+  }
+  std::string svg;
+  try {
+    svg = ReachPlotSvg(found.reach_set, x, y, found.chosen, traces, args.model + ": flowpipe");
+  } catch (const std::invalid_argument& e) {
+    throw OptionError("axes", Arg("axes") + ": " + e.what(), OptionError::Scope::kCommand);
+  }
+  WriteOutput(args.plot_reach, svg);
+}
+
 // Checks the chosen properties of `system` (and with --modes its discrete states).
 Findings FindingsOf(const CheckArgs& args, const System& system) {
   CheckOptions(args);
@@ -454,7 +507,18 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   prove.max_depth = args.depth;
   prove.max_induction = args.induction;
   MethodContext context{args, prove, &budget, &progress, &found.reach};
+  if (!args.plot_reach.empty()) context.reach_set = &found.reach_set;
   found.results = Methods(context).Make(args.method)->Check(system, found.chosen);
+  if (!args.plot_reach.empty() && found.reach_set.boxes.empty()) {
+    // The method decided without a flowpipe: compute one for the picture.
+    std::string why;
+    if (!FlowpipeReachability::Handles(system, found.chosen, &why)) {
+      throw OptionError("plot_reach",
+                        Arg("plot_reach") + ": no flowpipe for this model (" + why + ")",
+                        OptionError::Scope::kCommand);
+    }
+    MakeFlowpipe(context)->Check(system, found.chosen);
+  }
   if (const std::optional<std::string> none = system.NoAdmissibleStart()) {
     // A verdict about a model without runs holds vacuously: say so in every reason.
     for (CheckResult& r : found.results) {
@@ -487,6 +551,7 @@ ExitCode RunCheck(const CheckArgs& args) {
   const Findings found = FindingsOf(args, system);
   const Simulator sim(system);
   const ExitCode code = ExitCodeOf(found.results);
+  if (!args.plot_reach.empty()) WriteReachPlot(args, sim, found);
   if (args.json) {
     // The model path may be any bytes: replace invalid UTF-8 rather than throw.
     const json out = ReportJson(args, system, sim, found);

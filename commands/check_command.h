@@ -26,6 +26,10 @@ struct CheckArgs {
   std::uint64_t seed = 1;  ///< sample: seed
   int order = 6;           ///< flowpipe: Taylor order (1 to 12)
   double step = 0.0;       ///< flowpipe: step (0: automatic)
+  /// An SVG of the flowpipe projected on `axes` ("X,Y", two variables) is written here (none
+  /// when empty); the flowpipe is computed for it if the method did not run it.
+  std::string plot_reach;
+  std::string axes;
   /// Progress on standard error (the command line: kAuto, --quiet, --progress).
   ProgressMode progress = ProgressMode::kOff;
 };
@@ -35,7 +39,8 @@ struct CheckArgs {
 /// none is violated but some verdict is unknown. Throws hybrid::ParseError for a bad model,
 /// OptionError (commands/command_error.h) for bad arguments (an unknown property name, an
 /// unknown method, a depth outside [0, 1000], an induction bound outside [1, 100], runs < 1, a
-/// budget outside (0, 1e6]), and OutputError when standard output cannot be written.
+/// budget outside (0, 1e6], an order outside [1, 12], a negative step, a plot without two axes
+/// that are variables), and OutputError when standard output or the plot cannot be written.
 ExitCode RunCheck(const CheckArgs& args);
 
 /// The report `hybrid check --json` writes (docs/cli.md) for `system` checked with `args`
