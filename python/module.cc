@@ -39,6 +39,7 @@
 #include <new>
 #include <optional>
 #include <span>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -60,6 +61,7 @@
 #include "hybrid/automaton/dot_writer.h"
 #include "hybrid/automaton/log.h"
 #include "hybrid/automaton/parser.h"
+#include "hybrid/flowpipe/flowpipe_reachability.h"
 #include "hybrid/gripper/finger_closed_form.h"
 #include "hybrid/gripper/finger_parameters.h"
 #include "hybrid/gripper/measured_data.h"
@@ -498,6 +500,92 @@ class Model {
     return RunStoppable([&] { return cli::CheckReport(args, system_, nullptr).dump(); });
   }
 
+  // The flowpipe's boxes (hybrid.Model.reach_set): variables, modes, times and bounds as arrays.
+  py::dict ReachSet(const std::vector<std::string>& names, double budget, int order,
+                    double step) const {
+    std::vector<Property> chosen;
+    for (const Property& p : system_.properties()) {
+      if (names.empty() || std::find(names.begin(), names.end(), p.name) != names.end()) {
+        chosen.push_back(p);
+      }
+    }
+    if (!(budget > 0) || !(budget <= 1e6))
+      throw std::invalid_argument("budget must be in (0, 1e6]");
+    FlowpipeReachability::Options options;
+    options.max_steps =
+        static_cast<std::int64_t>(std::ceil(budget * kFlowpipeStepsPerBudgetSecond));
+    options.order = order;
+    options.step = step;
+    std::string why;
+    if (!FlowpipeReachability::Handles(system_, chosen, &why)) {
+      throw std::invalid_argument("no flowpipe for this model: " + why);
+    }
+    // The job may run in a child process (RunStoppable): the set comes back as text, one box per
+    // line (mode, then the numbers in hexadecimal floating point, exact).
+    const std::string text = RunStoppable([&] {
+      FlowpipeReachability::ReachSet set;
+      FlowpipeReachability(options).Check(system_, chosen, nullptr, &set);
+      std::ostringstream out;
+      out << std::hexfloat;
+      for (const std::string& v : set.variables) out << v << '\t';
+      out << '\n';
+      for (const auto& b : set.boxes) {
+        out << b.mode << '\t' << b.t_lo << ' ' << b.t_hi;
+        for (const auto& [l, h] : b.box) out << ' ' << l << ' ' << h;
+        out << '\n';
+      }
+      return out.str();
+    });
+    FlowpipeReachability::ReachSet set;
+    std::istringstream in(text);
+    std::string line;
+    std::getline(in, line);
+    for (std::size_t begin = 0, end; (end = line.find('\t', begin)) != std::string::npos;
+         begin = end + 1) {
+      set.variables.push_back(line.substr(begin, end - begin));
+    }
+    while (std::getline(in, line)) {
+      const std::size_t tab = line.find('\t');
+      FlowpipeReachability::ReachBox b;
+      b.mode = line.substr(0, tab);
+      const char* p = line.c_str() + tab + 1;
+      char* next = nullptr;
+      b.t_lo = std::strtod(p, &next);
+      b.t_hi = std::strtod(next, &next);
+      for (std::size_t j = 0; j < set.variables.size(); ++j) {
+        const double l = std::strtod(next, &next);
+        const double h = std::strtod(next, &next);
+        b.box.emplace_back(l, h);
+      }
+      set.boxes.push_back(std::move(b));
+    }
+    const auto n = static_cast<py::ssize_t>(set.boxes.size());
+    const auto v = static_cast<py::ssize_t>(set.variables.size());
+    py::array_t<double> time({n, static_cast<py::ssize_t>(2)});
+    py::array_t<double> lo({n, v}), hi({n, v});
+    auto tt = time.mutable_unchecked<2>();
+    auto l = lo.mutable_unchecked<2>();
+    auto h = hi.mutable_unchecked<2>();
+    py::list modes;
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const auto& b = set.boxes[static_cast<std::size_t>(i)];
+      tt(i, 0) = b.t_lo;
+      tt(i, 1) = b.t_hi;
+      for (py::ssize_t j = 0; j < v; ++j) {
+        l(i, j) = b.box[static_cast<std::size_t>(j)].first;
+        h(i, j) = b.box[static_cast<std::size_t>(j)].second;
+      }
+      modes.append(b.mode);
+    }
+    py::dict out;
+    out["variables"] = set.variables;
+    out["mode"] = modes;
+    out["time"] = time;
+    out["lo"] = lo;
+    out["hi"] = hi;
+    return out;
+  }
+
   py::dict Simulate(std::optional<double> until, const std::map<std::string, SignalValue>& inputs,
                     std::optional<double> sample,
                     const std::map<std::string, double>& parameters) const;
@@ -701,6 +789,8 @@ PYBIND11_MODULE(_hybrid, m) {
       .def("dot", &Model::Dot, py::arg("product") = false)
       .def("check_json", &Model::CheckJsonText, py::arg("properties"), py::arg("method"),
            py::arg("budget"), py::arg("depth"))
+      .def("reach_set", &Model::ReachSet, py::arg("properties"), py::arg("budget"),
+           py::arg("order"), py::arg("step"))
       .def("simulate", &Model::Simulate, py::arg("until") = py::none(),
            py::arg("inputs") = std::map<std::string, SignalValue>{}, py::arg("sample") = py::none(),
            py::arg("parameters") = std::map<std::string, double>{});

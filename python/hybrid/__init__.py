@@ -127,8 +127,8 @@ class Model:
 
         Args:
             properties: names of properties to check; None: every declared one.
-            method: "auto", "reach" (polyhedral reachability), "prove" (SMT k-induction) or
-                "sample" (random simulations).
+            method: "auto", "reach" (polyhedral reachability), "flowpipe" (Taylor flowpipes),
+                "prove" (SMT k-induction) or "sample" (random simulations).
             budget: the solver budget of "prove", in budget seconds.
             depth: the longest counterexample "prove" searches, in steps.
 
@@ -139,6 +139,41 @@ class Model:
         """
         report = self._model.check_json(list(properties or []), method, float(budget), int(depth))
         return _json.loads(report)
+
+    def reach_set(self, properties=None, budget=60.0, order=6, step=0.0):
+        """The flowpipe of ``hybrid check --method flowpipe`` (docs/verification.md): one box per
+        Taylor step of every mode entry, over-approximating every state reachable then.
+
+        Args:
+            properties: names of the properties that set the horizon (their ``within`` and the
+                scenario's ``until``); None: every declared one.
+            budget: the flowpipe's budget in budget seconds of Taylor steps.
+            order: the Taylor order (1 to 12); step: the time step (0: automatic).
+
+        Returns:
+            A dict: ``variables`` (names), ``mode`` (the mode of each box), ``time`` (n x 2:
+            each box's time span; inf for a positively invariant box), ``lo`` and ``hi``
+            (n x len(variables): the box's bounds). Raises ValueError for a model whose flows
+            are not polynomial.
+        """
+        return self._model.reach_set(list(properties or []), float(budget), int(order),
+                                     float(step))
+
+    def reach_vertices(self, x, y, **kwargs):
+        """The flowpipe projected on variables ``x`` and ``y`` as an (n, 4, 2) numpy array: the
+        corners of each box counter-clockwise, ready for matplotlib's PolyCollection. Takes the
+        arguments of reach_set."""
+        import numpy
+        reach = self.reach_set(**kwargs)
+        names = reach["variables"]
+        if x not in names or y not in names:
+            raise ValueError("axes must be variables of the model: %s" % ", ".join(names))
+        i, j = names.index(x), names.index(y)
+        lo, hi = reach["lo"], reach["hi"]
+        return numpy.stack([numpy.stack([lo[:, i], lo[:, j]], axis=1),
+                            numpy.stack([hi[:, i], lo[:, j]], axis=1),
+                            numpy.stack([hi[:, i], hi[:, j]], axis=1),
+                            numpy.stack([lo[:, i], hi[:, j]], axis=1)], axis=1)
 
     def __repr__(self):
         return "hybrid.Model(%r)" % self.path

@@ -39,6 +39,14 @@ class Model:
         budget: float = ...,
         depth: int = ...,
     ) -> dict[str, Any]: ...
+    def reach_set(
+        self,
+        properties: Sequence[str] | None = ...,
+        budget: float = ...,
+        order: int = ...,
+        step: float = ...,
+    ) -> dict[str, Any]: ...
+    def reach_vertices(self, x: str, y: str, **kwargs: Any) -> npt.NDArray[np.float64]: ...
 
 def load(path: Union[str, PathLike[str]]) -> Model: ...
 def hand(

@@ -360,3 +360,26 @@ def test_long_calls_raise_the_same_errors_and_work_off_the_main_thread(tmp_path)
     assert np.array_equal(results["run"]["time"], here["time"])
     assert np.array_equal(results["run"]["states"]["h"], here["states"]["h"])
     assert results["run"]["modes"] == here["modes"] and results["run"]["events"] == here["events"]
+
+
+def test_reach_set_encloses_the_falling_ball():
+    """The flowpipe of the bouncing ball as arrays: every box of the first fall holds the closed
+    form h(t) = 10 - g t^2 / 2 at its ends, and no box rises above the drop height."""
+    model = hybrid.load(os.path.join(SOURCE, "spec", "bouncing_ball.ha"))
+    reach = model.reach_set(properties=["never_rises_above_drop"])
+    h = reach["variables"].index("h")
+    assert reach["lo"].shape == reach["hi"].shape and reach["lo"].shape[1] == 2
+    assert (reach["hi"][:, h] <= 10.0).all()
+    first_impact = (2 * 10 / 9.81) ** 0.5
+    checked = 0
+    for (t0, t1), lo, hi in zip(reach["time"], reach["lo"], reach["hi"]):
+        if t1 > first_impact:
+            break
+        for t in (t0, t1):
+            assert lo[h] <= 10 - 9.81 * t * t / 2 <= hi[h]
+        checked += 1
+    assert checked > 5
+    corners = model.reach_vertices("h", "v", properties=["never_rises_above_drop"])
+    assert corners.shape == (len(reach["mode"]), 4, 2)
+    with pytest.raises(ValueError):
+        model.reach_vertices("h", "nope")
