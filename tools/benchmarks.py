@@ -23,10 +23,19 @@ Exit status: 0; 1 if some status is MISMATCH (with --require-all: also if some i
 2 on a usage error (an unknown benchmark, no `hybrid` binary).
 
 --peer-command TEMPLATE runs a peer tool once per model for comparison, e.g.
-  --peer-command 'peer_checker --model {model}'   ({model}: the model's path, shell-quoted)
+  --peer-command 'peer_checker --model {model}'   ({model}: the model's path, shell-quoted;
+  {name}: the model's file name without .ha)
 through the shell, with the same --timeout, and prints its wall time and the ratio of our wall
 time (the whole `hybrid check` process) to the peer's. The peer's verdicts are not read.
+
+--per-property runs `hybrid check --property P` once per expected property, and the peer command
+(which may then name {property}) once per property too, for tools that check one property per
+run (Flow*: one unsafe set per model file). The peer's verdict is the last word SAFE, UNSAFE or
+UNKNOWN in its output (Flow*'s), shown beside ours with both wall times and their ratio, e.g.
+  tools/benchmarks.py --expected spec/benchmarks/expected_flowpipe.tsv --per-property \
+      --peer-command '/path/to/run_one.sh {name}_{property}'
 """
+import re
 import argparse
 import json
 import os
@@ -128,9 +137,24 @@ def run(command, timeout, shell=False):
         time.monotonic() - start
 
 
-def check_model(hybrid, path, key, properties, args):
-    """The rows of one model (dicts) and our wall time."""
+def peer_verdict(text):
+    """The last SAFE, UNSAFE or UNKNOWN word of a peer's output, or "-"."""
+    found = re.findall(r"\b(SAFE|UNSAFE|UNKNOWN)\b", text)
+    return found[-1] if found else "-"
+
+
+def peer_template(template, path, prop=None):
+    name = os.path.splitext(os.path.basename(path))[0]
+    command = template.replace("{model}", shlex.quote(path)).replace("{name}", name)
+    return command.replace("{property}", prop) if prop is not None else command
+
+
+def check_model(hybrid, path, key, properties, args, only=None):
+    """The rows of one model (dicts) and our wall time (of property `only` alone if given)."""
     command = [hybrid, "check", path, "--json"]
+    if only is not None:
+        command += ["--property", only]
+        properties = [(n, v) for n, v in properties if n == only]
     if args.budget is not None:
         command += ["--budget", str(args.budget)]
     if args.method:
@@ -198,7 +222,7 @@ def main():
                         help="the hybrid binary (default: build/bin/hybrid of the repository)")
     parser.add_argument("--budget", type=float,
                         help="passed to `hybrid check --budget` (default: the tool's)")
-    parser.add_argument("--method", choices=["auto", "reach", "prove", "sample"],
+    parser.add_argument("--method", choices=["auto", "reach", "flowpipe", "prove", "sample"],
                         help="passed to `hybrid check --method` (default: the tool's, auto)")
     parser.add_argument("--timeout", type=float, default=600,
                         help="seconds per model before its process is killed (default 600)")
@@ -208,6 +232,9 @@ def main():
     parser.add_argument("--peer-command", metavar="TEMPLATE",
                         help="shell command of a peer tool, {model} replaced by the model's "
                              "path; its wall time and the ratio ours/peer are printed")
+    parser.add_argument("--per-property", action="store_true",
+                        help="one run per property, ours (--property) and the peer's "
+                             "({property} in its template)")
     parser.add_argument("--expected", default=EXPECTED,
                         help="the table of expected verdicts (default: spec/benchmarks/"
                              "expected.tsv)")
@@ -242,11 +269,38 @@ def main():
     start = time.monotonic()
     rows, per_model = [], []
     for path, key in models:
+        if args.per_property:
+            for prop, _ in expected.get(key, []):
+                model_rows, ours = check_model(args.hybrid, path, key, expected.get(key, []),
+                                               args, only=prop)
+                rows += model_rows
+                entry = {"file": key, "property": prop, "seconds": ours}
+                if args.peer_command:
+                    code, out, err, peer = run(peer_template(args.peer_command, path, prop),
+                                               args.timeout, shell=True)
+                    entry.update({"peer_seconds": peer, "peer_exit_code": code,
+                                  "peer_verdict": peer_verdict(out + err),
+                                  "ratio": ours / peer if peer > 0 else None})
+                    for r in model_rows:
+                        r["peer_verdict"] = entry["peer_verdict"]
+                per_model.append(entry)
+                if not args.json:
+                    for row in model_rows:
+                        widths[1] = max(widths[1], len(row["property"]))
+                        print(format_row(row, widths))
+                    if args.peer_command:
+                        ratio = "-" if entry["ratio"] is None else "%.3g" % entry["ratio"]
+                        print("    peer: %s in %.3f s%s; ours %.3f s; ours/peer %s"
+                              % (entry["peer_verdict"], entry["peer_seconds"],
+                                 "" if entry["peer_exit_code"] is not None else " (timeout)",
+                                 ours, ratio))
+                    sys.stdout.flush()
+            continue
         model_rows, ours = check_model(args.hybrid, path, key, expected.get(key, []), args)
         rows += model_rows
         entry = {"file": key, "seconds": ours}
         if args.peer_command:
-            command = args.peer_command.replace("{model}", shlex.quote(path))
+            command = peer_template(args.peer_command, path)
             code, _, err, peer = run(command, args.timeout, shell=True)
             entry.update({"peer_seconds": peer, "peer_exit_code": code,
                           "ratio": ours / peer if peer > 0 else None})
@@ -278,8 +332,9 @@ def main():
             for r in undecided:
                 print("  %s %s: %s (expected %s): %s"
                       % (r["file"], r["property"], r["got"], r["expected"], r["reason"]))
-        print("\nWall time per model (s): " + ", ".join(
-            "%s %.2f" % (m["file"], m["seconds"]) for m in per_model))
+        print("\nWall time per %s (s): " % ("property" if args.per_property else "model")
+              + ", ".join("%s%s %.2f" % (m["file"], ":" + m["property"] if "property" in m
+                                         else "", m["seconds"]) for m in per_model))
         print("\n%d properties in %d models: %d OK, %d MISMATCH, %d UNKNOWN; total %.1f s"
               % (len(rows), len(models), counts["OK"], counts["MISMATCH"], counts["UNKNOWN"],
                  total))
@@ -288,6 +343,11 @@ def main():
             peer = sum(m["peer_seconds"] for m in per_model)
             print("wall time: ours %.1f s, peer %.1f s, ours/peer %s"
                   % (ours, peer, "%.3g" % (ours / peer) if peer > 0 else "-"))
+            ratios = [m["ratio"] for m in per_model if m.get("ratio")]
+            if ratios:
+                print("ratio ours/peer per run: max %.3g, median %.3g; %d of %d runs faster than "
+                      "the peer" % (max(ratios), sorted(ratios)[len(ratios) // 2],
+                                    sum(r < 1 for r in ratios), len(ratios)))
     return 1 if failed else 0
 
 
