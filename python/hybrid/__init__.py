@@ -13,7 +13,7 @@ The C++ library behind the ``hybrid`` command line, in-process:
 
 Errors in a model raise :class:`ModelError` (a ``ValueError``) whose message names the file, line
 and column, as the command line does; bad arguments raise ``ValueError`` (its message names the
-keyword argument, e.g. ``method must be 'auto', 'reach', 'prove' or 'sample', not 'x'``, and its
+keyword argument, e.g. ``method must be 'auto', 'reach', 'flowpipe', 'prove' or 'sample', not 'x'``, and its
 attribute ``argument`` is that name) or ``KeyError``; a bug of the library raises
 ``RuntimeError`` ("internal error ...").
 

@@ -194,7 +194,7 @@ def test_errors_name_the_keyword_argument_not_a_flag(tmp_path):
     path.write_text(TANK)
     model = hybrid.load(path)
     expect_argument_error(lambda: model.check(method="x"), "method",
-                          "method must be 'auto', 'reach', 'prove' or 'sample', not 'x'")
+                          "method must be 'auto', 'reach', 'flowpipe', 'prove' or 'sample', not 'x'")
     expect_argument_error(lambda: model.check(depth=5000), "depth",
                           "depth must be in [0, 1000]")
     expect_argument_error(lambda: model.check(budget=0.0), "budget",
@@ -215,7 +215,8 @@ def test_errors_name_the_keyword_argument_not_a_flag(tmp_path):
     # The command line names the flags for the same mistakes.
     out = run("check", str(path), "--method", "x")
     assert out.returncode == 2
-    assert out.stderr == ("hybrid check: --method must be 'auto', 'reach', 'prove' or 'sample', "
+    assert out.stderr == ("hybrid check: --method must be 'auto', 'reach', 'flowpipe', 'prove' or "
+                          "'sample', "
                           "not 'x'\n")
 
 
