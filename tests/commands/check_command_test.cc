@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -24,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "commands/command_error.h"
 #include "commands/simulate_command.h"
 #include "tests/test_utilities/command_line.h"
 #include "tests/test_utilities/in_process.h"
@@ -772,6 +775,88 @@ TEST(CheckCommand, InvalidModelsExitOneWithFileLineColumn) {
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_EQ(r.out, "");
   EXPECT_TRUE(r.err.starts_with(missing + ":0:0:")) << r.err;
+}
+
+}  // namespace
+}  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+const std::string kThermostat = (kSourceDir / "spec" / "thermostat.ha").string();
+
+// The thermostat under `auto`: the flowpipe proves the true invariant for all time, the falsifier
+// finds the false one and the reachable mode, each with a trace the simulator replayed.
+TEST(CheckCommand, ThermostatIsDecidedByFlowpipeAndFalsifier) {
+  const json report = JsonHere(ArgsOf<cli::CheckArgs>(kThermostat), 6);
+  const json& props = report.at("properties");
+  ASSERT_EQ(props.size(), 3u);
+  EXPECT_EQ(props[0].at("name"), "comfortable");
+  EXPECT_EQ(props[0].at("verdict"), "violated");
+  EXPECT_TRUE(props[0].contains("trace"));
+  EXPECT_EQ(props[1].at("verdict"), "reachable");
+  EXPECT_TRUE(props[1].contains("trace"));
+  EXPECT_EQ(props[2].at("name"), "never_cold");
+  EXPECT_EQ(props[2].at("verdict"), "proved");
+  EXPECT_EQ(props[2].at("method"), "flowpipe");
+  EXPECT_FALSE(props[2].contains("verdict_within"));  // a fixpoint: for all time
+}
+
+// Without a fixpoint the flowpipe's proof is bounded, and says so in both outputs.
+TEST(CheckCommand, BoundedFlowpipeProofsSayWithin) {
+  TempDir dir;
+  const std::string model = (dir.path() / "spin.ha").string();
+  std::ofstream(model) << R"(automaton spin {
+    var x; var y;
+    mode m { x' = y; y' = -x; }
+    init m { x in [0.9, 1.1]; y = 0; }
+    scenario { until 3; }
+    property bounded: always x <= 1.5;
+  })";
+  const json report =
+      JsonHere(ArgsOf<cli::CheckArgs>(model, [](cli::CheckArgs& a) { a.method = "flowpipe"; }), 0);
+  EXPECT_EQ(report.at("properties")[0].at("verdict"), "proved");
+  EXPECT_EQ(report.at("properties")[0].at("verdict_within"), 3.0);
+  const InProcess text =
+      Here(ArgsOf<cli::CheckArgs>(model, [](cli::CheckArgs& a) { a.method = "flowpipe"; }));
+  EXPECT_NE(text.out.find("proved within 3  bounded"), std::string::npos) << text.out;
+}
+
+// --plot-reach draws the boxes, the property's bound and the counterexample; bad axes and
+// orders are errors that name the option.
+TEST(CheckCommand, PlotReachDrawsTheFlowpipe) {
+  TempDir dir;
+  const std::string svg = (dir.path() / "reach.svg").string();
+  const InProcess r = Here(ArgsOf<cli::CheckArgs>(kThermostat, [&](cli::CheckArgs& a) {
+    a.plot_reach = svg;
+    a.axes = "x,x";
+  }));
+  EXPECT_EQ(r.exit_code, 6);
+  const std::string text = ReadAll(svg);
+  EXPECT_NE(text.find("<svg"), std::string::npos);
+  EXPECT_NE(text.find("<rect"), std::string::npos);
+  EXPECT_NE(text.find("never_cold"), std::string::npos);              // the bound x >= 8
+  EXPECT_NE(text.find("comfortable (violated)"), std::string::npos);  // the counterexample
+  const auto error_of = [&](const std::function<void(cli::CheckArgs&)>& set) {
+    try {
+      Here(ArgsOf<cli::CheckArgs>(kThermostat, set));
+    } catch (const cli::OptionError& e) {
+      return std::string(e.argument()) + ": " + e.what();
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of([&](cli::CheckArgs& a) {
+              a.plot_reach = svg;
+              a.axes = "x";
+            }).find("axes: "),
+            std::string::npos);
+  EXPECT_NE(error_of([&](cli::CheckArgs& a) {
+              a.plot_reach = svg;
+              a.axes = "x,q";
+            }).find("no variable 'q'; the variables are: x"),
+            std::string::npos);
+  EXPECT_NE(error_of([](cli::CheckArgs& a) { a.order = 13; }).find("order: "), std::string::npos);
+  EXPECT_NE(error_of([](cli::CheckArgs& a) { a.step = -1; }).find("step: "), std::string::npos);
 }
 
 }  // namespace
