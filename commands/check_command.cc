@@ -285,8 +285,22 @@ std::unique_ptr<PropertyChecker> MakeFlowpipe(MethodContext& c) {
   FlowpipeReachability::Options options;
   options.max_steps =
       static_cast<std::int64_t>(std::ceil(c.args.budget * kFlowpipeStepsPerBudgetSecond));
+  options.max_entries = std::max(50, static_cast<int>(c.args.budget * kFlowpipeEntriesPerBudgetSecond));
   options.order = c.args.order;
   options.step = c.args.step;
+  // Before splitting initial sets for a property, a few simulations: a violation they find
+  // makes the refinement pointless (the falsifier of `auto` then reports it with its trace).
+  options.evidently_false = [seed = c.args.seed](const System& system,
+                                                 std::span<const Property> properties) {
+    PropertySampler::Options quick;
+    quick.runs = 8;
+    quick.seed = seed;
+    std::vector<bool> out;
+    for (const CheckResult& r : SampleChecker(quick).Check(system, properties)) {
+      out.push_back(r.verdict == Verdict::kViolated || r.verdict == Verdict::kReachable);
+    }
+    return out;
+  };
   if (c.progress && c.progress->enabled()) {
     ProgressLine& progress = *c.progress;
     options.progress = [&progress](std::int64_t steps, int queued) {

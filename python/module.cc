@@ -514,6 +514,7 @@ class Model {
     FlowpipeReachability::Options options;
     options.max_steps =
         static_cast<std::int64_t>(std::ceil(budget * kFlowpipeStepsPerBudgetSecond));
+    options.max_entries = std::max(50, static_cast<int>(budget * kFlowpipeEntriesPerBudgetSecond));
     options.order = order;
     options.step = step;
     std::string why;

@@ -174,6 +174,7 @@ std::vector<CheckResult> FlowpipeReachability::Check(const System& system,
   const double cap = TimeCap(system, properties);
   std::vector<std::optional<CheckResult>> decided(properties.size());
   std::vector<CheckResult> last(properties.size());
+  std::vector<char> not_worth(properties.size(), 0);  // evidently false: not refined
   std::vector<FlowpipeModel::Initial> pieces = model.Initials();
   Usage total;
   for (int level = 0;; ++level) {
@@ -194,8 +195,27 @@ std::vector<CheckResult> FlowpipeReachability::Check(const System& system,
       last[k] = Result(properties[k], k, ex, cap, pieces.size(), seconds);
       if (last[k].verdict != Verdict::kUnknown) {
         decided[k] = last[k];
-      } else if (!ex.findings()[k].met_wholly) {
+      } else if (!ex.findings()[k].met_wholly && !not_worth[k]) {
         open = true;
+      }
+    }
+    if (open && level == 0 && options_.evidently_false) {
+      std::vector<Property> asked;
+      std::vector<std::size_t> where;
+      for (std::size_t k = 0; k < properties.size(); ++k) {
+        if (!decided[k] && !ex.findings()[k].met_wholly) {
+          asked.push_back(properties[k]);
+          where.push_back(k);
+        }
+      }
+      const std::vector<bool> refuted = options_.evidently_false(system, asked);
+      open = false;
+      for (std::size_t i = 0; i < where.size(); ++i) {
+        if (i < refuted.size() && refuted[i]) {
+          not_worth[where[i]] = true;
+        } else {
+          open = true;
+        }
       }
     }
     // Split the initial sets where a property is still open, while the budget lasts.

@@ -13,9 +13,12 @@
 namespace hybrid {
 
 /// Taylor steps in one budget second (`hybrid check --budget`): about a second of exploration of
-/// a two-dimensional model on the machine it was calibrated on. A count, not a clock, so the
-/// same check stops at the same point everywhere.
-inline constexpr std::int64_t kFlowpipeStepsPerBudgetSecond = 20000;
+/// a five-dimensional model with guards (the spacecraft) on the development machine, a few
+/// tenths of one for a two-dimensional model. A count, not a clock, so the same check stops at
+/// the same point everywhere.
+inline constexpr std::int64_t kFlowpipeStepsPerBudgetSecond = 4000;
+/// Mode entries explored per budget second (at least 50 in all).
+inline constexpr int kFlowpipeEntriesPerBudgetSecond = 20;
 
 /// The `flowpipe` method of `hybrid check`: sound reachability for hybrid automata with affine
 /// and polynomial dynamics (x' = A x + B u + c, Van der Pol's x' = y, y' = (1 - x^2) y - x, and
@@ -81,6 +84,11 @@ class FlowpipeReachability {
     /// Noise symbols kept per set before the smallest are boxed (Girard's reduction); 0:
     /// 10 per state component.
     int max_symbols = 0;
+    /// Optional: called once, before the first split, with the properties still open; those
+    /// for which it returns true (e.g. a few simulations found a violation) are not refined
+    /// further. Saves the splitting of properties that are simply false; the verdicts do not
+    /// depend on it (such a property stays `unknown` here, for a falsifier to decide).
+    std::function<std::vector<bool>(const System&, std::span<const Property>)> evidently_false;
     /// Called now and then with the steps taken and the sets still queued (must not throw).
     std::function<void(std::int64_t steps, int queued)> progress;
   };
