@@ -68,6 +68,17 @@ echo "wrote out/check_finger.json, out/check_hand.json, out/check_finger_modes.j
   "out/check_controlled_hand.json"
 echo
 
+# Affine and nonlinear dynamics (docs/verification.md, "flowpipe"): the thermostat and the ball
+# decided by flowpipes and the falsifier (exit 6: a property is violated, as expected), and the
+# reach set of Van der Pol drawn.
+echo "=== flowpipes ==="
+"$hybrid" check spec/thermostat.ha || [ $? -eq 6 ]
+"$hybrid" check spec/bouncing_ball.ha
+"$hybrid" check spec/benchmarks/vanderpol.ha --property y_below_2_75 \
+  --plot-reach "$out/vanderpol_reach.svg" --axes x,y
+echo "wrote out/vanderpol_reach.svg"
+echo
+
 # Diagnosis from measured data (docs/diagnosis.md): the bundled demo data (SYNTHETIC: made by
 # `hybrid synthesize --effect backlash=6 --effect theta3_bias=2.5 --seed 7`, see its header) are
 # diagnosed; the extended model is written and `hybrid check` proves the finger's invariants on it.
