@@ -31,14 +31,15 @@ time (the whole `hybrid check` process) to the peer's. The peer's verdicts are n
 --per-property runs `hybrid check --property P` once per expected property, and the peer command
 (which may then name {property}) once per property too, for tools that check one property per
 run (Flow*: one unsafe set per model file). The peer's verdict is the last word SAFE, UNSAFE or
-UNKNOWN in its output (Flow*'s), shown beside ours with both wall times and their ratio, e.g.
+UNKNOWN in its output (Flow*'s), shown beside ours with both wall times and their ratio; a run
+whose output has none of them ("-": the peer cannot state that property) is not compared. E.g.
   tools/benchmarks.py --expected spec/benchmarks/expected_flowpipe.tsv --per-property \
       --peer-command '/path/to/run_one.sh {name}_{property}'
 """
-import re
 import argparse
 import json
 import os
+import re
 import shlex
 import signal
 import subprocess
@@ -278,9 +279,12 @@ def main():
                 if args.peer_command:
                     code, out, err, peer = run(peer_template(args.peer_command, path, prop),
                                                args.timeout, shell=True)
+                    verdict = peer_verdict(out + err)
+                    # A property the peer has no run for ("-") is not compared.
                     entry.update({"peer_seconds": peer, "peer_exit_code": code,
-                                  "peer_verdict": peer_verdict(out + err),
-                                  "ratio": ours / peer if peer > 0 else None})
+                                  "peer_verdict": verdict,
+                                  "ratio": ours / peer if peer > 0 and verdict != "-"
+                                  else None})
                     for r in model_rows:
                         r["peer_verdict"] = entry["peer_verdict"]
                 per_model.append(entry)
