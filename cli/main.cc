@@ -194,7 +194,8 @@ void AddCheck(CLI::App& app, Commands& c) {
   AddNumberOption(check, "--runs", &a.runs, "sample: random runs per property");
   AddNumberOption(check, "--order", &a.order, "flowpipe: Taylor order, 1 to 12");
   AddNumberOption(check, "--step", &a.step,
-                  "flowpipe: time step (0, the default: automatic, 0.2 / |df/dx| rounded down to "
+                  "flowpipe: time step (0, the default: automatic, 0.2 divided by the Jacobian's "
+                  "norm, rounded down to "
                   "a power of two)");
   check->add_option("--plot-reach", a.plot_reach,
                     "Write an SVG of the flowpipe projected on --axes, with the property bounds "
