@@ -35,6 +35,10 @@ run_sanitized() {
   # The engine agreement test's random systems (tests/solvers/verification/engine_agreement_test.cc):
   # fewer under the sanitizers, as rapidcheck's cases above (200 in the Release stage).
   export HYBRID_AGREEMENT_SYSTEMS="${HYBRID_AGREEMENT_SYSTEMS:-60}"
+  # The flowpipe engine's soundness test (tests/solvers/flowpipe/flowpipe_soundness_test.cc): its
+  # Taylor steps are many times slower unoptimised (30 models and 5 systems in the Release stage).
+  export HYBRID_FLOWPIPE_SOUNDNESS_MODELS="${HYBRID_FLOWPIPE_SOUNDNESS_MODELS:-6}"
+  export HYBRID_FLOWPIPE_SYSTEMS_MODELS="${HYBRID_FLOWPIPE_SYSTEMS_MODELS:-2}"
   (cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" --timeout 900)
 }
 

@@ -100,7 +100,11 @@ RandomRelation AnyRelation(Rng& rng) { return static_cast<RandomRelation>(Unifor
 struct Context {
   RandomHybridAutomaton* a = nullptr;
   std::vector<double> base;  // per variable: a typical value (its first initial value)
+  RandomAutomatonOptions options = {};
 };
+
+// Whether the flows are drawn for the flowpipe engine (RandomDynamics::kAffine).
+bool Affine(const Context& ctx) { return ctx.options.dynamics == RandomDynamics::kAffine; }
 
 RandomInput DrawInput(Rng& rng, const std::string& name) {
   const double a = Tenths(rng, 1, 20), b = a + Tenths(rng, 1, 20);
@@ -208,7 +212,163 @@ RandomComparison DrawInvariantAtom(Rng& rng, const Context& ctx) {
   return {Name(a.variables[v].name), rel, rhs};
 }
 
+// ---- flows affine in the state and polynomial ones (RandomDynamics::kAffine) ----
+
+// A multiple of 0.1 nearest to x.
+double RoundTenths(double x) { return std::round(x * 10) / 10; }
+
+// An index of a variable other than v (v must not be the only one).
+int OtherVariable(Rng& rng, const Context& ctx, int v) {
+  int w = UniformInt(rng, 0, static_cast<int>(ctx.a->variables.size()) - 2);
+  return w >= v ? w + 1 : w;
+}
+
+// A constant term that puts the equilibrium of `rate * x + c` near the typical value of x (a
+// stable rate), or a small drift otherwise; nothing when it comes out as 0.
+void AddDrift(Rng& rng, const Context& ctx, int v, double rate, RandomSum& sum) {
+  const double c =
+      rate < 0 ? RoundTenths(-rate * (ctx.base[v] + Tenths(rng, -40, 40))) : Tenths(rng, -20, 20);
+  if (c != 0.0) sum.terms.push_back({c, {}});
+}
+
+// Input terms `u`, `-0.6*u`, each input with probability `percent`.
+void AddInputs(Rng& rng, const Context& ctx, int percent, RandomSum& sum) {
+  for (const RandomInput& in : ctx.a->inputs) {
+    if (RandomChance(rng, percent)) {
+      sum.terms.push_back({RandomChance(rng, 50) ? 1.0 : NonZeroTenths(rng, 10), {in.name}});
+    }
+  }
+}
+
+// x' = A x + c + B u (+ a parameter term): a stable (most often) or unstable diagonal, cross terms
+// to the other variables, a drift, inputs; a parameter as a constant or as a coefficient of x
+// (`0.1*p*x`: uncertain parameters range over a few units, so the rate stays below 1).
+RandomSum AffineStateFlow(Rng& rng, const Context& ctx, int v) {
+  const RandomHybridAutomaton& a = *ctx.a;
+  const std::string& x = a.variables[v].name;
+  RandomSum sum;
+  const int diagonal = Weighted(rng, {70, 18, 12});  // stable, unstable, none
+  const double rate = diagonal == 0 ? -Tenths(rng, 1, 10) : diagonal == 1 ? Tenths(rng, 1, 2) : 0.0;
+  if (rate != 0.0) sum.terms.push_back({rate, {x}});
+  for (int w = 0; w < static_cast<int>(a.variables.size()); ++w) {
+    if (w != v && RandomChance(rng, 35)) {
+      sum.terms.push_back({NonZeroTenths(rng, 3), {a.variables[w].name}});
+    }
+  }
+  if (RandomChance(rng, 80)) AddDrift(rng, ctx, v, rate, sum);
+  AddInputs(rng, ctx, 35, sum);
+  if (!a.parameters.empty() && RandomChance(rng, 20)) {
+    const std::string& p = Pick(rng, a.parameters).name;
+    if (RandomChance(rng, 50)) {
+      sum.terms.push_back({0.1, {p, x}});
+    } else {
+      sum.terms.push_back({RandomChance(rng, 50) ? 1.0 : NonZeroTenths(rng, 10), {p}});
+    }
+  }
+  if (sum.terms.empty()) sum.terms.push_back({NonZeroTenths(rng, 20), {}});
+  return sum;
+}
+
+// A polynomial flow whose runs stay finite: a stable linear part and a drift, and a cubic
+// damping `-0.2*x*x*x`, a damping by another variable `-0.1*x*y*y`, or a square of another
+// variable `0.2*y*y` (which grows no faster than y does).
+RandomSum PolynomialFlow(Rng& rng, const Context& ctx, int v) {
+  const RandomHybridAutomaton& a = *ctx.a;
+  const std::string& x = a.variables[v].name;
+  RandomSum sum;
+  const double rate = -Tenths(rng, 1, 10);
+  sum.terms.push_back({rate, {x}});
+  const int kind = a.variables.size() < 2 ? 0 : UniformInt(rng, 0, 2);
+  if (kind == 0) {
+    sum.terms.push_back({-Tenths(rng, 1, 3), {x, x, x}});
+  } else {
+    const std::string& y = a.variables[OtherVariable(rng, ctx, v)].name;
+    if (kind == 1) {
+      sum.terms.push_back({-Tenths(rng, 1, 3), {x, y, y}});
+    } else {
+      sum.terms.push_back({NonZeroTenths(rng, 2), {y, y}});
+    }
+  }
+  if (RandomChance(rng, 70)) AddDrift(rng, ctx, v, rate, sum);
+  AddInputs(rng, ctx, 25, sum);
+  return sum;
+}
+
+// An oscillator over variables v, w: `x' = y; y' = -k*(x - c) + mu*y - g*x*x*y (+ u)`, undamped
+// in its linear part (mu = 0), damped (mu < 0) or Van der Pol (mu > 0); the cubic term keeps
+// every run bounded.
+void AddOscillator(Rng& rng, const Context& ctx, int v, int w, RandomMode& m) {
+  const RandomHybridAutomaton& a = *ctx.a;
+  const std::string& x = a.variables[v].name;
+  const std::string& y = a.variables[w].name;
+  m.flows.emplace_back(x, RandomSum{{{RandomChance(rng, 70) ? 1.0 : Tenths(rng, 5, 15), {y}}}});
+  RandomSum acc;
+  const double k = Tenths(rng, 3, 15);
+  acc.terms.push_back({-k, {x}});
+  const double centre = RoundTenths(k * (ctx.base[v] + Tenths(rng, -20, 20)));
+  if (centre != 0.0) acc.terms.push_back({centre, {}});
+  const int damping = Weighted(rng, {30, 40, 30});
+  if (damping == 1) acc.terms.push_back({-Tenths(rng, 1, 5), {y}});
+  if (damping == 2) acc.terms.push_back({Tenths(rng, 1, 5), {y}});
+  acc.terms.push_back({-Tenths(rng, 1, 3), {x, x, y}});
+  AddInputs(rng, ctx, 30, acc);
+  m.flows.emplace_back(y, acc);
+}
+
+// A mode of RandomDynamics::kAffine: sometimes an oscillator over two variables, the other
+// variables' flows mostly affine in the state, sometimes polynomial, else the shapes of kMixed.
+RandomMode DrawAffineMode(Rng& rng, const Context& ctx, const std::string& name) {
+  RandomMode m{name, {}, {}, {}};
+  const auto& vars = ctx.a->variables;
+  const int nv = static_cast<int>(vars.size());
+  std::vector<bool> drawn(nv, false);
+  if (nv >= 2 && RandomChance(rng, 20)) {
+    const int v = UniformInt(rng, 0, nv - 1);
+    const int w = OtherVariable(rng, ctx, v);
+    AddOscillator(rng, ctx, v, w, m);
+    drawn[v] = drawn[w] = true;
+  }
+  for (int v = 0; v < nv; ++v) {
+    if (drawn[v]) continue;
+    switch (Weighted(rng, {6, 4, 8, 10, 6, 54, 12})) {
+      case 0:  // no flow
+        break;
+      case 1:
+        m.flows.emplace_back(vars[v].name, Constant(0.0));
+        break;
+      case 2:
+        m.flows.emplace_back(vars[v].name, Constant(NonZeroTenths(rng, 20)));
+        break;
+      case 3: {  // affine in the inputs only
+        RandomSum sum;
+        if (RandomChance(rng, 50) || ctx.a->inputs.empty()) {
+          sum.terms.push_back({NonZeroTenths(rng, 10), {}});
+        }
+        AddInputs(rng, ctx, 60, sum);
+        m.flows.emplace_back(vars[v].name, sum);
+        break;
+      }
+      case 4: {  // a rectangular rate, sometimes a point
+        const double lo = Tenths(rng, -20, 20);
+        const double width = RandomChance(rng, 15) ? 0.0 : Tenths(rng, 1, 20);
+        m.rates.push_back({vars[v].name, lo, RoundTenths(lo + width)});
+        break;
+      }
+      case 5:
+        m.flows.emplace_back(vars[v].name, AffineStateFlow(rng, ctx, v));
+        break;
+      default:
+        m.flows.emplace_back(vars[v].name, PolynomialFlow(rng, ctx, v));
+        break;
+    }
+  }
+  const int atoms = Weighted(rng, {35, 45, 20});
+  for (int i = 0; i < atoms; ++i) m.invariant.push_back(DrawInvariantAtom(rng, ctx));
+  return m;
+}
+
 RandomMode DrawMode(Rng& rng, const Context& ctx, const std::string& name) {
+  if (Affine(ctx)) return DrawAffineMode(rng, ctx, name);
   RandomMode m{name, {}, {}, {}};
   const auto& vars = ctx.a->variables;
   for (int v = 0; v < static_cast<int>(vars.size()); ++v) {
@@ -273,7 +433,10 @@ RandomInit DrawInit(Rng& rng, const Context& ctx, bool first) {
   RandomInit init{Pick(rng, a.modes).name, {}};
   for (int v = 0; v < static_cast<int>(a.variables.size()); ++v) {
     const double lo = first ? ctx.base[v] : Tenths(rng, -50, 50);
-    const double hi = RandomChance(rng, 30) ? std::round((lo + Tenths(rng, 0, 20)) * 10) / 10 : lo;
+    // Small boxes for the flowpipe engine (kAffine), which must enclose every run from them.
+    const int width = Affine(ctx) ? 5 : 20;
+    const double hi =
+        RandomChance(rng, 30) ? std::round((lo + Tenths(rng, 0, width)) * 10) / 10 : lo;
     init.values.push_back({a.variables[v].name, {lo, hi}});
   }
   return init;
@@ -324,7 +487,7 @@ RandomProperty DrawProperty(Rng& rng, const Context& ctx, const std::string& nam
   p.name = name;
   p.kind = static_cast<RandomProperty::Kind>(Weighted(rng, {45, 15, 40}));
   p.predicate = DrawPredicate(rng, ctx);
-  if (RandomChance(rng, 15)) p.within = Tenths(rng, 5, 200);
+  if (RandomChance(rng, Affine(ctx) ? 30 : 15)) p.within = Tenths(rng, 5, 200);
   return p;
 }
 
@@ -579,8 +742,13 @@ std::string RandomHybridAutomaton::Text(const PrintOptions& options) const {
 }
 
 RandomHybridAutomaton GenerateRandomAutomaton(std::mt19937_64& rng) {
+  return GenerateRandomAutomaton(rng, RandomAutomatonOptions{});
+}
+
+RandomHybridAutomaton GenerateRandomAutomaton(std::mt19937_64& rng,
+                                              const RandomAutomatonOptions& options) {
   RandomHybridAutomaton a;
-  Context ctx{&a, {}};
+  Context ctx{&a, {}, options};
   a.name = Pick(rng, ShortNamePool());
   const int nv = UniformInt(rng, 1, 3);
   const int ni = Weighted(rng, {15, 45, 30, 10});
@@ -976,8 +1144,9 @@ void AddLabels(Rng& rng, RandomHybridAutomaton& a) {
 }
 
 // A random automaton for a system: no properties, decorated; its name not in `taken`.
-RandomHybridAutomaton DrawComponent(Rng& rng, const std::set<std::string>& taken) {
-  RandomHybridAutomaton a = GenerateRandomAutomaton(rng);
+RandomHybridAutomaton DrawComponent(Rng& rng, const std::set<std::string>& taken,
+                                    const RandomAutomatonOptions& options) {
+  RandomHybridAutomaton a = GenerateRandomAutomaton(rng, options);
   a.properties.clear();
   if (taken.count(a.name) != 0) a.name = FreshName(rng, taken);
   AddDerivedParameters(rng, a);
@@ -1587,7 +1756,7 @@ void DrawSystemProperties(Rng& rng, RandomSystem& s) {
 
 // Draws 1 to 3 instances (sometimes two of one automaton, sometimes one unqualified) and their
 // automata.
-void DrawInstances(Rng& rng, RandomSystem& s) {
+void DrawInstances(Rng& rng, RandomSystem& s, const RandomAutomatonOptions& options) {
   const int n = Weighted(rng, {25, 45, 30}) + 1;
   const std::vector<std::string> names = DistinctNames(rng, n);
   const int unqualified = RandomChance(rng, 15) ? UniformInt(rng, 0, n - 1) : -1;
@@ -1598,7 +1767,7 @@ void DrawInstances(Rng& rng, RandomSystem& s) {
     } else {
       std::set<std::string> taken;
       for (const RandomHybridAutomaton& a : s.automata) taken.insert(a.name);
-      s.automata.push_back(DrawComponent(rng, taken));
+      s.automata.push_back(DrawComponent(rng, taken, options));
       in.automaton = static_cast<int>(s.automata.size()) - 1;
     }
     s.instances.push_back(in);
@@ -1610,7 +1779,7 @@ void DrawInstances(Rng& rng, RandomSystem& s) {
 RandomSystem GenerateRandomSystem(std::mt19937_64& rng, const RandomSystemOptions& options) {
   RandomSystem s;
   s.name = Pick(rng, ShortNamePool());
-  DrawInstances(rng, s);
+  DrawInstances(rng, s, options.automata);
   DrawConnections(rng, s);
   MakeConsistent(rng, s);
   DrawSystemProperties(rng, s);

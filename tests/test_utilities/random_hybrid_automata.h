@@ -175,6 +175,29 @@ std::string LazyChoiceInput(int transition);
 /// Name of the input that picks the rate of `variable` (PrintOptions::explicit_rates).
 std::string RateInput(const std::string& variable);
 
+/// Which flows GenerateRandomAutomaton draws.
+enum class RandomDynamics {
+  /// Constant rates, affine in the inputs (also with parameter coefficients), zero, absent,
+  /// rectangular rates, or occasionally affine in the state (relaxation towards a constant).
+  /// The default: every seed keeps the models it has always given.
+  kMixed,
+  /// Mostly affine in the state with small coefficients, stable and unstable, with cross terms
+  /// (`x' = -0.4*x + 2 + u`, `x' = 0.3*y - 0.2*x + 0.1*p*x`), sometimes polynomial (a cubic
+  /// damping `x' = -0.5*x - 0.2*x*x*x`, `x' = -0.3*x - 0.1*x*y*y + 0.2*y*y`, and, with two or more
+  /// variables, oscillators `x' = y; y' = -x - 0.1*x*x*y` (damped or Van der Pol: bounded
+  /// runs)), besides the other shapes of kMixed (constant, input-affine, rectangular rates, zero,
+  /// absent), and small initial sets: models the flowpipe engine (`check --method flowpipe`)
+  /// can prove things about (tests/solvers/flowpipe/flowpipe_soundness_test.cc). Inputs,
+  /// uncertain parameters, invariants, guards (urgent and lazy), resets, several init
+  /// declarations and `within T` properties are drawn as for kMixed.
+  kAffine,
+};
+
+/// How to draw a RandomHybridAutomaton (GenerateRandomAutomaton).
+struct RandomAutomatonOptions {
+  RandomDynamics dynamics = RandomDynamics::kMixed;
+};
+
 /// A random automaton: 1 to 3 variables (some with a domain), 0 to 3 inputs whose bounds take
 /// every sign ([-a, 0], [0, a], [0, 0], [-a, b], [a, b], [-b, -a]), 0 to 2 parameters (most with a
 /// range, some degenerate), 1 to 3 modes whose flows are constant rates, affine in the inputs
@@ -186,7 +209,11 @@ std::string RateInput(const std::string& variable);
 /// `never`, `reach`, some `within T`) whose predicates combine comparisons of sums of variables and
 /// parameters, `in MODE`, `not`, `and`, `or`. Constants are short decimals that the parser reads
 /// to the same double. Every name is drawn from ShortNamePool().
+/// `options` (RandomAutomatonOptions) chooses the flows; the default draws exactly what the
+/// overload without options draws.
 RandomHybridAutomaton GenerateRandomAutomaton(std::mt19937_64& rng);
+RandomHybridAutomaton GenerateRandomAutomaton(std::mt19937_64& rng,
+                                              const RandomAutomatonOptions& options);
 
 /// sum's value; every factor must be in `values` (throws std::out_of_range otherwise).
 double EvaluateSum(const RandomSum& sum, const std::map<std::string, double>& values);
@@ -266,6 +293,8 @@ struct RandomSystemOptions {
   /// Chance (percent) that the system is given a conflict on purpose (RandomSystem::conflict);
   /// a system with fewer than two instances of different automata gets none.
   int conflict_percent = 0;
+  /// How the instances' automata are drawn (the default keeps every seed's systems).
+  RandomAutomatonOptions automata = {};
 };
 
 /// A random system: 1 to 3 instances (sometimes two of one automaton, sometimes one unqualified:

@@ -48,6 +48,7 @@
 #include "hybrid/verification/property_prover.h"
 #include "hybrid/verification/property_sampler.h"
 #include "tests/test_utilities/random_hybrid_automata.h"
+#include "tests/test_utilities/soundness_attack.h"
 
 namespace hybrid {
 namespace {
@@ -275,280 +276,27 @@ std::string SummaryText(const Settings& settings, const Summary& s) {
   return out.str();
 }
 
-// ---- concrete runs, written back as model text ----
+// ---- concrete runs, written back as model text (tests/test_utilities/soundness_attack.h) ----
 
-/// The choices that make a run of a system concrete.
-struct RunChoices {
-  std::map<std::string, double> parameters;      // uncertain parameters, by system name
-  std::vector<int> inits;                        // the init declaration of each instance
-  std::map<std::string, double> initial_values;  // by system variable name
-  ht::RandomScenario scenario;                   // inputs by system name
-  std::vector<bool> lazy_choices;                // per instance: urgent copies of lazy jumps
-  std::vector<ScheduledJump> schedule;           // a trace's lazy jumps
-  std::vector<double> sample_times;              // input breakpoints and other times to record
-  std::string note;
-};
-
-/// `s` as a concrete run: one automaton per instance (zz_run_K), with the run's parameter values
-/// as nominal values and its chosen init declaration alone, its initial values as points; the
-/// inputs as the scenario. `print` receives the print options of each automaton.
-RandomSystem ConcreteSystem(const RandomSystem& s, const RunChoices& c,
-                            std::vector<ht::PrintOptions>& print) {
-  RandomSystem out = s;
-  out.properties.clear();
-  out.automata.clear();
-  print.clear();
-  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
-    ht::RandomHybridAutomaton a = s.automata[s.instances[k].automaton];
-    a.name = "zz_run_" + std::to_string(k);
-    for (ht::RandomParameter& p : a.parameters) {
-      const auto it = c.parameters.find(s.SystemName(k, p.name));
-      if (it != c.parameters.end() && p.range) p.nominal = it->second;
-    }
-    a.inits = {a.inits.at(c.inits.at(k))};
-    for (auto& [v, range] : a.inits.front().values) {
-      const auto it = c.initial_values.find(s.SystemName(k, v));
-      if (it != c.initial_values.end()) range = {it->second, it->second};
-    }
-    out.instances[k].automaton = k;
-    out.automata.push_back(a);
-    ht::PrintOptions options;
-    options.lazy_choices = c.lazy_choices.at(k);
-    options.explicit_rates = true;
-    print.push_back(options);
-  }
-  out.scenario = c.scenario;
-  return out;
-}
-
-/// A step signal over [0, until] of 1 to 6 pieces with values at the bounds' ends, at 0 (when
-/// admitted) or uniform in the bounds.
-std::vector<std::pair<double, double>> DrawSignal(Rng& rng, double lo, double hi, double until) {
-  std::vector<double> times = {0.0};
-  const int pieces = ht::UniformInt(rng, 1, 6);
-  for (int i = 1; i < pieces; ++i) times.push_back(ht::UniformReal(rng, 0.0, until));
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  std::vector<std::pair<double, double>> points;
-  for (double t : times) {
-    const int kind = ht::UniformInt(rng, 0, 99);
-    const double v = kind < 30   ? lo
-                     : kind < 60 ? hi
-                     : kind < 75 ? std::clamp(0.0, lo, hi)
-                                 : ht::UniformReal(rng, lo, hi);
-    points.emplace_back(t, std::clamp(v, lo, hi));
-  }
-  return points;
-}
-
-/// Pulses of 1 on a lazy transition's choice input (or none).
-std::vector<std::pair<double, double>> DrawChoice(Rng& rng, double until) {
-  std::vector<std::pair<double, double>> points = {{0.0, 0.0}};
-  if (ht::RandomChance(rng, 40)) return points;
-  std::vector<double> times;
-  for (int i = ht::UniformInt(rng, 1, 3) * 2; i > 0; --i) {
-    times.push_back(ht::UniformReal(rng, 0.0, until));
-  }
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  for (std::size_t i = 0; i < times.size(); ++i) {
-    if (times[i] == 0.0) points.clear();
-    points.emplace_back(times[i], i % 2 == 0 ? 1.0 : 0.0);
-  }
-  return points;
-}
-
-double DrawInRange(Rng& rng, double lo, double hi, double nominal) {
-  const int kind = ht::UniformInt(rng, 0, 99);
-  if (kind < 25) return nominal;
-  if (kind < 45) return lo;
-  if (kind < 65) return hi;
-  return std::clamp(ht::UniformReal(rng, lo, hi), lo, hi);
-}
-
-/// The variables of `a` that have a rectangular rate in some mode.
-std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
-  std::set<std::string> out;
-  for (const ht::RandomMode& m : a.modes) {
-    for (const ht::RandomRate& r : m.rates) out.insert(r.variable);
-  }
-  return out;
-}
-
-/// Random values for the uncertain parameters and a random start (init declaration per instance,
-/// values in its boxes), each system name drawn once.
-void DrawStart(const RandomSystem& s, Rng& rng, RunChoices& c) {
-  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
-    const ht::RandomHybridAutomaton& a = s.automata[s.instances[k].automaton];
-    for (const ht::RandomParameter& p : a.parameters) {
-      if (p.range && !c.parameters.count(s.SystemName(k, p.name))) {
-        c.parameters[s.SystemName(k, p.name)] =
-            DrawInRange(rng, p.range->first, p.range->second, p.nominal);
-      }
-    }
-    c.inits.push_back(ht::UniformInt(rng, 0, static_cast<int>(a.inits.size()) - 1));
-    for (const auto& [v, range] : a.inits[c.inits.back()].values) {
-      if (!c.initial_values.count(s.SystemName(k, v))) {
-        c.initial_values[s.SystemName(k, v)] =
-            DrawInRange(rng, range.first, range.second, range.first);
-      }
-    }
-  }
-}
+using RunChoices = ht::SystemRunChoices;
+using Simulation = ht::SystemSimulation;
+using ModelState = ht::SystemState;
+using ht::RatedVariables;
 
 /// A random run of `s` for an attack.
-RunChoices DrawAttack(const RandomSystem& s, Rng& rng) {
-  RunChoices c;
-  DrawStart(s, rng, c);
-  ht::RandomScenario& sc = c.scenario;
-  sc.until = ht::UniformInt(rng, 5, 300) / 10.0;
-  std::set<std::string> driven;
-  const auto drive = [&](const std::string& name, std::vector<std::pair<double, double>> points) {
-    if (driven.insert(name).second) sc.steps.emplace_back(name, std::move(points));
-  };
-  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
-    const ht::RandomHybridAutomaton& a = s.automata[s.instances[k].automaton];
-    for (const ht::RandomInput& in : a.inputs) {
-      drive(s.SystemName(k, in.name), DrawSignal(rng, in.lo, in.hi, sc.until));
-    }
-    const bool lazy = std::any_of(a.transitions.begin(), a.transitions.end(), [](const auto& t) {
-      return t.urgency == ht::RandomTransition::Urgency::kLazy;
-    });
-    c.lazy_choices.push_back(lazy && ht::RandomChance(rng, 60));
-    for (int t = 0; c.lazy_choices.back() && t < static_cast<int>(a.transitions.size()); ++t) {
-      if (a.transitions[t].urgency != ht::RandomTransition::Urgency::kLazy) continue;
-      drive(s.SystemName(k, ht::LazyChoiceInput(t)), DrawChoice(rng, sc.until));
-    }
-    for (const std::string& v : RatedVariables(a)) {
-      drive(s.SystemName(k, ht::RateInput(v)), DrawSignal(rng, 0.0, 1.0, sc.until));
-    }
-  }
-  for (const auto& [name, points] : sc.steps) {
-    for (const auto& [t, v] : points) c.sample_times.push_back(t);
-  }
-  c.note = "random attack";
-  return c;
-}
+RunChoices DrawAttack(const RandomSystem& s, Rng& rng) { return ht::DrawSystemAttack(s, rng); }
 
-/// A simulation of a concrete run.
-struct Simulation {
-  std::string text;
-  std::optional<Simulator> simulator;
-  SimulationResult result;
-  double sample_step = 0.0;
-  std::map<std::string, double> parameters;  // every parameter's value, by system name
-  std::string error;                         // the model or the simulator refused the run
-};
-
-/// Whether the simulator numbers the modes of every instance as `s` declares them.
-std::string ModeNumberingProblem(const RandomSystem& s, const Simulator& sim) {
-  for (int k = 0; k < static_cast<int>(s.instances.size()); ++k) {
-    const auto& modes = s.automata[s.instances[k].automaton].modes;
-    for (int m = 0; m < static_cast<int>(modes.size()); ++m) {
-      if (sim.ModeName(k, m) != s.ModeName(k, modes[m].name)) {
-        return "mode " + std::to_string(m) + " of instance " + std::to_string(k) + " is '" +
-               sim.ModeName(k, m) + "', not '" + s.ModeName(k, modes[m].name) + "'";
-      }
-    }
-  }
-  return "";
-}
-
-Simulation Simulate(const RandomSystem& s, const RunChoices& c) {
-  Simulation out;
-  std::vector<ht::PrintOptions> print;
-  const RandomSystem concrete = ConcreteSystem(s, c, print);
-  out.text = concrete.Text(print);
-  out.parameters = ht::SystemParameterValues(s, c.parameters);
-  try {
-    const System system = ParseModel(out.text, "run.ha");
-    out.simulator.emplace(system);
-    out.error = ModeNumberingProblem(s, *out.simulator);
-    if (!out.error.empty()) return out;
-    SimulationOptions options;
-    out.sample_step = c.scenario.until / 256;
-    options.sample_step = out.sample_step;
-    std::vector<double> times;
-    for (double t : c.sample_times) {
-      if (t >= 0 && t <= c.scenario.until) times.push_back(t);
-    }
-    std::sort(times.begin(), times.end());
-    times.erase(std::unique(times.begin(), times.end()), times.end());
-    options.sample_times = times;
-    options.lazy_schedule = c.schedule;
-    out.result = out.simulator->Run(options);
-  } catch (const std::exception& e) {
-    out.error = e.what();
-    out.simulator.reset();
-  }
-  return out;
-}
-
-/// The values (variables, parameters, discrete variables; system names) at recorded state `x`.
-std::map<std::string, double> StateValues(const RandomSystem& s, const Simulation& sim,
-                                          const StateSample& x) {
-  std::map<std::string, double> values = sim.parameters;
-  const auto& names = sim.simulator->variable_names();
-  for (std::size_t i = 0; i < names.size(); ++i) values[names[i]] = x.x[static_cast<int>(i)];
-  ht::AddDiscreteValues(s, x.modes, values);
-  return values;
-}
-
-std::string StateText(const Simulator& sim, const StateSample& x) {
-  std::ostringstream out;
-  out.precision(17);
-  out << "t = " << x.time << " in " << sim.ModeLabel(x.modes) << ":";
-  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
-    out << " " << sim.variable_names()[i] << " = " << x.x[static_cast<int>(i)] << ";";
-  }
-  return out.str();
-}
+Simulation Simulate(const RandomSystem& s, const RunChoices& c) { return ht::SimulateSystem(s, c); }
 
 /// The events of a run up to state `index` (all if negative), that state, and the run's text.
-std::string RunText(const Simulation& sim, int index) {
-  std::ostringstream out;
-  out.precision(17);
-  const SimulationResult& r = sim.result;
-  out << "  simulation status: " << StatusName(r.status)
-      << (r.message.empty() ? "" : " (" + r.message + ")") << "\n";
-  const double until = index >= 0 ? r.samples[index].time : INFINITY;
-  std::size_t shown = 0;
-  while (shown < r.events.size() && r.events[shown].time <= until) ++shown;
-  for (std::size_t i = 0; i < shown; ++i) {
-    if (i == 20 && shown > 30) {
-      out << "  ... " << shown - 25 << " more events ...\n";
-      i = shown - 5;
-    }
-    const EventRecord& e = r.events[i];
-    std::string names;
-    for (const std::string& n : e.transitions) names += (names.empty() ? "" : "+") + n;
-    out << "  event t = " << e.time << ": " << names << " ("
-        << sim.simulator->ModeLabel(e.modes_before) << " -> "
-        << sim.simulator->ModeLabel(e.modes_after) << ")\n";
-  }
-  if (index >= 0) out << "  state: " << StateText(*sim.simulator, r.samples[index]) << "\n";
-  out << "  replay: save the text below as run.ha and run `hybrid simulate run.ha --sample "
-      << sim.sample_step << "`\n--- run.ha ---\n"
-      << sim.text;
-  return out.str();
-}
+std::string RunText(const Simulation& sim, int index) { return ht::SystemRunText(sim, index); }
 
 // ---- judging states ----
 
 /// Whether a state refutes the claim `verdict` about `p` (proved invariant, unreachable target).
 bool Refutes(const RandomProperty& p, Verdict verdict, const std::map<std::string, double>& values,
              const std::set<std::string>& modes) {
-  using K = RandomProperty::Kind;
-  if (verdict == Verdict::kProved && p.kind == K::kAlways) {
-    return !ht::HoldsInModes(p.predicate, values, modes, kTolerance);
-  }
-  if (verdict == Verdict::kProved && p.kind == K::kNever) {
-    return ht::HoldsInModes(p.predicate, values, modes, -kTolerance);
-  }
-  if (verdict == Verdict::kUnreachable && p.kind == K::kReach) {
-    return ht::HoldsInModes(p.predicate, values, modes, -kTolerance);
-  }
-  return false;
+  return ht::RefutesInModes(p, verdict, values, modes);
 }
 
 /// Whether a state confirms `violated` (always, never) or `reachable` (reach): a `reach` target
@@ -573,30 +321,10 @@ bool ClearlyConfirms(const RandomProperty& p, const std::map<std::string, double
   return ht::HoldsInModes(p.predicate, values, modes, -kConfirmTolerance);
 }
 
-/// A recorded state of a run, as the generator's evaluator reads it.
-struct ModelState {
-  int index = 0;  // into the run's samples
-  double time = 0.0;
-  std::map<std::string, double> values;  // variables, parameters, discrete variables
-  std::set<std::string> modes;           // system names of the instances' modes
-};
-
 /// The recorded states of `sim` up to the first one outside its modes' invariants (`*outside`
-/// then): the simulator records the state a jump leads to even when it breaks the target mode's
-/// invariant, and such a state is no state of the model, nor what it records after it.
+/// then).
 std::vector<ModelState> ModelStates(const RandomSystem& s, const Simulation& sim, bool* outside) {
-  std::vector<ModelState> out;
-  const auto& samples = sim.result.samples;
-  for (int j = 0; j < static_cast<int>(samples.size()); ++j) {
-    ModelState x{j, samples[j].time, StateValues(s, sim, samples[j]),
-                 ht::ModeNames(s, samples[j].modes)};
-    if (!ht::InsideInvariants(s, samples[j].modes, x.values, kTolerance)) {
-      *outside = true;
-      break;
-    }
-    out.push_back(std::move(x));
-  }
-  return out;
+  return ht::SystemStates(s, sim, outside);
 }
 
 // ---- one system ----

@@ -10,6 +10,8 @@
 // - every `violated` trace and every `reachable` witness is turned back into model text (its
 //   parameter and initial values as declared values, its inputs as the scenario) and simulated:
 //   it must reach the violation or the target.
+// The attacks and replays are tests/test_utilities/soundness_attack.h (shared with the flowpipe
+// engine's test, tests/solvers/flowpipe/flowpipe_soundness_test.cc).
 // The oracle shares no code with the SMT encoding: the model is text, the simulator (CVODE with
 // event location, exact on constant-rate segments) produces the states, and the properties are
 // evaluated by the generator's own evaluator. One contradiction fails the test and prints the
@@ -41,6 +43,7 @@
 #include "hybrid/simulation/simulator.h"
 #include "hybrid/verification/property_prover.h"
 #include "tests/test_utilities/random_hybrid_automata.h"
+#include "tests/test_utilities/soundness_attack.h"
 
 namespace hybrid {
 namespace {
@@ -48,51 +51,23 @@ namespace {
 namespace ht = hybrid::testing;
 using ht::RandomHybridAutomaton;
 using ht::RandomProperty;
+using Summary = ht::SoundnessSummary;
+using Settings = ht::SoundnessSettings;
+using ht::AttackClaims;
+using ht::CheckAutomaton;
+using ht::Checker;
+using ht::KindName;
+using ht::ModelSeed;
+using ht::RatedVariables;
+using ht::SummaryText;
 
 constexpr std::uint64_t kDefaultSeed = 20261121;
 constexpr int kDefaultModels = 300;
 constexpr int kDefaultAttacks = 40;
-/// A claim is contradicted only by a state that breaks it by more than this (relative to the
-/// magnitude of the comparison's terms): simulation rounding never counts.
-constexpr double kTolerance = 1e-6;
-/// A `violated` trace must break its property by at least this (relative) margin on replay.
-constexpr double kConfirmTolerance = 1e-9;
-
-/// A non-negative integer from the environment, or `fallback` when unset.
-std::uint64_t EnvNumber(const char* name, std::uint64_t fallback) {
-  const char* text = std::getenv(name);
-  if (text == nullptr || *text == '\0') return fallback;
-  char* end = nullptr;
-  const unsigned long long value = std::strtoull(text, &end, 10);
-  if (*end != '\0' || *text == '-') {
-    ADD_FAILURE() << name << "='" << text << "' is not a non-negative integer";
-    return fallback;
-  }
-  return value;
-}
-
-struct Settings {
-  std::uint64_t seed = kDefaultSeed;
-  std::uint64_t first = 0;
-  int models = kDefaultModels;
-  int attacks = kDefaultAttacks;
-};
 
 Settings SettingsFromEnvironment(int default_models = kDefaultModels) {
-  Settings s;
-  s.seed = EnvNumber("HYBRID_SOUNDNESS_SEED", kDefaultSeed);
-  s.first = EnvNumber("HYBRID_SOUNDNESS_FIRST", 0);
-  s.models = static_cast<int>(EnvNumber("HYBRID_SOUNDNESS_MODELS", default_models));
-  s.attacks = static_cast<int>(EnvNumber("HYBRID_SOUNDNESS_ATTACKS", kDefaultAttacks));
-  return s;
-}
-
-/// The seed of model `index` (SplitMix64 of seed and index): every model is reproducible alone.
-std::uint64_t ModelSeed(std::uint64_t seed, std::uint64_t index) {
-  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (index + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
+  return ht::SoundnessSettingsFromEnvironment("HYBRID_SOUNDNESS", kDefaultSeed, default_models,
+                                              kDefaultAttacks);
 }
 
 /// What `hybrid check --method prove --depth 6 --induction 2 --budget 30` does: Z3 resource
@@ -108,500 +83,7 @@ PropertyProver::Options ProverOptions() {
   return o;
 }
 
-struct Summary {
-  int models = 0;
-  std::map<std::string, int> verdicts;  // "always proved", "reach unreachable", ...
-  int claims = 0;                       // proved / unreachable verdicts attacked
-  long attacks = 0;                     // simulations run against claims
-  long rejected = 0;                    // simulations the model refused (initial state outside
-                                        // its invariant)
-  long states = 0;                      // recorded states checked against claims
-  int replays = 0;                      // violated / reachable traces replayed and confirmed
-  long outside = 0;                     // attacks cut at a state outside its mode's invariant
-  std::map<std::string, int> refusals;  // why the model refused attacks (up to the first quote)
-  std::vector<std::string> contradictions;
-  double prover_seconds = 0.0;
-  double attack_seconds = 0.0;
-};
-
-std::string KindName(RandomProperty::Kind k) {
-  switch (k) {
-    case RandomProperty::Kind::kAlways:
-      return "always";
-    case RandomProperty::Kind::kNever:
-      return "never";
-    case RandomProperty::Kind::kReach:
-      return "reach";
-  }
-  return "?";
-}
-
-std::string VerdictText(Verdict v) {
-  switch (v) {
-    case Verdict::kProved:
-      return "proved";
-    case Verdict::kViolated:
-      return "violated";
-    case Verdict::kReachable:
-      return "reachable";
-    case Verdict::kUnreachable:
-      return "unreachable";
-    case Verdict::kUnknown:
-      return "unknown";
-  }
-  return "?";
-}
-
-/// Whether a state refutes the claim `verdict` about `p` (proved invariant, unreachable target).
-bool Refutes(const RandomProperty& p, Verdict verdict, const std::map<std::string, double>& values,
-             const std::string& mode) {
-  if (verdict == Verdict::kProved && p.kind == RandomProperty::Kind::kAlways) {
-    return !ht::Holds(p.predicate, values, mode, kTolerance);
-  }
-  if (verdict == Verdict::kProved && p.kind == RandomProperty::Kind::kNever) {
-    return ht::Holds(p.predicate, values, mode, -kTolerance);
-  }
-  if (verdict == Verdict::kUnreachable && p.kind == RandomProperty::Kind::kReach) {
-    return ht::Holds(p.predicate, values, mode, -kTolerance);
-  }
-  return false;
-}
-
-/// Whether a state confirms the verdict `violated` (always, never) or `reachable` (reach).
-bool Confirms(const RandomProperty& p, const std::map<std::string, double>& values,
-              const std::string& mode) {
-  switch (p.kind) {
-    case RandomProperty::Kind::kAlways:
-      return !ht::Holds(p.predicate, values, mode, kConfirmTolerance);
-    case RandomProperty::Kind::kNever:
-      return ht::Holds(p.predicate, values, mode, -kConfirmTolerance);
-    case RandomProperty::Kind::kReach:
-      return ht::Holds(p.predicate, values, mode, kTolerance);
-  }
-  return false;
-}
-
-/// Whether a recorded state lies in its mode's invariant (within kTolerance). The simulator
-/// records the state after a jump even when it breaks the target mode's invariant (and stops
-/// there, or jumps on at the same instant): such a state is no state of the model, whose states
-/// all satisfy their mode's invariant, and neither is anything recorded after it. So a run is
-/// cut at its first such state: it neither refutes a claim nor confirms a trace from there on.
-bool InsideInvariant(const RandomHybridAutomaton& a, const std::string& mode,
-                     const std::map<std::string, double>& values) {
-  for (const ht::RandomMode& m : a.modes) {
-    if (m.name != mode) continue;
-    for (const ht::RandomComparison& c : m.invariant) {
-      ht::RandomPredicate atom;
-      atom.comparison = c;
-      if (!ht::Holds(atom, values, mode, kTolerance)) return false;
-    }
-  }
-  return true;
-}
-
-/// A concrete run, written as model text: the automaton with the run's parameter values and
-/// initial values as its declared ones, and its inputs as its scenario.
-struct ConcreteRun {
-  RandomHybridAutomaton automaton;
-  ht::PrintOptions print;
-  std::map<std::string, double> parameters;  // every parameter's value in this run
-  std::vector<double> sample_times;          // input breakpoints (recorded states)
-  std::string note;                          // how it was drawn (for reports)
-  std::vector<ScheduledJump> schedule;       // a trace's lazy jumps (SimulationOptions)
-};
-
-std::map<std::string, double> ParameterValues(const RandomHybridAutomaton& a) {
-  std::map<std::string, double> out;
-  for (const ht::RandomParameter& p : a.parameters) out[p.name] = p.nominal;
-  return out;
-}
-
-/// A step signal over [0, until] of 1 to 6 pieces with values at the bounds' ends, at 0 (when
-/// admitted) or uniform in the bounds.
-std::vector<std::pair<double, double>> DrawSignal(std::mt19937_64& rng, double lo, double hi,
-                                                  double until) {
-  std::vector<double> times = {0.0};
-  const int pieces = ht::UniformInt(rng, 1, 6);
-  for (int i = 1; i < pieces; ++i) times.push_back(ht::UniformReal(rng, 0.0, until));
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  std::vector<std::pair<double, double>> points;
-  for (double t : times) {
-    const int kind = ht::UniformInt(rng, 0, 99);
-    double v = kind < 30   ? lo
-               : kind < 60 ? hi
-               : kind < 75 ? std::clamp(0.0, lo, hi)
-                           : ht::UniformReal(rng, lo, hi);
-    points.emplace_back(t, std::clamp(v, lo, hi));
-  }
-  return points;
-}
-
-/// Pulses of 1 on a lazy transition's choice input (or none): the transition is taken at the
-/// start of a pulse if its guard holds then, or as soon as it holds during the pulse.
-std::vector<std::pair<double, double>> DrawChoice(std::mt19937_64& rng, double until) {
-  std::vector<std::pair<double, double>> points = {{0.0, 0.0}};
-  if (ht::RandomChance(rng, 40)) return points;
-  std::vector<double> times;
-  for (int i = ht::UniformInt(rng, 1, 3) * 2; i > 0; --i) {
-    times.push_back(ht::UniformReal(rng, 0.0, until));
-  }
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  for (std::size_t i = 0; i < times.size(); ++i) {
-    if (times[i] == 0.0) points.clear();
-    points.emplace_back(times[i], i % 2 == 0 ? 1.0 : 0.0);
-  }
-  return points;
-}
-
-double DrawInRange(std::mt19937_64& rng, double lo, double hi, double nominal) {
-  const int kind = ht::UniformInt(rng, 0, 99);
-  if (kind < 25) return nominal;
-  if (kind < 45) return lo;
-  if (kind < 65) return hi;
-  return std::clamp(ht::UniformReal(rng, lo, hi), lo, hi);
-}
-
-// The variables that have a rectangular rate in some mode of `a`.
-std::set<std::string> RatedVariables(const ht::RandomHybridAutomaton& a) {
-  std::set<std::string> out;
-  for (const ht::RandomMode& m : a.modes) {
-    for (const ht::RandomRate& r : m.rates) out.insert(r.variable);
-  }
-  return out;
-}
-
-/// A random run of `a` for an attack.
-ConcreteRun DrawAttack(const RandomHybridAutomaton& a, std::mt19937_64& rng) {
-  ConcreteRun run{a, {}, {}, {}, "", {}};
-  RandomHybridAutomaton& c = run.automaton;
-  for (ht::RandomParameter& p : c.parameters) {
-    if (p.range) p.nominal = DrawInRange(rng, p.range->first, p.range->second, p.nominal);
-  }
-  run.parameters = ParameterValues(c);
-  run.print.first_init = ht::UniformInt(rng, 0, static_cast<int>(c.inits.size()) - 1);
-  for (auto& [name, range] : c.inits[run.print.first_init].values) {
-    const double v = DrawInRange(rng, range.first, range.second, range.first);
-    range = {v, v};
-  }
-  const bool has_lazy = std::any_of(c.transitions.begin(), c.transitions.end(), [](const auto& t) {
-    return t.urgency == ht::RandomTransition::Urgency::kLazy;
-  });
-  run.print.lazy_choices = has_lazy && ht::RandomChance(rng, 60);
-  ht::RandomScenario scenario;
-  scenario.until = ht::UniformInt(rng, 5, 300) / 10.0;
-  for (const ht::RandomInput& in : c.inputs) {
-    scenario.steps.emplace_back(in.name, DrawSignal(rng, in.lo, in.hi, scenario.until));
-  }
-  if (run.print.lazy_choices) {
-    for (int i = 0; i < static_cast<int>(c.transitions.size()); ++i) {
-      if (c.transitions[i].urgency != ht::RandomTransition::Urgency::kLazy) continue;
-      scenario.steps.emplace_back(ht::LazyChoiceInput(i), DrawChoice(rng, scenario.until));
-    }
-  }
-  // Rectangular rates: a random rate in the range, segment by segment.
-  run.print.explicit_rates = true;
-  for (const std::string& v : RatedVariables(c)) {
-    scenario.steps.emplace_back(ht::RateInput(v), DrawSignal(rng, 0.0, 1.0, scenario.until));
-  }
-  for (const auto& [name, points] : scenario.steps) {
-    for (const auto& [t, v] : points) run.sample_times.push_back(t);
-  }
-  c.scenario = scenario;
-  run.note = "random attack (init " + std::to_string(run.print.first_init) +
-             (run.print.lazy_choices ? ", lazy transitions at random times)" : ")");
-  return run;
-}
-
-/// The variables and parameters at recorded state `s` of a run of `sim`.
-std::map<std::string, double> StateValues(const Simulator& sim, const StateSample& s,
-                                          const std::map<std::string, double>& parameters) {
-  std::map<std::string, double> values = parameters;
-  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
-    values[sim.variable_names()[i]] = s.x[static_cast<int>(i)];
-  }
-  return values;
-}
-
-/// A simulation of a concrete run: the parsed model text, the simulator and its result.
-struct Simulation {
-  std::string text;
-  std::optional<Simulator> simulator;
-  SimulationResult result;
-  double sample_step = 0.0;
-  std::string error;  // the model or the simulator refused the run
-};
-
-Simulation Simulate(const ConcreteRun& run) {
-  Simulation out;
-  out.text = run.automaton.Text(run.print);
-  try {
-    const System system = ParseModel(out.text, "attack.ha");
-    out.simulator.emplace(system);
-    SimulationOptions options;
-    out.sample_step = run.automaton.scenario->until / 256;
-    options.sample_step = out.sample_step;
-    std::vector<double> times;
-    for (double t : run.sample_times) {
-      if (t >= 0 && t <= run.automaton.scenario->until) times.push_back(t);
-    }
-    std::sort(times.begin(), times.end());
-    times.erase(std::unique(times.begin(), times.end()), times.end());
-    options.sample_times = times;
-    options.lazy_schedule = run.schedule;
-    out.result = out.simulator->Run(options);
-  } catch (const std::exception& e) {
-    out.error = e.what();
-    out.simulator.reset();
-  }
-  return out;
-}
-
-std::string StateText(const Simulator& sim, const StateSample& s) {
-  std::ostringstream out;
-  out.precision(17);
-  out << "t = " << s.time << " in mode " << sim.ModeLabel(s.modes) << ":";
-  for (std::size_t i = 0; i < sim.variable_names().size(); ++i) {
-    out << " " << sim.variable_names()[i] << " = " << s.x[static_cast<int>(i)] << ";";
-  }
-  return out.str();
-}
-
-/// The events of `sim`'s run up to the state `index` and that state, for a report.
-std::string RunText(const Simulation& sim, int index) {
-  std::ostringstream out;
-  out.precision(17);
-  const SimulationResult& r = sim.result;
-  out << "  simulation status: " << StatusName(r.status)
-      << (r.message.empty() ? "" : " (" + r.message + ")") << "\n";
-  const double until = index >= 0 ? r.samples[index].time : INFINITY;
-  std::size_t shown = 0;
-  while (shown < r.events.size() && r.events[shown].time <= until) ++shown;
-  for (std::size_t i = 0; i < shown; ++i) {
-    if (i == 20 && shown > 30) {
-      out << "  ... " << shown - 25 << " more events ...\n";
-      i = shown - 5;
-    }
-    const EventRecord& e = r.events[i];
-    std::string names;
-    for (const std::string& n : e.transitions) names += (names.empty() ? "" : "+") + n;
-    out << "  event t = " << e.time << ": " << names << " ("
-        << sim.simulator->ModeLabel(e.modes_before) << " -> "
-        << sim.simulator->ModeLabel(e.modes_after) << ")\n";
-  }
-  if (index >= 0) out << "  state: " << StateText(*sim.simulator, r.samples[index]) << "\n";
-  out << "  replay: save the text below as attack.ha and run `hybrid simulate attack.ha --sample "
-      << sim.sample_step << "`\n--- attack.ha ---\n"
-      << sim.text;
-  return out.str();
-}
-
-std::string Header(const std::string& what, const std::string& label,
-                   const RandomHybridAutomaton& a, int property, const CheckResult& result) {
-  std::ostringstream out;
-  out << "=== " << what << " (" << label << ") ===\n"
-      << "property: " << a.PropertyText(property) << "\n"
-      << "prover: " << VerdictText(result.verdict) << " (" << result.reason << ")\n"
-      << "--- model (as checked) ---\n"
-      << a.Text();
-  return out.str();
-}
-
-/// Whether the state a simulator starts from in `run` (the first init declaration's mode and
-/// values, an interval at its midpoint) is an initial state of `a`: some init declaration of
-/// that mode admits every value.
-bool StartsInInitialState(const RandomHybridAutomaton& a, const RandomHybridAutomaton& run) {
-  const ht::RandomInit& start = run.inits[0];
-  for (const ht::RandomInit& init : a.inits) {
-    if (init.mode != start.mode) continue;
-    bool inside = true;
-    for (std::size_t v = 0; v < init.values.size(); ++v) {
-      const auto [lo, hi] = init.values[v].second;
-      const double x = (start.values[v].second.first + start.values[v].second.second) / 2;
-      inside = inside && x >= lo - 1e-9 * (1 + std::abs(lo)) && x <= hi + 1e-9 * (1 + std::abs(hi));
-    }
-    if (inside) return true;
-  }
-  return false;
-}
-
-/// The run that a prover's trace describes, as a concrete run. `problem` collects what makes
-/// the trace no run of the model: an unknown or fixed parameter, a parameter outside its range,
-/// a start that is no initial state, a signal that is not a step.
-ConcreteRun TraceRun(const RandomHybridAutomaton& a, const System& system, const Trace& t,
-                     std::string& problem) {
-  ConcreteRun run{a, {}, {}, {}, "the checker's trace, replayed", {}};
-  RandomHybridAutomaton& c = run.automaton;
-  for (const auto& [name, v] : t.parameters) {
-    auto it = std::find_if(c.parameters.begin(), c.parameters.end(),
-                           [&](const auto& p) { return p.name == name; });
-    if (it == c.parameters.end() || !it->range) {
-      problem += "the trace sets '" + name + "', which is no uncertain parameter; ";
-      continue;
-    }
-    const auto [lo, hi] = *it->range;
-    if (v < lo - 1e-9 * (1 + std::abs(lo)) || v > hi + 1e-9 * (1 + std::abs(hi))) {
-      problem += "parameter " + name + " = " + ht::DecimalText(v) + " is outside its range; ";
-    }
-    it->nominal = std::clamp(v, lo, hi);
-  }
-  run.parameters = ParameterValues(c);
-  // The init declaration the trace starts from goes first (the simulator starts from the first).
-  for (const auto& [component, index] : t.initial_states) {
-    if (component != 0 || index < 0 || index >= static_cast<int>(c.inits.size())) {
-      problem += "the trace names initial state " + std::to_string(index) + " of component " +
-                 std::to_string(component) + ", which does not exist; ";
-      continue;
-    }
-    std::rotate(c.inits.begin(), c.inits.begin() + index, c.inits.begin() + index + 1);
-  }
-  for (const auto& [name, v] : t.initial_values) {
-    auto& values = c.inits[0].values;
-    auto it =
-        std::find_if(values.begin(), values.end(), [&](const auto& x) { return x.first == name; });
-    if (it == values.end()) {
-      problem += "the trace sets the initial value of '" + name + "', no variable; ";
-      continue;
-    }
-    it->second = {v, v};
-  }
-  if (!StartsInInitialState(a, c)) {
-    problem +=
-        "the trace starts from a state that no init declaration admits (see the first init of "
-        "the trace text); ";
-  }
-  ht::RandomScenario scenario;
-  scenario.until = t.inputs.until;
-  run.print.explicit_rates = true;
-  for (const InputSignal& signal : t.inputs.inputs) {
-    if (signal.shape != InputSignal::Shape::kStep) problem += "a signal is not a step; ";
-    const std::string& name = system.symbols()[signal.slot].name;
-    if (!name.empty() && name.back() == '\'') {
-      // The rate input x' in [-1, 1] of `x' in [lo, hi]` (rate (lo + hi)/2 + (hi - lo)/2 * w)
-      // is the explicit rate input in [0, 1] at (w + 1) / 2 (rate lo + (hi - lo) * z).
-      std::vector<std::pair<double, double>> points = signal.points;
-      for (auto& [time, w] : points) w = (w + 1) / 2;
-      scenario.steps.emplace_back(ht::RateInput(name.substr(0, name.size() - 1)), points);
-    } else {
-      scenario.steps.emplace_back(name, signal.points);
-    }
-    for (const auto& [time, value] : signal.points) run.sample_times.push_back(time);
-  }
-  for (const std::string& v : RatedVariables(c)) {  // an unlisted rate input is 0: the midpoint
-    const bool listed =
-        std::any_of(scenario.steps.begin(), scenario.steps.end(),
-                    [&](const auto& step) { return step.first == ht::RateInput(v); });
-    if (!listed)
-      scenario.steps.emplace_back(ht::RateInput(v),
-                                  std::vector<std::pair<double, double>>{{0.0, 0.5}});
-  }
-  c.scenario = scenario;
-  run.schedule = t.schedule;  // transition indices: the text keeps the declaration order
-  for (const ScheduledJump& j : t.schedule) run.sample_times.push_back(j.time);
-  if (t.state_index >= 0 && t.state_index < static_cast<int>(t.run.samples.size())) {
-    run.sample_times.push_back(t.run.samples[t.state_index].time);
-  }
-  return run;
-}
-
-/// Replays the trace of a `violated` or `reachable` verdict on property `i` from model text.
-void ConfirmTrace(const RandomHybridAutomaton& a, const System& system, int i, const CheckResult& r,
-                  const std::string& label, Summary& s) {
-  const std::string what = VerdictText(r.verdict);
-  if (!r.trace) {
-    s.contradictions.push_back(Header("`" + what + "` WITHOUT A TRACE", label, a, i, r));
-    return;
-  }
-  std::string problem;
-  const ConcreteRun run = TraceRun(a, system, *r.trace, problem);
-  const Simulation sim = Simulate(run);
-  if (!problem.empty() || !sim.error.empty()) {
-    s.contradictions.push_back(
-        Header("`" + what + "` TRACE IS NO RUN OF THE MODEL", label, a, i, r) +
-        "--- problem ---\n" + problem + sim.error + "\n--- trace text ---\n" + sim.text);
-    return;
-  }
-  const RandomProperty& p = a.properties[i];
-  const auto& samples = sim.result.samples;
-  bool outside = false;
-  for (const StateSample& state : samples) {
-    if (p.within && state.time > *p.within) break;
-    const std::string mode = sim.simulator->ModeLabel(state.modes);
-    const auto values = StateValues(*sim.simulator, state, run.parameters);
-    if (!InsideInvariant(a, mode, values)) {
-      outside = true;  // the run is no run of the model from here on
-      break;
-    }
-    if (Confirms(p, values, mode)) {
-      ++s.replays;
-      return;
-    }
-  }
-  s.contradictions.push_back(
-      Header("`" + what + "` TRACE DOES NOT REPLAY", label, a, i, r) +
-      (outside ? "(the replay leaves its mode's invariant after a jump before it gets there)\n"
-               : "") +
-      "--- replay of the trace ---\n" + RunText(sim, -1));
-}
-
-/// Attacks every `proved` and `unreachable` verdict of `results` (one per property of `a`) with
-/// `attacks` random simulations; each claim is reported at its first contradiction.
-void AttackClaims(const RandomHybridAutomaton& a, const std::vector<CheckResult>& results,
-                  const std::string& label, int attacks, std::mt19937_64& rng, Summary& s) {
-  std::vector<int> open;
-  for (int i = 0; i < static_cast<int>(results.size()); ++i) {
-    if (results[i].verdict == Verdict::kProved || results[i].verdict == Verdict::kUnreachable) {
-      open.push_back(i);
-    }
-  }
-  s.claims += static_cast<int>(open.size());
-  for (int k = 0; k < attacks && !open.empty(); ++k) {
-    const ConcreteRun run = DrawAttack(a, rng);
-    const Simulation sim = Simulate(run);
-    ++s.attacks;
-    if (!sim.error.empty()) {
-      // A drawn start outside its mode's invariant is no run; anything else is a bug of the test
-      // (an attack text that does not parse, a signal out of bounds) or of the simulator.
-      if (sim.error.find("initial state") == std::string::npos) {
-        s.contradictions.push_back("=== ATTACK REFUSED UNEXPECTEDLY (" + label + "): " + sim.error +
-                                   " ===\n" + sim.text);
-      }
-      ++s.rejected;
-      ++s.refusals[sim.error.substr(0, sim.error.find('\''))];
-      continue;
-    }
-    const auto& samples = sim.result.samples;
-    for (int j = 0; j < static_cast<int>(samples.size()) && !open.empty(); ++j) {
-      const auto values = StateValues(*sim.simulator, samples[j], run.parameters);
-      const std::string mode = sim.simulator->ModeLabel(samples[j].modes);
-      if (!InsideInvariant(a, mode, values)) {
-        ++s.outside;  // no state of the model, nor what the simulator records after it
-        break;
-      }
-      ++s.states;
-      for (auto it = open.begin(); it != open.end();) {
-        const RandomProperty& p = a.properties[*it];
-        const CheckResult& r = results[*it];
-        if ((!p.within || samples[j].time <= *p.within) && Refutes(p, r.verdict, values, mode)) {
-          s.contradictions.push_back(
-              Header("CONTRADICTION: `" + VerdictText(r.verdict) + "` refuted by a simulation",
-                     label, a, *it, r) +
-              "--- counterexample: " + run.note + " ---\n" + RunText(sim, j));
-          it = open.erase(it);
-        } else {
-          ++it;
-        }
-      }
-    }
-  }
-}
-
-/// Checks `a` as `hybrid check --method prove` does, confirms every trace and attacks every
-/// claim.
 // A checker under test: every declared property of a system, one result each.
-using Checker = std::function<std::vector<CheckResult>(const System&)>;
-
 std::vector<CheckResult> Prove(const System& system) {
   return PropertyProver(ProverOptions()).Check(system, DeclaredProperties(system));
 }
@@ -613,66 +95,6 @@ std::vector<CheckResult> Reach(const System& system) {
   PolyhedralReachability::Options options;
   options.max_states = 2000;
   return PolyhedralReachability(options).Check(system, DeclaredProperties(system));
-}
-
-void CheckAutomaton(const RandomHybridAutomaton& a, const std::string& label, int attacks,
-                    std::mt19937_64& rng, Summary& s, const Checker& check = Prove) {
-  ++s.models;
-  const std::string text = a.Text();
-  std::optional<System> system;
-  try {
-    system.emplace(ParseModel(text, label + ".ha"));
-  } catch (const std::exception& e) {
-    s.contradictions.push_back("=== GENERATED MODEL DOES NOT PARSE (" + label + ") ===\n" +
-                               e.what() + "\n" + text);
-    return;
-  }
-  const auto start = std::chrono::steady_clock::now();
-  std::vector<CheckResult> results;
-  try {
-    results = check(*system);
-  } catch (const std::exception& e) {
-    s.contradictions.push_back("=== PROVER THREW (" + label + "): " + e.what() + " ===\n" + text);
-    return;
-  }
-  const auto proved = std::chrono::steady_clock::now();
-  s.prover_seconds += std::chrono::duration<double>(proved - start).count();
-  std::vector<CheckResult> by_property;
-  for (const RandomProperty& p : a.properties) {
-    auto it = std::find_if(results.begin(), results.end(),
-                           [&](const CheckResult& r) { return r.property == p.name; });
-    if (it == results.end()) {
-      s.contradictions.push_back("=== NO RESULT FOR '" + p.name + "' (" + label + ") ===\n" + text);
-      return;
-    }
-    by_property.push_back(*it);
-    ++s.verdicts[KindName(p.kind) + " " + VerdictText(it->verdict)];
-  }
-  for (int i = 0; i < static_cast<int>(by_property.size()); ++i) {
-    const Verdict v = by_property[i].verdict;
-    if (v == Verdict::kViolated || v == Verdict::kReachable) {
-      ConfirmTrace(a, *system, i, by_property[i], label, s);
-    }
-  }
-  AttackClaims(a, by_property, label, attacks, rng, s);
-  s.attack_seconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - proved).count();
-}
-
-std::string SummaryText(const Settings& settings, std::size_t known, const Summary& s) {
-  std::ostringstream out;
-  out.precision(3);
-  out << "soundness: seed " << settings.seed << ", " << settings.models << " random models from "
-      << settings.first << " (+" << known << " known cases), " << s.models
-      << " checked\n  verdicts:";
-  for (const auto& [kind, count] : s.verdicts) out << " " << kind << " " << count << ";";
-  out << "\n  claims attacked " << s.claims << ", attacks " << s.attacks << " (" << s.rejected
-      << " refused by the model), states checked " << s.states << ", traces replayed " << s.replays
-      << "\n  runs cut at a jump outside the target mode's invariant " << s.outside << "\n";
-  for (const auto& [why, count] : s.refusals) out << "  refused " << count << "x: " << why << "\n";
-  out << "  contradictions " << s.contradictions.size() << "\n  prover " << s.prover_seconds
-      << " s, attacks and replays " << s.attack_seconds << " s\n";
-  return out.str();
 }
 
 /// The model of issue 12: the tank rises at 0.3 to 0.5 per second, yet an input named `d`
@@ -877,17 +299,17 @@ TEST(SoundnessTest, ReplaysCheckTraces) {
   r.trace->inputs.until = 1.0;  // h reaches at most 5.5
   r.trace->inputs.inputs = {{*input, InputSignal::Shape::kStep, {{0.0, 0.0}}}};
   Summary forged;
-  ConfirmTrace(tank, system, 0, r, "forged", forged);
+  ht::ReplayTraceBySimulation(tank, system, 0, r, "forged", forged);
   ASSERT_EQ(forged.contradictions.size(), 1u);
   EXPECT_NE(forged.contradictions[0].find("TRACE DOES NOT REPLAY"), std::string::npos);
   r.trace->inputs.until = 3.0;  // h reaches 6.5
   Summary genuine;
-  ConfirmTrace(tank, system, 0, r, "genuine", genuine);
+  ht::ReplayTraceBySimulation(tank, system, 0, r, "genuine", genuine);
   EXPECT_TRUE(genuine.contradictions.empty()) << genuine.contradictions[0];
   EXPECT_EQ(genuine.replays, 1);
   r.trace->inputs.inputs[0].points = {{0.0, 0.5}};  // outside d's bounds
   Summary outside;
-  ConfirmTrace(tank, system, 0, r, "outside", outside);
+  ht::ReplayTraceBySimulation(tank, system, 0, r, "outside", outside);
   ASSERT_EQ(outside.contradictions.size(), 1u);
   EXPECT_NE(outside.contradictions[0].find("IS NO RUN OF THE MODEL"), std::string::npos);
 }
