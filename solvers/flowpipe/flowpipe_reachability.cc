@@ -169,6 +169,19 @@ std::vector<CheckResult> FlowpipeReachability::Check(const System& system,
     throw std::invalid_argument("the flowpipe budget (steps, entries, symbols) must be positive");
   }
   const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!Handles(system, properties, &why)) {  // e.g. --method flowpipe on a model it cannot read
+    std::vector<CheckResult> results;
+    for (const Property& p : properties) {
+      CheckResult r;
+      r.property = p.name;
+      r.kind = p.kind;
+      r.method = "flowpipe";
+      r.reason = "the flowpipe engine does not apply: " + why;
+      results.push_back(std::move(r));
+    }
+    return results;
+  }
   flowpipe_internal::RoundingGuard rounding;
   FlowpipeModel model(system);
   const double cap = TimeCap(system, properties);

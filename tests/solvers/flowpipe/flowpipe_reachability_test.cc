@@ -219,6 +219,11 @@ TEST(FlowpipeReachability, HandlesSaysWhichFlowIsNotPolynomial) {
   EXPECT_FALSE(FlowpipeReachability::Handles(s, s.properties(), &why));
   EXPECT_NE(why.find("sin(a)"), std::string::npos) << why;
   EXPECT_NE(why.find("swing"), std::string::npos) << why;
+  // Asked anyway (--method flowpipe), it answers unknown at once, saying why.
+  const std::vector<CheckResult> r = CheckAll(s);
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0].verdict, Verdict::kUnknown);
+  EXPECT_NE(r[0].reason.find("sin(a)"), std::string::npos) << r[0].reason;
 }
 
 TEST(FlowpipeReachability, BadOptionsAreRefused) {
