@@ -285,7 +285,8 @@ std::unique_ptr<PropertyChecker> MakeFlowpipe(MethodContext& c) {
   FlowpipeReachability::Options options;
   options.max_steps =
       static_cast<std::int64_t>(std::ceil(c.args.budget * kFlowpipeStepsPerBudgetSecond));
-  options.max_entries = std::max(50, static_cast<int>(c.args.budget * kFlowpipeEntriesPerBudgetSecond));
+  options.max_entries =
+      std::max(50, static_cast<int>(c.args.budget * kFlowpipeEntriesPerBudgetSecond));
   options.order = c.args.order;
   options.step = c.args.step;
   // Before splitting initial sets for a property, a few simulations: a violation they find
