@@ -91,7 +91,7 @@ CheckResult Result(const Property& p, std::size_t k, const Exploration& ex, doub
 
 // Splits every box in two along its widest component (state components: variables and
 // uncertain parameters); false when no box has width left.
-bool SplitAll(std::vector<FlowpipeModel::Initial>& pieces, int) {
+bool SplitAll(std::vector<FlowpipeModel::Initial>& pieces) {
   std::vector<FlowpipeModel::Initial> out;
   bool split = false;
   for (const FlowpipeModel::Initial& p : pieces) {
@@ -235,7 +235,7 @@ std::vector<CheckResult> FlowpipeReachability::Check(const System& system,
     if (!open || total.steps >= options_.max_steps ||
         static_cast<int>(pieces.size()) * 2 > options_.max_pieces)
       break;
-    if (!SplitAll(pieces, model.num_variables())) break;
+    if (!SplitAll(pieces)) break;
   }
   std::vector<CheckResult> results;
   for (std::size_t k = 0; k < properties.size(); ++k)

@@ -175,7 +175,6 @@ std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, d
   out.segment.ComputeBox(*apriori);
   // The set at h: sum_k h^k x_k + the remainder; the error terms become new symbols.
   out.end.resize(n);
-  std::size_t m = 0;
   for (std::size_t i = 0; i < n; ++i) {
     AffineForm sum = out.segment.series[0][i];
     TightInterval hk(1.0);  // h^k (a point when h is a power of two)
@@ -185,10 +184,9 @@ std::optional<StepResult> FlowpipeStep::Take(const std::vector<AffineForm>& x, d
       sum = sum + (hk.lo == hk.hi ? xk.Scaled(hk.lo) : xk.Scaled(hk));
     }
     out.end[i] = sum.PlusInterval(end_remainder[i]);
-    m = std::max(m, out.end[i].coefficients().size());
   }
   Reduce(out.end);
-  m = 0;
+  std::size_t m = 0;
   for (const AffineForm& f : out.end) m = std::max(m, f.coefficients().size());
   for (std::size_t i = 0; i < n; ++i) out.end[i].ErrorToSymbol(static_cast<int>(m + i));
   return out;

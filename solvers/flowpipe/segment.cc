@@ -78,8 +78,8 @@ void Segment::ComputeBox(const std::vector<TightInterval>& apriori) {
     unit[i] = 1.0;
     TightInterval b = LinearBound(unit);
     unit[i] = 0.0;
+    // Both enclose the same states, so they meet (up to the outward rounding of each).
     if (i < apriori.size()) b = {std::max(b.lo, apriori[i].lo), std::min(b.hi, apriori[i].hi)};
-    if (b.lo > b.hi) b = i < apriori.size() ? apriori[i] : b;  // cannot happen for sound bounds
     box[i] = b;
   }
 }

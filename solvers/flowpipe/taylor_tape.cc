@@ -1,7 +1,6 @@
 #include "solvers/flowpipe/taylor_tape.h"
 
 #include <cmath>
-#include <map>
 
 #include "solvers/flowpipe/affine_form.h"
 
@@ -30,10 +29,6 @@ TightInterval Zero<TightInterval>() {
 
 AffineForm Square(const AffineForm& a) { return a.Square(); }
 TightInterval Square(const TightInterval& a) { return Power(a, 2); }
-
-struct BuildState {
-  std::map<const void*, int> memo;
-};
 
 }  // namespace
 

@@ -58,21 +58,7 @@ std::string KindName(RandomProperty::Kind k) {
   return "?";
 }
 
-std::string VerdictText(Verdict v) {
-  switch (v) {
-    case Verdict::kProved:
-      return "proved";
-    case Verdict::kViolated:
-      return "violated";
-    case Verdict::kReachable:
-      return "reachable";
-    case Verdict::kUnreachable:
-      return "unreachable";
-    case Verdict::kUnknown:
-      return "unknown";
-  }
-  return "?";
-}
+std::string VerdictText(Verdict v) { return std::string(VerdictName(v)); }
 
 bool Refutes(const RandomProperty& p, Verdict verdict, const std::map<std::string, double>& values,
              const std::string& mode) {
@@ -302,8 +288,10 @@ std::string StateText(const Simulator& sim, const StateSample& s) {
   return out.str();
 }
 
-/// The events of `sim`'s run up to the state `index` and that state, for a report.
-std::string RunText(const Simulation& sim, int index) {
+// The status and events of a run up to the state `index`, that state (`state`), and the model
+// text to replay it (saved as `file`): the report of one attack, of an automaton or a system.
+template <class Sim, class StateTextOf>
+std::string RunReport(const Sim& sim, int index, StateTextOf state_text, const std::string& file) {
   std::ostringstream out;
   out.precision(17);
   const SimulationResult& r = sim.result;
@@ -324,11 +312,18 @@ std::string RunText(const Simulation& sim, int index) {
         << sim.simulator->ModeLabel(e.modes_before) << " -> "
         << sim.simulator->ModeLabel(e.modes_after) << ")\n";
   }
-  if (index >= 0) out << "  state: " << StateText(*sim.simulator, r.samples[index]) << "\n";
-  out << "  replay: save the text below as attack.ha and run `hybrid simulate attack.ha --sample "
-      << sim.sample_step << "`\n--- attack.ha ---\n"
+  if (index >= 0) out << "  state: " << state_text(*sim.simulator, r.samples[index]) << "\n";
+  out << "  replay: save the text below as " << file << " and run `hybrid simulate " << file
+      << " --sample " << sim.sample_step << "`\n--- " << file << " ---\n"
       << sim.text;
   return out.str();
+}
+
+/// The events of `sim`'s run up to the state `index` and that state, for a report.
+std::string RunText(const Simulation& sim, int index) {
+  return RunReport(
+      sim, index, [](const Simulator& s, const StateSample& x) { return StateText(s, x); },
+      "attack.ha");
 }
 
 std::string Header(const std::string& what, const std::string& label,
@@ -767,31 +762,9 @@ std::string SystemStateText(const Simulator& sim, const StateSample& x) {
 }  // namespace
 
 std::string SystemRunText(const SystemSimulation& sim, int index) {
-  std::ostringstream out;
-  out.precision(17);
-  const SimulationResult& r = sim.result;
-  out << "  simulation status: " << StatusName(r.status)
-      << (r.message.empty() ? "" : " (" + r.message + ")") << "\n";
-  const double until = index >= 0 ? r.samples[index].time : INFINITY;
-  std::size_t shown = 0;
-  while (shown < r.events.size() && r.events[shown].time <= until) ++shown;
-  for (std::size_t i = 0; i < shown; ++i) {
-    if (i == 20 && shown > 30) {
-      out << "  ... " << shown - 25 << " more events ...\n";
-      i = shown - 5;
-    }
-    const EventRecord& e = r.events[i];
-    std::string names;
-    for (const std::string& n : e.transitions) names += (names.empty() ? "" : "+") + n;
-    out << "  event t = " << e.time << ": " << names << " ("
-        << sim.simulator->ModeLabel(e.modes_before) << " -> "
-        << sim.simulator->ModeLabel(e.modes_after) << ")\n";
-  }
-  if (index >= 0) out << "  state: " << SystemStateText(*sim.simulator, r.samples[index]) << "\n";
-  out << "  replay: save the text below as run.ha and run `hybrid simulate run.ha --sample "
-      << sim.sample_step << "`\n--- run.ha ---\n"
-      << sim.text;
-  return out.str();
+  return RunReport(
+      sim, index, [](const Simulator& s, const StateSample& x) { return SystemStateText(s, x); },
+      "run.ha");
 }
 
 bool RefutesInModes(const RandomProperty& p, Verdict verdict,
