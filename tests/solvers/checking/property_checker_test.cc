@@ -38,12 +38,15 @@ class ScriptedChecker : public PropertyChecker {
       r.seconds = 1.0;
       const auto it = script_.find(p.name);
       r.verdict = it == script_.end() ? Verdict::kUnknown : it->second;
+      if (const auto w = within_.find(p.name); w != within_.end()) r.within = w->second;
       r.reason = name_ + " says so";
       out.push_back(r);
     }
     return out;
   }
   std::shared_ptr<std::vector<std::string>> asked = std::make_shared<std::vector<std::string>>();
+  /// Properties whose verdict covers the runs up to a time only (CheckResult::within).
+  std::map<std::string, double> within_;
 
  private:
   std::string name_;
@@ -102,6 +105,36 @@ TEST(FallbackChecker, AsksLaterCheckersOnlyWhatIsUnknown) {
   EXPECT_EQ(results[2].verdict, Verdict::kUnknown);
   EXPECT_EQ(results[2].reason, "reach says so; prove: prove says so");
   EXPECT_DOUBLE_EQ(results[2].seconds, 2.0);
+}
+
+// A proof up to a time only (a flowpipe's `proved within T`) stays open: a later checker is asked,
+// and a violation it finds, or a proof for longer, replaces it; its `unknown` does not.
+TEST(FallbackChecker, BoundedProofsAreAskedAgainAndImprovedOnly) {
+  auto flowpipe = std::make_unique<ScriptedChecker>(
+      "flowpipe", std::map<std::string, Verdict>{{"a", Verdict::kProved},
+                                                 {"b", Verdict::kProved},
+                                                 {"c", Verdict::kProved},
+                                                 {"d", Verdict::kProved}});
+  flowpipe->within_ = {{"a", 5.0}, {"b", 5.0}, {"c", 5.0}};
+  auto sample = std::make_unique<ScriptedChecker>(
+      "sample", std::map<std::string, Verdict>{{"a", Verdict::kViolated}, {"c", Verdict::kProved}});
+  sample->within_ = {{"c", 9.0}};
+  const auto sample_asked = sample->asked;
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(std::move(flowpipe));
+  checkers.push_back(std::move(sample));
+  FallbackChecker fallback("auto", std::move(checkers));
+  const System system("s");
+  const std::vector<CheckResult> r = fallback.Check(system, Named({"a", "b", "c", "d"}));
+  EXPECT_EQ(*sample_asked, (std::vector<std::string>{"sample:a", "sample:b", "sample:c"}));
+  EXPECT_EQ(r[0].verdict, Verdict::kViolated);
+  EXPECT_EQ(r[0].method, "sample");
+  EXPECT_EQ(r[1].verdict, Verdict::kProved);  // sample's unknown leaves the bounded proof
+  EXPECT_EQ(r[1].within, 5.0);
+  EXPECT_EQ(r[1].reason, "flowpipe says so");
+  EXPECT_EQ(r[2].within, 9.0);  // proved for longer
+  EXPECT_FALSE(r[3].within.has_value());
+  EXPECT_EQ(r[3].method, "flowpipe");
 }
 
 TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {
