@@ -151,6 +151,18 @@ AffineForm AffineForm::operator/(const AffineForm& b) const {
 
 AffineForm AffineForm::PlusInterval(const TightInterval& x) const { return *this + OfInterval(x); }
 
+AffineForm AffineForm::WithoutSymbol(std::size_t symbol) const {
+  AffineForm f = *this;
+  if (symbol < f.g_.size()) f.g_[symbol] = 0.0;
+  return f;
+}
+
+AffineForm AffineForm::WithoutError() const {
+  AffineForm f = *this;
+  f.err_ = 0.0;
+  return f;
+}
+
 void AffineForm::MergeSymbols(const std::vector<char>& merge) {
   for (std::size_t i = 0; i < g_.size() && i < merge.size(); ++i) {
     if (merge[i] && g_[i] != 0) {

@@ -53,6 +53,11 @@ class AffineForm {
   /// this + [lo, hi] (an independent interval).
   AffineForm PlusInterval(const TightInterval& x) const;
 
+  /// The form with symbol `symbol`'s coefficient set to 0.
+  AffineForm WithoutSymbol(std::size_t symbol) const;
+  /// The form with its error term set to 0 (its affine part).
+  AffineForm WithoutError() const;
+
   /// Moves the coefficient of every symbol in `merge` (flags, true to merge) into err.
   void MergeSymbols(const std::vector<char>& merge);
   /// Keeps the symbols in `keep` (old index -> new index or -1 to merge into err).

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solvers/flowpipe/crossing_form.h"
+
 namespace hybrid::flowpipe_internal {
 namespace {
 
@@ -22,6 +24,28 @@ Segment BoxSegment(std::vector<TightInterval> box) {
   Segment s;
   s.box = std::move(box);
   return s;
+}
+
+// The smallest power of two >= x (x > 0).
+double PowerOfTwoAbove(double x) {
+  const double below = PowerOfTwoBelow(x);
+  return below == x ? x : 2 * below;
+}
+
+// Replaces the form of every component whose range is more than twice as wide as the box by
+// a fresh symbol over the box (a point when the box is one): the box's states in the forms
+// stay, each component's correlations are kept only where they are worth more than the box.
+void ClipToBox(std::vector<AffineForm>& form, const std::vector<TightInterval>& box) {
+  std::size_t next_symbol = 0;
+  for (const AffineForm& f : form) next_symbol = std::max(next_symbol, f.coefficients().size());
+  for (std::size_t i = 0; i < form.size(); ++i) {
+    const TightInterval r = form[i].Range();
+    if (r.hi - r.lo <= 2 * (box[i].hi - box[i].lo)) continue;
+    form[i] =
+        box[i].lo == box[i].hi
+            ? AffineForm(box[i].lo)
+            : AffineForm::Symbol(box[i].Mid(), static_cast<int>(next_symbol++), box[i].RadiusUp());
+  }
 }
 
 }  // namespace
@@ -49,7 +73,7 @@ void Exploration::StopAt(double t, const std::string& why) {
 }
 
 void Exploration::Run(std::vector<FlowpipeModel::Initial> initials) {
-  for (FlowpipeModel::Initial& init : initials) Push({init.mode, std::move(init.box), 0.0});
+  for (FlowpipeModel::Initial& init : initials) Push({init.mode, std::move(init.box), 0.0, {}});
   while (!queue_.empty()) {
     const Entry entry = queue_.top();
     queue_.pop();
@@ -78,20 +102,34 @@ void Exploration::Run(std::vector<FlowpipeModel::Initial> initials) {
 }
 
 bool Exploration::AlreadyExplored(const Entry& entry) const {
+  return Covering(entry, /*boxes_only=*/true) != nullptr;
+}
+
+const Exploration::Entry* Exploration::Covering(const Entry& entry, bool boxes_only) const {
   const auto it = explored_.find(entry.mode);
-  if (it == explored_.end()) return false;
+  if (it == explored_.end()) return nullptr;
   for (const Entry& old : it->second) {
-    if (old.t0 > entry.t0) continue;
+    if (old.t0 > entry.t0 || (boxes_only && !old.form.empty())) continue;
     bool inside = true;
     for (std::size_t i = 0; i < entry.box.size() && inside; ++i)
       inside = old.box[i].Contains(entry.box[i]);
-    if (inside) return true;
+    if (inside) return &old;
   }
-  return false;
+  return nullptr;
 }
 
 void Exploration::Push(Entry entry) {
-  if (!AlreadyExplored(entry)) queue_.push(std::move(entry));
+  if (AlreadyExplored(entry)) return;
+  if (!entry.form.empty()) {
+    // An entry explored from its forms covers only the part of its box they hold, so a later
+    // set inside that box is not known to be covered: it is explored from the whole box instead
+    // (once: that box then covers every later set inside it), which keeps the fixpoint.
+    if (const Entry* old = Covering(entry, /*boxes_only=*/false)) {
+      entry.box = old->box;
+      entry.form.clear();
+    }
+  }
+  queue_.push(std::move(entry));
 }
 
 bool Exploration::InsideUrgentGuard(const Segment& segment,
@@ -137,14 +175,19 @@ void Exploration::Explore(const Entry& entry) {
                            model_.ComponentName(static_cast<int>(i)) + "'");
       return;
     }
-    x[i] = box[i].lo == box[i].hi
-               ? AffineForm(box[i].lo)
-               : AffineForm::Symbol(box[i].Mid(), static_cast<int>(i), box[i].RadiusUp());
+    if (!entry.form.empty()) {
+      x[i] = entry.form[i];
+    } else {
+      x[i] = box[i].lo == box[i].hi
+                 ? AffineForm(box[i].lo)
+                 : AffineForm::Symbol(box[i].Mid(), static_cast<int>(i), box[i].RadiusUp());
+    }
     protect[i] = static_cast<int>(i) >= model_.num_variables();
   }
   const int max_symbols =
       options_.max_symbols > 0 ? options_.max_symbols : 10 * static_cast<int>(dim);
   const FlowpipeStep stepper(*mode.tape, model_.input_box(), options_.order, protect, max_symbols);
+  stepper_ = &stepper;
   const double h0 = options_.step > 0 ? PowerOfTwoBelow(options_.step) : stepper.SuggestedStep(box);
   double h = h0, t = 0.0;
   std::vector<Crossing> crossings(mode.jumps.size());
@@ -168,7 +211,8 @@ void Exploration::Explore(const Entry& entry) {
     if (model_.HoldsAll(mode.invariant, start, mode.env) == Truth::kFalse) break;
     if (local_steps == 0) CheckProperties(start, mode, entry.t0, entry.t0);  // the entry itself
     if (InsideUrgentGuard(start, mode)) {
-      if (local_steps == 0) Visit(start, entry.mode, entry.t0, entry.t0, crossings, &hull);
+      if (local_steps == 0)
+        Visit(start, entry.mode, entry.t0, entry.t0, crossings, &hull, {&x, &known});
       break;
     }
     // A step ends at the next horizon of a `within T` property, so that no segment reaches past it.
@@ -190,7 +234,8 @@ void Exploration::Explore(const Entry& entry) {
     }
     ++steps_;
     ++local_steps;
-    if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + length, crossings, &hull))
+    if (!Visit(step->segment, entry.mode, entry.t0 + t, entry.t0 + t + length, crossings, &hull,
+               {&x, &known}))
       break;
     x = std::move(step->end);
     known = std::move(step->segment.box);  // holds the next start set too
@@ -200,7 +245,7 @@ void Exploration::Explore(const Entry& entry) {
       std::vector<TightInterval> invariant_box = hull;
       if (InvariantBox(entry.mode, invariant_box, entry.t0 + t)) {
         Visit(BoxSegment(invariant_box), entry.mode, entry.t0 + t,
-              std::numeric_limits<double>::infinity(), crossings, nullptr);
+              std::numeric_limits<double>::infinity(), crossings, nullptr, {});
         break;
       }
     }
@@ -208,10 +253,12 @@ void Exploration::Explore(const Entry& entry) {
   for (std::size_t j = 0; j < crossings.size(); ++j) {
     if (crossings[j].open) CloseCrossing(entry.mode, static_cast<int>(j), crossings[j]);
   }
+  stepper_ = nullptr;
 }
 
 bool Exploration::Visit(const Segment& segment, int mode_index, double t, double t_end,
-                        std::vector<Crossing>& crossings, std::vector<TightInterval>* hull) {
+                        std::vector<Crossing>& crossings, std::vector<TightInterval>* hull,
+                        const StepStart& from) {
   const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
   Segment s = segment;
   const Truth inside = model_.HoldsAll(mode.invariant, s, mode.env);
@@ -239,9 +286,14 @@ bool Exploration::Visit(const Segment& segment, int mode_index, double t, double
       c.open = true;
       c.box = box;
       c.t0 = t;
+      c.formless = from.x == nullptr;
+      c.start = from.x ? *from.x : std::vector<AffineForm>{};
+      c.start_known = from.known ? *from.known : std::vector<TightInterval>{};
     } else {
       for (std::size_t i = 0; i < box.size(); ++i) c.box[i] = Hull(c.box[i], box[i]);
+      c.formless = c.formless || from.x == nullptr;
     }
+    c.t_end = t_end;
   }
   return true;
 }
@@ -295,9 +347,50 @@ void Exploration::CloseCrossing(int mode_index, int jump_index, Crossing& crossi
     if (component >= 0)
       next[static_cast<std::size_t>(component)] = model_.Value(value, crossing.box, mode.env);
   }
+  std::optional<std::vector<AffineForm>> crossing_form =
+      FormOfCrossing(mode_index, jump_index, crossing);
+  if (!crossing_form) return;  // no state of the flow meets the guard
+  std::vector<AffineForm> form = std::move(*crossing_form);
+  if (!form.empty()) {
+    // The same reset over the forms: it keeps the correlations the box above loses.
+    std::vector<AffineForm> after = form;
+    for (const auto& [component, value] : jump.resets) {
+      if (component >= 0)
+        after[static_cast<std::size_t>(component)] = model_.FormValue(value, form, mode.env);
+    }
+    // Both enclose the states after the jump.
+    for (std::size_t i = 0; i < next.size(); ++i) {
+      const TightInterval r = after[i].Range();
+      next[i] = {std::max(next[i].lo, r.lo), std::min(next[i].hi, r.hi)};
+      if (next[i].lo > next[i].hi) return;
+    }
+    form = std::move(after);
+  }
   const FlowpipeModel::CompiledMode& target = model_.Mode(jump.target);
   if (!model_.Contract(target.invariant, next, target.env)) return;
-  Push({jump.target, std::move(next), crossing.t0});
+  if (!form.empty()) ClipToBox(form, next);
+  Push({jump.target, std::move(next), crossing.t0, std::move(form)});
+}
+
+std::optional<std::vector<AffineForm>> Exploration::FormOfCrossing(int mode_index, int jump_index,
+                                                                   const Crossing& crossing) {
+  if (crossing.formless || crossing.start.empty() || !stepper_) return std::vector<AffineForm>{};
+  if (crossing.t_end <= crossing.t0) return crossing.start;
+  // One step from the crossing's first start set over the whole crossing (or a little more):
+  // its segment holds every crossing state, over the symbols of that one start set.
+  const double h = PowerOfTwoAbove(crossing.t_end - crossing.t0);
+  std::optional<StepResult> step = stepper_->Take(crossing.start, h, crossing.start_known);
+  if (!step) return std::vector<AffineForm>{};
+  ++steps_;
+  const FlowpipeModel::CompiledMode& mode = model_.Mode(mode_index);
+  const FlowpipeModel::Jump& jump = mode.jumps[static_cast<std::size_t>(jump_index)];
+  const CrossingForm crossing_form(model_, mode.env);
+  const std::optional<Segment> window =
+      crossing_form.Window(step->segment, jump.guard_and_invariant);
+  if (!window) return std::nullopt;
+  int time_symbol = 0;
+  const std::vector<AffineForm> y = CrossingForm::OfSegment(*window, time_symbol);
+  return crossing_form.OnGuard(y, time_symbol, jump.guard_and_invariant, crossing.box);
 }
 
 bool Exploration::InvariantBox(int mode_index, std::vector<TightInterval>& box, double t) const {

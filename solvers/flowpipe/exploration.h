@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <optional>
 #include <queue>
 #include <span>
 #include <string>
@@ -46,30 +47,55 @@ class Exploration {
   const std::string& stop_reason() const { return stop_reason_; }
 
  private:
+  // A set entering a mode at time t0: the box, or (when `form` is not empty) the states of the
+  // affine forms inside the box.
   struct Entry {
     int mode = -1;
     std::vector<TightInterval> box;
     double t0 = 0.0;
+    std::vector<AffineForm> form;
   };
   struct Later {
     bool operator()(const Entry& a, const Entry& b) const { return a.t0 > b.t0; }
   };
+  // The states of one jump's guard met by consecutive segments from t0 to t_end: their box,
+  // and the start set of the first of them (its forms and a box holding it), from which
+  // CrossingForm steps over the whole crossing; `formless` when a segment had no start set.
   struct Crossing {
     bool open = false;
     std::vector<TightInterval> box;
     double t0 = 0.0;
+    double t_end = 0.0;
+    std::vector<AffineForm> start;
+    std::vector<TightInterval> start_known;
+    bool formless = false;
+  };
+  // The start set of a segment: its forms and a box known to hold it (null for a segment that is
+  // a box only).
+  struct StepStart {
+    const std::vector<AffineForm>* x = nullptr;
+    const std::vector<TightInterval>* known = nullptr;
   };
 
   void Explore(const Entry& entry);
+  // Whether an explored box entry from no later a time holds the entry's box.
   bool AlreadyExplored(const Entry& entry) const;
+  // An explored entry from no later a time whose box holds the entry's box (a box entry only,
+  // when `boxes_only`), or null.
+  const Entry* Covering(const Entry& entry, bool boxes_only) const;
   void Push(Entry entry);
   // Checks a segment of mode `mode` from global time t against the properties, the guards and
   // the reach set; false when the segment holds no state (outside the invariant).
   bool Visit(const Segment& segment, int mode, double t, double t_end,
-             std::vector<Crossing>& crossings, std::vector<TightInterval>* hull);
+             std::vector<Crossing>& crossings, std::vector<TightInterval>* hull,
+             const StepStart& from);
   void CheckProperties(const Segment& segment, const FlowpipeModel::CompiledMode& mode, double t,
                        double t_end);
   void CloseCrossing(int mode, int jump, Crossing& crossing);
+  // Affine forms holding every state of the crossing: empty when none are found (the box
+  // alone then holds them), nullopt when the crossing is found to hold no state.
+  std::optional<std::vector<AffineForm>> FormOfCrossing(int mode, int jump,
+                                                        const Crossing& crossing);
   // A positively invariant box around `box` (the flow from time t on), if one is found.
   bool InvariantBox(int mode, std::vector<TightInterval>& box, double t) const;
   bool MayMeetUrgentGuard(const Segment& segment, const FlowpipeModel::CompiledMode& mode) const;
@@ -95,6 +121,7 @@ class Exploration {
   std::int64_t steps_ = 0;
   int entries_ = 0;
   std::string stop_reason_;
+  const FlowpipeStep* stepper_ = nullptr;  // the flow of the mode Explore is in
 };
 
 }  // namespace hybrid::flowpipe_internal

@@ -258,6 +258,75 @@ TightInterval FlowpipeModel::Value(const Residual& r, const std::vector<TightInt
   return EvaluateTight(r.expression, EnvironmentOf(box, env));
 }
 
+namespace {
+
+// Whether the form has no symbol: a number with an error interval.
+bool IsConstantForm(const AffineForm& f) {
+  return std::all_of(f.coefficients().begin(), f.coefficients().end(),
+                     [](double g) { return g == 0; });
+}
+
+// e in affine arithmetic (FlowpipeModel::FormValue): `state` maps a slot to its state
+// component or -1, `x` holds the components' forms, `env` the other slots.
+AffineForm EvaluateForm(const Expression& e, const std::vector<int>& state,
+                        const std::vector<AffineForm>& x, const std::vector<TightInterval>& env) {
+  const auto arg = [&](int i) {
+    return EvaluateForm(e.args()[static_cast<std::size_t>(i)], state, x, env);
+  };
+  switch (e.op()) {
+    case Op::kConstant:
+      return AffineForm(e.constant());
+    case Op::kSymbol: {
+      const int i = state[static_cast<std::size_t>(e.slot())];
+      return i >= 0 ? x[static_cast<std::size_t>(i)]
+                    : AffineForm::OfInterval(env.at(static_cast<std::size_t>(e.slot())));
+    }
+    case Op::kNeg:
+      return -arg(0);
+    case Op::kAdd:
+      return arg(0) + arg(1);
+    case Op::kSub:
+      return arg(0) - arg(1);
+    case Op::kMul: {
+      const AffineForm a = arg(0), b = arg(1);
+      if (IsConstantForm(a)) return b.Scaled(a.Range());
+      if (IsConstantForm(b)) return a.Scaled(b.Range());
+      return a * b;
+    }
+    case Op::kDiv: {
+      const AffineForm a = arg(0), b = arg(1);
+      if (IsConstantForm(b)) return a.Scaled(TightInterval(1.0) / b.Range());
+      return a / b;
+    }
+    case Op::kPow: {
+      const Expression& p = e.args()[1];
+      if (p.is_constant() && p.constant() >= 0 && p.constant() <= 64 &&
+          p.constant() == std::floor(p.constant())) {
+        const AffineForm a = arg(0);
+        AffineForm y(1.0);
+        for (int k = 0; k < static_cast<int>(p.constant()); ++k) y = y * a;
+        return y;
+      }
+      break;
+    }
+    default:
+      break;
+  }
+  // Any other function: its interval value over the ranges of its arguments' forms.
+  std::vector<TightInterval> ranges = env;
+  for (std::size_t slot = 0; slot < state.size() && slot < ranges.size(); ++slot) {
+    if (state[slot] >= 0) ranges[slot] = x[static_cast<std::size_t>(state[slot])].Range();
+  }
+  return AffineForm::OfInterval(EvaluateTight(e, ranges));
+}
+
+}  // namespace
+
+AffineForm FlowpipeModel::FormValue(const Residual& r, const std::vector<AffineForm>& x,
+                                    const std::vector<TightInterval>& env) const {
+  return EvaluateForm(r.expression, slots_.state, x, env);
+}
+
 TightInterval FlowpipeModel::Bound(const Residual& r, const Segment& segment,
                                    const std::vector<TightInterval>& env) const {
   TightInterval value = Value(r, segment.box, env);

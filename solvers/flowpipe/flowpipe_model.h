@@ -108,6 +108,12 @@ class FlowpipeModel {
   /// The value of `r`'s expression over `box` (an enclosure).
   TightInterval Value(const Residual& r, const std::vector<TightInterval>& box,
                       const std::vector<TightInterval>& env) const;
+  /// The value of `r`'s expression over the states of the forms `x` (one per state component),
+  /// in affine arithmetic: an affine expression keeps the forms' correlations (up to rounding,
+  /// bounded into the error term); a product, a quotient or a power bounds its non-affine part
+  /// into the error term; any other function is an interval over the forms' ranges.
+  AffineForm FormValue(const Residual& r, const std::vector<AffineForm>& x,
+                       const std::vector<TightInterval>& env) const;
 
  private:
   int ModeIndex(const std::vector<int>& tuple);

@@ -84,4 +84,26 @@ void Segment::ComputeBox(const std::vector<TightInterval>& apriori) {
   }
 }
 
+Segment Segment::Restricted(double lo, double hi) const {
+  Segment out;
+  out.h = hi - lo;
+  out.remainder = remainder;
+  const std::size_t order = series.size();
+  out.series.resize(order);
+  for (std::size_t j = 0; j < order; ++j) {
+    out.series[j] = series[j];
+    if (lo == 0) continue;
+    double binomial = 1.0;  // C(k, j), exact for the orders used
+    for (std::size_t k = j + 1; k < order; ++k) {
+      binomial = binomial * static_cast<double>(k) / static_cast<double>(k - j);
+      const TightInterval factor =
+          TightInterval(binomial) * Power(TightInterval(lo), static_cast<int>(k - j));
+      for (std::size_t i = 0; i < series[k].size(); ++i)
+        out.series[j][i] = out.series[j][i] + series[k][i].Scaled(factor);
+    }
+  }
+  out.ComputeBox(box);
+  return out;
+}
+
 }  // namespace hybrid::flowpipe_internal

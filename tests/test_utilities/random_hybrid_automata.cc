@@ -385,8 +385,40 @@ RandomMode DrawMode(Rng& rng, const Context& ctx, const std::string& name) {
   return m;
 }
 
+// The comparison that holds exactly where `c` fails, up to its boundary: the guard that leaves a
+// mode through that invariant atom (both hold on the boundary, where the flowpipe engine pins a
+// crossing to it).
+RandomComparison Complement(const RandomComparison& c) {
+  RandomComparison out = c;
+  switch (c.relation) {
+    case RandomRelation::kLess:
+    case RandomRelation::kLessEqual:
+      out.relation = RandomRelation::kGreaterEqual;
+      break;
+    case RandomRelation::kGreater:
+    case RandomRelation::kGreaterEqual:
+      out.relation = RandomRelation::kLessEqual;
+      break;
+    case RandomRelation::kEqual:
+      break;
+  }
+  return out;
+}
+
+// An affine reset of v (RandomDynamics::kAffine): a v + b w + c for another variable w, as the
+// impacts of mechanical models mix velocities.
+RandomSum AffineReset(Rng& rng, const Context& ctx, int v) {
+  const RandomHybridAutomaton& a = *ctx.a;
+  RandomSum s = Name(a.variables[v].name, NonZeroTenths(rng, 12));
+  if (a.variables.size() > 1)
+    s.terms.push_back({NonZeroTenths(rng, 8), {a.variables[OtherVariable(rng, ctx, v)].name}});
+  if (RandomChance(rng, 50)) s.terms.push_back({NonZeroTenths(rng, 20), {}});
+  return s;
+}
+
 RandomSum DrawReset(Rng& rng, const Context& ctx, int v) {
   const RandomHybridAutomaton& a = *ctx.a;
+  if (Affine(ctx) && RandomChance(rng, 35)) return AffineReset(rng, ctx, v);
   switch (Weighted(rng, {35, 25, 15, 15, 10})) {
     case 0:
       return Constant(std::round(ctx.base[v] * 10 + UniformInt(rng, -30, 30)) / 10);
@@ -419,6 +451,14 @@ RandomTransition DrawTransition(Rng& rng, const Context& ctx, const std::string&
       t.guard.push_back({Name(in.name), AnyRelation(rng), mid});
     } else {
       t.guard.push_back(DrawStateComparison(rng, ctx, 60));
+    }
+  }
+  if (Affine(ctx) && RandomChance(rng, 40)) {
+    // Leave the source mode where it ends: a guard on the complement of one of its invariant
+    // atoms, so that the crossing lies on the invariant's boundary.
+    for (const RandomMode& m : a.modes) {
+      if (m.name == t.source && !m.invariant.empty())
+        t.guard.insert(t.guard.begin(), Complement(Pick(rng, m.invariant)));
     }
   }
   for (int v = 0; v < static_cast<int>(a.variables.size()); ++v) {
