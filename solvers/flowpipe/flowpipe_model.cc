@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "hybrid/automaton/interval.h"
@@ -136,11 +137,91 @@ Expression FlowpipeModel::Resolve(const Expression& e) const {
       .FoldConstants();
 }
 
+namespace {
+
+// An affine form with interval coefficients (ExactAffine).
+struct IntervalAffine {
+  TightInterval constant{0.0};
+  std::map<int, TightInterval> terms;
+
+  bool IsConstant() const { return terms.empty(); }
+  IntervalAffine Scaled(const TightInterval& k) const {
+    IntervalAffine out{constant * k, {}};
+    for (const auto& [slot, a] : terms) out.terms[slot] = a * k;
+    return out;
+  }
+  IntervalAffine Plus(const IntervalAffine& b, double sign) const {
+    IntervalAffine out = *this;
+    out.constant = out.constant + TightInterval(sign) * b.constant;
+    for (const auto& [slot, a] : b.terms) {
+      auto [it, fresh] = out.terms.emplace(slot, TightInterval(0.0));
+      it->second = it->second + TightInterval(sign) * a;
+    }
+    return out;
+  }
+};
+
+// e as an affine form whose coefficients are computed in interval arithmetic; nullopt when e is
+// not affine (the cases Expression::AsAffine recognises).
+std::optional<IntervalAffine> IntervalAffineOf(const Expression& e) {
+  if (e.is_constant()) return IntervalAffine{TightInterval(e.constant()), {}};
+  if (e.is_symbol()) return IntervalAffine{TightInterval(0.0), {{e.slot(), TightInterval(1.0)}}};
+  std::vector<IntervalAffine> parts;
+  for (const Expression& a : e.args()) {
+    std::optional<IntervalAffine> p = IntervalAffineOf(a);
+    if (!p) return std::nullopt;
+    parts.push_back(std::move(*p));
+  }
+  switch (e.op()) {
+    case Op::kNeg:
+      return parts[0].Scaled(TightInterval(-1.0));
+    case Op::kAdd:
+      return parts[0].Plus(parts[1], 1.0);
+    case Op::kSub:
+      return parts[0].Plus(parts[1], -1.0);
+    case Op::kMul:
+      if (parts[0].IsConstant()) return parts[1].Scaled(parts[0].constant);
+      if (parts[1].IsConstant()) return parts[0].Scaled(parts[1].constant);
+      return std::nullopt;
+    case Op::kDiv:
+      if (parts[1].IsConstant()) return parts[0].Scaled(TightInterval(1.0) / parts[1].constant);
+      return std::nullopt;
+    case Op::kPow:
+      if (e.args()[1].is_constant() && e.args()[1].constant() == 1.0) return parts[0];
+      return std::nullopt;
+    default:
+      return std::nullopt;
+  }
+}
+
+// Expression::AsAffine of e when its coefficients are the exact coefficients of e (the engine
+// reads them as exact), nullopt otherwise: a coefficient such as the 1/3 of (x + y) / 3 is
+// rounded, and then e is read by interval evaluation only.
+std::optional<hybrid::AffineForm> ExactAffine(const Expression& e) {
+  std::optional<hybrid::AffineForm> a = e.AsAffine();
+  if (!a) return a;
+  const std::optional<IntervalAffine> exact = IntervalAffineOf(e);
+  if (!exact || exact->constant.lo != a->constant || exact->constant.hi != a->constant)
+    return std::nullopt;
+  std::size_t nonzero = 0;
+  for (const auto& [slot, k] : exact->terms) {
+    if (k.lo == 0 && k.hi == 0) continue;
+    ++nonzero;
+    const auto it = std::find_if(a->terms.begin(), a->terms.end(),
+                                 [&](const auto& term) { return term.first == slot; });
+    if (it == a->terms.end() || k.lo != it->second || k.hi != it->second) return std::nullopt;
+  }
+  if (nonzero != a->terms.size()) return std::nullopt;
+  return a;
+}
+
+}  // namespace
+
 Residual FlowpipeModel::Compile(const Comparison& c) const {
   Residual r;
   r.expression = Resolve(c.Residual());
   r.relation = c.relation;
-  r.affine = r.expression.AsAffine();
+  r.affine = ExactAffine(r.expression);
   return r;
 }
 
@@ -191,7 +272,7 @@ void FlowpipeModel::MakeJumps(int index) {
     for (const Reset& r : step.transition.resets) {
       Residual value;
       value.expression = Resolve(r.value);
-      value.affine = value.expression.AsAffine();
+      value.affine = ExactAffine(value.expression);
       j.resets.push_back({slots_.state[static_cast<std::size_t>(r.slot)], std::move(value)});
     }
     j.urgent = step.transition.urgency == Urgency::kUrgent;

@@ -18,7 +18,9 @@ enum class Truth { kFalse, kMaybe, kTrue };
 
 /// A comparison `r REL 0` compiled for the engine: the residual with the parameters resolved
 /// (System::ResolvedParameter: fixed ones as constants, uncertain ones as state components),
-/// and its affine form over the slots when it is affine.
+/// and its affine form over the slots when it is affine with coefficients that are exactly
+/// those of the expression (a rounded one, such as the 1/3 of (x + y) / 3, would make the bounds
+/// built on it unsound; such a residual is read by interval evaluation only).
 struct Residual {
   Expression expression;
   Relation relation = Relation::kLessEqual;
