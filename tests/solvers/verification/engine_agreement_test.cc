@@ -4,8 +4,8 @@
 // parameters, strict and non-strict invariants and guards, urgent and lazy transitions and several
 // init declarations are generated as model-language text (tests/test_utilities/
 // random_hybrid_automata.h, GenerateRandomSystem) and every property is checked by every engine:
-// polyhedral reachability (`check --method reach`), the SMT prover (`prove`) and the sampler
-// (`sample`), each with a small deterministic budget. Then:
+// polyhedral reachability (`check --method reach`), flowpipes (`flowpipe`), the SMT prover
+// (`prove`) and the sampler (`sample`), each with a small deterministic budget. Then:
 // - every `proved` and `unreachable` verdict is attacked by simulations of concrete runs written
 //   back as model text (random values of the uncertain parameters, a random init declaration per
 //   instance with random values in its boxes, random step inputs, lazy transitions at random
@@ -43,6 +43,7 @@
 
 #include "hybrid/automaton/parser.h"
 #include "hybrid/checking/trace.h"
+#include "hybrid/flowpipe/flowpipe_reachability.h"
 #include "hybrid/reachability/polyhedral_reachability.h"
 #include "hybrid/simulation/simulator.h"
 #include "hybrid/verification/property_prover.h"
@@ -178,9 +179,19 @@ std::vector<CheckResult> Sample(const System& system, const std::vector<Property
   return out;
 }
 
+/// `check --method flowpipe` with a small deterministic budget (400 Taylor steps, 20 mode
+/// entries, no splitting of the initial set).
+std::vector<CheckResult> Flowpipe(const System& system, const std::vector<Property>& properties) {
+  FlowpipeReachability::Options o;
+  o.max_steps = 400;
+  o.max_entries = 20;
+  o.max_pieces = 1;
+  return FlowpipeReachability(o).Check(system, properties);
+}
+
 const std::vector<std::pair<std::string, Engine>>& Engines() {
   static const std::vector<std::pair<std::string, Engine>> engines = {
-      {"reach", Reach}, {"prove", Prove}, {"sample", Sample}};
+      {"reach", Reach}, {"flowpipe", Flowpipe}, {"prove", Prove}, {"sample", Sample}};
   return engines;
 }
 
