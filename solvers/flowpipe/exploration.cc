@@ -167,23 +167,11 @@ void Exploration::Explore(const Entry& entry) {
   std::vector<TightInterval> box = entry.box;
   if (!model_.Contract(mode.invariant, box, mode.env)) return;
   const std::size_t dim = box.size();
-  std::vector<AffineForm> x(dim);
+  std::optional<std::vector<AffineForm>> start_forms = StartForms(entry, box);
+  if (!start_forms) return;
+  std::vector<AffineForm> x = std::move(*start_forms);
   std::vector<char> protect(dim, 0);
-  for (std::size_t i = 0; i < dim; ++i) {
-    if (!box[i].IsFinite()) {
-      StopAt(entry.t0, "the set entering mode " + mode.name + " is unbounded in '" +
-                           model_.ComponentName(static_cast<int>(i)) + "'");
-      return;
-    }
-    if (!entry.form.empty()) {
-      x[i] = entry.form[i];
-    } else {
-      x[i] = box[i].lo == box[i].hi
-                 ? AffineForm(box[i].lo)
-                 : AffineForm::Symbol(box[i].Mid(), static_cast<int>(i), box[i].RadiusUp());
-    }
-    protect[i] = static_cast<int>(i) >= model_.num_variables();
-  }
+  for (std::size_t i = 0; i < dim; ++i) protect[i] = static_cast<int>(i) >= model_.num_variables();
   const int max_symbols =
       options_.max_symbols > 0 ? options_.max_symbols : 10 * static_cast<int>(dim);
   const FlowpipeStep stepper(*mode.tape, model_.input_box(), options_.order, protect, max_symbols);
@@ -254,6 +242,27 @@ void Exploration::Explore(const Entry& entry) {
     if (crossings[j].open) CloseCrossing(entry.mode, static_cast<int>(j), crossings[j]);
   }
   stepper_ = nullptr;
+}
+
+std::optional<std::vector<AffineForm>> Exploration::StartForms(
+    const Entry& entry, const std::vector<TightInterval>& box) {
+  std::vector<AffineForm> x(box.size());
+  for (std::size_t i = 0; i < box.size(); ++i) {
+    if (!box[i].IsFinite()) {
+      StopAt(entry.t0, "the set entering mode " + model_.Mode(entry.mode).name +
+                           " is unbounded in '" + model_.ComponentName(static_cast<int>(i)) + "'");
+      return std::nullopt;
+    }
+    if (!entry.form.empty()) {
+      x[i] = entry.form[i];
+    } else {
+      // Symbol i for component i: the uncertain parameters' symbols are then protected.
+      x[i] = box[i].lo == box[i].hi
+                 ? AffineForm(box[i].lo)
+                 : AffineForm::Symbol(box[i].Mid(), static_cast<int>(i), box[i].RadiusUp());
+    }
+  }
+  return x;
 }
 
 bool Exploration::Visit(const Segment& segment, int mode_index, double t, double t_end,

@@ -78,6 +78,10 @@ class Exploration {
   };
 
   void Explore(const Entry& entry);
+  // The entry's forms, or forms of `box` (the entry's box cut by the mode's invariant); nullopt
+  // (and the exploration stopped there) when the box is unbounded.
+  std::optional<std::vector<AffineForm>> StartForms(const Entry& entry,
+                                                    const std::vector<TightInterval>& box);
   // Whether an explored box entry from no later a time holds the entry's box.
   bool AlreadyExplored(const Entry& entry) const;
   // An explored entry from no later a time whose box holds the entry's box (a box entry only,
