@@ -34,6 +34,7 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -529,24 +530,34 @@ bool CheckTrace(const Verdicts& v, const System& system, const Property& propert
 
 // ---- attacks on claims ----
 
-/// A `proved` or `unreachable` claim about property `property`, and the engines that made it.
+/// A `proved` or `unreachable` claim about property `property` up to time `until` (infinity, or
+/// the CheckResult::within of a bounded proof), and the engines that made it.
 struct Claim {
   int property = 0;
   Verdict verdict = Verdict::kUnknown;
+  double until = std::numeric_limits<double>::infinity();
   std::vector<std::string> engines;
 };
 
+/// The time up to which a negative verdict holds.
+double ClaimedUntil(const CheckResult& r) {
+  return r.within.value_or(std::numeric_limits<double>::infinity());
+}
+
+/// The claims of every engine, one per property and horizon.
 std::vector<Claim> ClaimsOf(const Verdicts& v) {
   std::vector<Claim> claims;
   for (int i = 0; i < static_cast<int>(v.model->properties.size()); ++i) {
-    Claim c;
-    c.property = i;
+    std::map<double, Claim> by_horizon;
     for (const EngineRun& run : v.runs) {
       if (!run.errors[i].empty() || !Negative(run.results[i].verdict)) continue;
+      Claim& c = by_horizon[ClaimedUntil(run.results[i])];
+      c.property = i;
       c.verdict = run.results[i].verdict;
+      c.until = ClaimedUntil(run.results[i]);
       c.engines.push_back(run.engine);
     }
-    if (!c.engines.empty()) claims.push_back(c);
+    for (auto& [until, c] : by_horizon) claims.push_back(std::move(c));
   }
   return claims;
 }
@@ -581,7 +592,8 @@ void AttackClaims(const Verdicts& v, std::vector<Claim> open, int attacks, Rng& 
       ++s.states;
       for (auto it = open.begin(); it != open.end();) {
         const RandomProperty& p = model.properties[it->property];
-        if ((p.within && x.time > *p.within) || !Refutes(p, it->verdict, x.values, x.modes)) {
+        if ((p.within && x.time > *p.within) || x.time > it->until ||
+            !Refutes(p, it->verdict, x.values, x.modes)) {
           ++it;
           continue;
         }
@@ -607,6 +619,19 @@ void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, in
   for (int i = 0; i < static_cast<int>(v.model->properties.size()); ++i) {
     const bool reach = v.model->properties[i].kind == RandomProperty::Kind::kReach;
     std::vector<std::string> positive, negative;
+    // A bounded proof (`proved within T`) contradicts only a witness that meets the property's
+    // states by T.
+    double earliest_witness = std::numeric_limits<double>::infinity();
+    for (const EngineRun& run : v.runs) {
+      const CheckResult& r = run.results[i];
+      if (run.errors[i].empty() && Positive(r.verdict) && r.trace && r.trace->state_index >= 0) {
+        const auto k = static_cast<std::size_t>(r.trace->state_index);
+        if (k < r.trace->run.samples.size())
+          earliest_witness = std::min(earliest_witness, r.trace->run.samples[k].time);
+      } else if (run.errors[i].empty() && Positive(r.verdict)) {
+        earliest_witness = 0.0;  // no time known: compared with every claim
+      }
+    }
     for (const EngineRun& run : v.runs) {
       if (!run.errors[i].empty()) {
         ++s.verdicts[run.engine]["threw"];
@@ -627,7 +652,8 @@ void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, in
                                   (r.verdict == Verdict::kProved && run.engine != "sample")));
       if (!fits) s.other_failures.push_back(Header("VERDICT OF THE WRONG KIND", v, i));
       if (Positive(r.verdict)) positive.push_back(run.engine);
-      if (Negative(r.verdict)) negative.push_back(run.engine);
+      if (Negative(r.verdict) && earliest_witness <= ClaimedUntil(r))
+        negative.push_back(run.engine);
     }
     if (!positive.empty() && !negative.empty()) {
       const bool at_boundary = std::all_of(positive.begin(), positive.end(), [&](const auto& e) {
