@@ -48,7 +48,8 @@ std::optional<Segment> CrossingForm::Window(const Segment& segment,
     const double piece = (hi - lo) / kWindowPieces;
     double first = hi, last = lo;
     for (int i = 0; i < kWindowPieces; ++i) {
-      const double a = lo + i * piece, b = a + piece;
+      // Shared ends, the last one hi: the pieces cover [lo, hi] even if a sum were rounded.
+      const double a = lo + i * piece, b = i + 1 == kWindowPieces ? hi : lo + (i + 1) * piece;
       if (model_.HoldsAll(atoms, segment.Restricted(a, b), env_) == Truth::kFalse) continue;
       first = std::min(first, a);
       last = b;
