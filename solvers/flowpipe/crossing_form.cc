@@ -67,7 +67,7 @@ std::vector<AffineForm> CrossingForm::OfSegment(const Segment& segment, int& tim
     for (const AffineForm& f : coefficients) m = std::max(m, f.coefficients().size());
   }
   time_symbol = static_cast<int>(m);
-  // h is a power of two, so h/2 is exact.
+  // Halving is exact: s = h/2 + (h/2) e covers [0, h] exactly.
   const AffineForm s = AffineForm::Symbol(segment.h / 2, time_symbol, segment.h / 2);
   const std::size_t n = segment.series[0].size();
   std::vector<AffineForm> out(n);
