@@ -189,7 +189,10 @@ enum class RandomDynamics {
   /// absent), and small initial sets: models the flowpipe engine (`check --method flowpipe`)
   /// can prove things about (tests/solvers/flowpipe/flowpipe_soundness_test.cc). Inputs,
   /// uncertain parameters, invariants, guards (urgent and lazy), resets, several init
-  /// declarations and `within T` properties are drawn as for kMixed.
+  /// declarations and `within T` properties are drawn as for kMixed, and besides: 4 in 10
+  /// transitions also leave their source mode through the boundary of one of its invariant atoms
+  /// (guard `x >= 3` for an invariant `x <= 3`), and a third of the resets mix two variables
+  /// (`v := -0.7*v + 0.2*w + 1.1`).
   kAffine,
 };
 
