@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "automaton/internal_assert.h"
+
 namespace hybrid::flowpipe_internal {
 
 namespace {
@@ -85,6 +87,8 @@ void Segment::ComputeBox(const std::vector<TightInterval>& apriori) {
 }
 
 Segment Segment::Restricted(double lo, double hi) const {
+  HYBRID_ASSERT(0 <= lo && lo <= hi && hi <= h && (hi - lo) + lo == hi,
+                "a restriction lies within the segment and its length is exact");
   Segment out;
   out.h = hi - lo;
   out.remainder = remainder;

@@ -27,7 +27,8 @@ struct Segment {
   /// The box of the series bound (per component LinearBound of the unit vector) intersected with
   /// `apriori` (an enclosure of the same states).
   void ComputeBox(const std::vector<TightInterval>& apriori);
-  /// The part of the segment over s in [lo, hi] (0 <= lo <= hi <= h), re-centred at lo: its
+  /// The part of the segment over s in [lo, hi] (0 <= lo <= hi <= h, hi - lo exact in floating
+  /// point, as for ends that are multiples of a power of two), re-centred at lo: its
   /// series are x(lo + u) = sum_j u^j sum_{k >= j} C(k, j) lo^(k - j) series[k] (coefficients as
   /// intervals, so the forms stay enclosures), u in [0, hi - lo]; the remainder, which holds for
   /// every s in [0, h], is kept; its box is the new series bound within this one's box.
