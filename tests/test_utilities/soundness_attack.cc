@@ -477,22 +477,41 @@ void ReplayTraceBySimulation(const RandomHybridAutomaton& a, const System& syste
       "--- replay of the trace ---\n" + RunText(sim, -1));
 }
 
-void AttackClaims(const RandomHybridAutomaton& a, const std::vector<CheckResult>& results,
-                  const std::string& label, int attacks, std::mt19937_64& rng, SoundnessSummary& s,
-                  const AttackOptions& options) {
+namespace {
+
+// The claims of `results` under attack (their `proved` and `unreachable` verdicts), each one's
+// horizon (ClaimHorizon) and the runs' longest horizon (infinity unless options.cap_horizon);
+// counted into `s`.
+struct OpenClaimSet {
   std::vector<int> open;
-  std::vector<double> horizon(results.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> horizon;
+  double max_until = std::numeric_limits<double>::infinity();
+};
+OpenClaimSet OpenClaims(const std::vector<RandomProperty>& properties,
+                        const std::vector<CheckResult>& results, const AttackOptions& options,
+                        SoundnessSummary& s) {
+  OpenClaimSet c;
+  c.horizon.assign(results.size(), std::numeric_limits<double>::infinity());
   double longest = 0.0;
   for (int i = 0; i < static_cast<int>(results.size()); ++i) {
     if (results[i].verdict == Verdict::kProved || results[i].verdict == Verdict::kUnreachable) {
-      open.push_back(i);
-      horizon[i] = ClaimHorizon(a.properties[i], results[i]);
-      longest = std::max(longest, horizon[i]);
-      if (std::isfinite(horizon[i])) ++s.bounded_claims;
+      c.open.push_back(i);
+      c.horizon[i] = ClaimHorizon(properties[i], results[i]);
+      longest = std::max(longest, c.horizon[i]);
+      if (std::isfinite(c.horizon[i])) ++s.bounded_claims;
     }
   }
-  s.claims += static_cast<int>(open.size());
-  const double max_until = options.cap_horizon ? longest : std::numeric_limits<double>::infinity();
+  s.claims += static_cast<int>(c.open.size());
+  if (options.cap_horizon) c.max_until = longest;
+  return c;
+}
+
+}  // namespace
+
+void AttackClaims(const RandomHybridAutomaton& a, const std::vector<CheckResult>& results,
+                  const std::string& label, int attacks, std::mt19937_64& rng, SoundnessSummary& s,
+                  const AttackOptions& options) {
+  auto [open, horizon, max_until] = OpenClaims(a.properties, results, options, s);
   for (int k = 0; k < attacks && !open.empty(); ++k) {
     const ConcreteRun run = DrawAttack(a, rng, max_until);
     const Simulation sim = Simulate(run);
@@ -801,19 +820,7 @@ std::vector<SystemState> SystemStates(const RandomSystem& s, const SystemSimulat
 void AttackSystemClaims(const RandomSystem& model, const std::vector<CheckResult>& results,
                         const std::string& label, int attacks, std::mt19937_64& rng,
                         SoundnessSummary& s, const AttackOptions& options) {
-  std::vector<int> open;
-  std::vector<double> horizon(results.size(), std::numeric_limits<double>::infinity());
-  double longest = 0.0;
-  for (int i = 0; i < static_cast<int>(results.size()); ++i) {
-    if (results[i].verdict == Verdict::kProved || results[i].verdict == Verdict::kUnreachable) {
-      open.push_back(i);
-      horizon[i] = ClaimHorizon(model.properties[i], results[i]);
-      longest = std::max(longest, horizon[i]);
-      if (std::isfinite(horizon[i])) ++s.bounded_claims;
-    }
-  }
-  s.claims += static_cast<int>(open.size());
-  const double max_until = options.cap_horizon ? longest : std::numeric_limits<double>::infinity();
+  auto [open, horizon, max_until] = OpenClaims(model.properties, results, options, s);
   for (int k = 0; k < attacks && !open.empty(); ++k) {
     const SystemRunChoices c = DrawSystemAttack(model, rng, max_until);
     const SystemSimulation sim = SimulateSystem(model, c);

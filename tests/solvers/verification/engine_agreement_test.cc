@@ -530,19 +530,15 @@ bool CheckTrace(const Verdicts& v, const System& system, const Property& propert
 
 // ---- attacks on claims ----
 
-/// A `proved` or `unreachable` claim about property `property` up to time `until` (infinity, or
-/// the CheckResult::within of a bounded proof), and the engines that made it.
+/// A `proved` or `unreachable` claim about property `property` up to time `until`
+/// (ht::ClaimHorizon: the property's `within T`, a bounded proof's CheckResult::within, or
+/// infinity), and the engines that made it.
 struct Claim {
   int property = 0;
   Verdict verdict = Verdict::kUnknown;
   double until = std::numeric_limits<double>::infinity();
   std::vector<std::string> engines;
 };
-
-/// The time up to which a negative verdict holds.
-double ClaimedUntil(const CheckResult& r) {
-  return r.within.value_or(std::numeric_limits<double>::infinity());
-}
 
 /// The claims of every engine, one per property and horizon.
 std::vector<Claim> ClaimsOf(const Verdicts& v) {
@@ -551,10 +547,11 @@ std::vector<Claim> ClaimsOf(const Verdicts& v) {
     std::map<double, Claim> by_horizon;
     for (const EngineRun& run : v.runs) {
       if (!run.errors[i].empty() || !Negative(run.results[i].verdict)) continue;
-      Claim& c = by_horizon[ClaimedUntil(run.results[i])];
+      const double until = ht::ClaimHorizon(v.model->properties[i], run.results[i]);
+      Claim& c = by_horizon[until];
       c.property = i;
       c.verdict = run.results[i].verdict;
-      c.until = ClaimedUntil(run.results[i]);
+      c.until = until;
       c.engines.push_back(run.engine);
     }
     for (auto& [until, c] : by_horizon) claims.push_back(std::move(c));
@@ -592,8 +589,7 @@ void AttackClaims(const Verdicts& v, std::vector<Claim> open, int attacks, Rng& 
       ++s.states;
       for (auto it = open.begin(); it != open.end();) {
         const RandomProperty& p = model.properties[it->property];
-        if ((p.within && x.time > *p.within) || x.time > it->until ||
-            !Refutes(p, it->verdict, x.values, x.modes)) {
+        if (x.time > it->until || !Refutes(p, it->verdict, x.values, x.modes)) {
           ++it;
           continue;
         }
@@ -652,7 +648,7 @@ void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, in
                                   (r.verdict == Verdict::kProved && run.engine != "sample")));
       if (!fits) s.other_failures.push_back(Header("VERDICT OF THE WRONG KIND", v, i));
       if (Positive(r.verdict)) positive.push_back(run.engine);
-      if (Negative(r.verdict) && earliest_witness <= ClaimedUntil(r))
+      if (Negative(r.verdict) && earliest_witness <= ht::ClaimHorizon(v.model->properties[i], r))
         negative.push_back(run.engine);
     }
     if (!positive.empty() && !negative.empty()) {
