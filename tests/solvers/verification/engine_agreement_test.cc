@@ -70,18 +70,7 @@ constexpr double kTolerance = 1e-6;
 /// A `violated` trace must break its property by at least this (relative) on replay.
 constexpr double kConfirmTolerance = 1e-9;
 
-/// A non-negative integer from the environment, or `fallback` when unset.
-std::uint64_t EnvNumber(const char* name, std::uint64_t fallback) {
-  const char* text = std::getenv(name);
-  if (text == nullptr || *text == '\0') return fallback;
-  char* end = nullptr;
-  const unsigned long long value = std::strtoull(text, &end, 10);
-  if (*end != '\0' || *text == '-') {
-    ADD_FAILURE() << name << "='" << text << "' is not a non-negative integer";
-    return fallback;
-  }
-  return value;
-}
+using ht::EnvNumber;  // a non-negative integer from the environment, or a fallback
 
 struct Settings {
   std::uint64_t seed = kDefaultSeed;
