@@ -361,16 +361,6 @@ int MeasuredData::samples() const {
   return n;
 }
 
-// Messages quote cells, column names and run labels of the file: escaped (quoted_text.h), like
-// the file name in what(), so that no control character of the input reaches a terminal.
-DataError::DataError(std::string source, int line, int column, std::string message)
-    : std::runtime_error(EscapedForMessage(source) + ":" + std::to_string(line) + ":" +
-                         std::to_string(column) + ": " + EscapedForMessage(message)),
-      source_(std::move(source)),
-      line_(line),
-      column_(column),
-      message_(EscapedForMessage(message)) {}
-
 MeasuredData ReadMeasuredData(std::istream& in, const std::string& source) {
   return Reader(in, source).Read();
 }
