@@ -405,4 +405,39 @@ std::vector<double> Automaton::ParameterEnvironment() const {
   return env;
 }
 
+Automaton CopySymbols(const Automaton& a) {
+  Automaton out(a.name());
+  const SymbolTable& symbols = a.symbols();
+  for (int slot = 0; slot < symbols.size(); ++slot) {
+    const Symbol& s = symbols[slot];
+    switch (s.kind) {
+      case SymbolKind::kVariable: {
+        std::optional<Range> domain;
+        for (const VariableInfo& v : a.variables()) {
+          if (v.slot == slot) domain = v.domain;
+        }
+        out.AddVariable(s.name, s.unit, domain);
+        break;
+      }
+      case SymbolKind::kDiscrete:
+        out.AddDiscreteVariable(s.name);
+        break;
+      case SymbolKind::kInput: {
+        for (const InputInfo& in : a.inputs()) {
+          if (in.slot == slot) out.AddInput(s.name, in.bounds, s.unit);
+        }
+        break;
+      }
+      case SymbolKind::kParameter: {
+        for (const auto& [p, value] : a.parameters()) {
+          if (p == slot) out.AddParameter(s.name, value, s.unit, a.ParameterRange(slot));
+        }
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+
 }  // namespace hybrid

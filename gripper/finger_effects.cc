@@ -31,42 +31,6 @@ Comparison Compare(Expression lhs, Relation r, Expression rhs) {
   return Comparison{std::move(lhs), r, std::move(rhs)};
 }
 
-// Copies the symbols of `a` into a new automaton in slot order (so every expression of `a` stays
-// valid in the copy).
-Automaton CopySymbols(const Automaton& a) {
-  Automaton out(a.name());
-  const SymbolTable& symbols = a.symbols();
-  for (int slot = 0; slot < symbols.size(); ++slot) {
-    const Symbol& s = symbols[slot];
-    switch (s.kind) {
-      case SymbolKind::kVariable: {
-        std::optional<Range> domain;
-        for (const VariableInfo& v : a.variables()) {
-          if (v.slot == slot) domain = v.domain;
-        }
-        out.AddVariable(s.name, s.unit, domain);
-        break;
-      }
-      case SymbolKind::kDiscrete:
-        out.AddDiscreteVariable(s.name);
-        break;
-      case SymbolKind::kInput: {
-        for (const InputInfo& in : a.inputs()) {
-          if (in.slot == slot) out.AddInput(s.name, in.bounds, s.unit);
-        }
-        break;
-      }
-      case SymbolKind::kParameter: {
-        for (const auto& [p, value] : a.parameters()) {
-          if (p == slot) out.AddParameter(s.name, value, s.unit, a.ParameterRange(slot));
-        }
-        break;
-      }
-    }
-  }
-  return out;
-}
-
 void SetFlow(Mode& mode, int slot, std::optional<Expression> rhs) {
   std::erase_if(mode.flows, [slot](const auto& f) { return f.first == slot; });
   if (rhs) mode.flows.emplace_back(slot, std::move(*rhs));

@@ -182,4 +182,11 @@ class Automaton {
   std::optional<Scenario> scenario_;
 };
 
+/// A new automaton named as `a` that declares `a`'s symbols in slot order (continuous variables
+/// with their units and domains, discrete variables, inputs with their bounds, parameters with
+/// their defining expressions and ranges) and nothing else: every expression of `a` reads the
+/// same slots in it. The start of a model transformation that rebuilds modes or transitions;
+/// symbols added to it afterwards take the slots after `a`'s.
+Automaton CopySymbols(const Automaton& a);
+
 }  // namespace hybrid
