@@ -439,5 +439,4 @@ Automaton CopySymbols(const Automaton& a) {
   return out;
 }
 
-
 }  // namespace hybrid

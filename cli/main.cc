@@ -28,6 +28,7 @@
 #include "commands/bundled_files.h"
 #include "commands/check_command.h"
 #include "commands/closest_name.h"
+#include "commands/diagnose_model_command.h"
 #include "commands/exit_code.h"
 #include "commands/info_command.h"
 #include "commands/mode_groups.h"
@@ -40,6 +41,7 @@
 #include "hybrid/automaton/log.h"
 #include "hybrid/automaton/parser.h"
 #include "hybrid/automaton/system.h"
+#include "hybrid/model_diagnosis/trace_data.h"
 #include "hybrid/spaceex/spaceex_import.h"
 
 namespace {
@@ -76,6 +78,8 @@ struct Commands {
   hybrid::cli::FingerArgs finger_args;
   hybrid::cli::HandArgs hand_args;
   hybrid::cli::DiagnoseArgs diagnose_args;
+  std::vector<std::string> diagnose_files;  // [MODEL] DATA
+  std::vector<std::string> diagnose_noise;  // --noise NAME=SD (any model)
   hybrid::cli::SynthesizeArgs synthesize_args;
   std::string log;  // --log LEVEL: debug, info or warning; empty: no log
 };
@@ -282,14 +286,25 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
   hybrid::cli::DiagnoseArgs& d = c.diagnose_args;
   CLI::App* diagnose = c.diagnose = app.add_subcommand(
       "diagnose",
-      "Compare measured finger data with the model: residuals per joint, mode and direction, "
-      "the physical cause (backlash, motor_offset, joint_range, sensor_bias, compliance, "
-      "theta3_law, none or unexplained), an extended model and its held-out gain");
+      "Compare measured data with a model: residuals per variable and mode, the cause (a "
+      "parameter, a sensor bias or gain, a flow gain, a moved guard or invariant threshold, an "
+      "input offset; for the finger backlash, motor_offset, joint_range, sensor_bias, "
+      "compliance, theta3_law), or none, or unexplained; an extended model and its held-out "
+      "gain");
   diagnose
-      ->add_option("DATA", d.data,
-                   "CSV: run,g,theta1,theta2,theta3[,gob,contact_link] (docs/diagnosis.md)")
-      ->required();
-  diagnose->add_option("--model", d.model, "Finger automaton (default: the bundled finger.ha)");
+      ->add_option("FILES", c.diagnose_files,
+                   "MODEL DATA.csv: a model and a trace of it (columns run,time,inputs,variables; "
+                   "docs/diagnosis.md), or DATA alone: the finger's measured runs "
+                   "(run,g,theta1,theta2,theta3[,gob,contact_link])")
+      ->required()
+      ->expected(1, 2);
+  diagnose->add_option("--model", d.model,
+                       "The model (default for the finger's data: the bundled finger.ha)");
+  diagnose
+      ->add_option("--noise", c.diagnose_noise,
+                   "NAME=SD: noise standard deviation of a traced variable, in place of the "
+                   "estimate (traces of any model); repeatable")
+      ->take_all();
   diagnose->add_flag("--json", d.json, "Machine-readable output");
   diagnose->add_option("--out-model", d.out_model,
                        "Write the extended model (accepted by simulate, dot and check)");
@@ -327,12 +342,45 @@ void DefaultModels(Commands& c) {
   if (c.hand->parsed() && c.hand_args.model.empty() && c.hand_args.simulate) {
     c.hand_args.model = BundledFile("spec/hand.ha").string();
   }
-  if (c.diagnose->parsed() && c.diagnose_args.model.empty()) {
-    c.diagnose_args.model = BundledFile("spec/finger.ha").string();
-  }
   if (c.synthesize->parsed() && c.synthesize_args.model.empty()) {
     c.synthesize_args.model = BundledFile("spec/finger.ha").string();
   }
+}
+
+// `hybrid diagnose [MODEL] DATA [--model MODEL]`: a trace of any model (a CSV with a `time`
+// column) goes to RunDiagnoseModel, the finger's measured runs to RunDiagnose.
+ExitCode RunDiagnosis(Commands& c) {
+  using hybrid::cli::Arg;
+  using hybrid::cli::OptionError;
+  hybrid::cli::DiagnoseArgs& d = c.diagnose_args;
+  if (c.diagnose_files.size() == 2) {
+    if (!d.model.empty()) {
+      throw OptionError("model",
+                        "the model is given twice: write `hybrid diagnose MODEL DATA` or "
+                        "`hybrid diagnose DATA --model MODEL`");
+    }
+    d.model = c.diagnose_files[0];
+  }
+  d.data = c.diagnose_files.back();
+  if (hybrid::IsTraceFile(d.data)) {
+    if (d.model.empty()) {
+      throw OptionError("model", d.data +
+                                     " is a trace (it has a 'time' column): give its model, "
+                                     "`hybrid diagnose MODEL " +
+                                     d.data + "`");
+    }
+    const hybrid::cli::DiagnoseModelArgs m{d.model,     d.data,           d.json,
+                                           d.out_model, d.report,         d.significance,
+                                           d.threads,   c.diagnose_noise, d.progress};
+    return hybrid::cli::RunDiagnoseModel(m);
+  }
+  if (!c.diagnose_noise.empty()) {
+    throw OptionError("noise", Arg("noise") +
+                                   " applies to a trace of any model (a CSV with a "
+                                   "'time' column), not to the finger's data");
+  }
+  if (d.model.empty()) d.model = hybrid::cli::BundledFile("spec/finger.ha").string();
+  return hybrid::cli::RunDiagnose(d);
 }
 
 // `hybrid import`: the translation, checked by parsing it, then written; notes on stderr.
@@ -417,7 +465,7 @@ ExitCode Run(Commands& c) {
       DefaultModels(c);
       if (command == c.finger) return hybrid::cli::RunFinger(c.finger_args);
       if (command == c.hand) return hybrid::cli::RunHand(c.hand_args);
-      if (command == c.diagnose) return hybrid::cli::RunDiagnose(c.diagnose_args);
+      if (command == c.diagnose) return RunDiagnosis(c);
       if (command == c.synthesize) return hybrid::cli::RunSynthesize(c.synthesize_args);
       return hybrid::cli::RunCheck(c.check_args);
     } catch (...) {

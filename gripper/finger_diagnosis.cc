@@ -133,7 +133,7 @@ Diagnosis DiagnoseCleaned(const FingerPredictor& predictor, const MeasuredData& 
                           std::optional<FingerEffects>* best) {
   Diagnosis d;
   d.outliers = std::move(outliers);
-  d.noise = EstimateNoiseFloor(cleaned);
+  d.noise = EstimateNoiseFloor(cleaned, options.spike_sigmas);  // the engine's outlier rule
   d.samples = cleaned.samples();
   const FingerDiagnosisModel model(predictor, cleaned, std::move(base));
   const ChannelNoise noise{{d.noise.variance.begin(), d.noise.variance.end()},

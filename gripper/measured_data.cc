@@ -16,6 +16,7 @@
 
 #include "automaton/number_syntax.h"
 #include "automaton/quoted_text.h"
+#include "hybrid/diagnosis/noise_floor.h"
 
 namespace hybrid {
 
@@ -334,15 +335,6 @@ class Reader {
   std::map<std::string, int> first_line_of_run_;
 };
 
-double Median(std::vector<double> values) {
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(values.begin(), values.begin() + mid);
-  return 0.5 * (lower + upper);
-}
-
 bool Repeats(const MeasuredRun& a, const MeasuredRun& b) {
   if (a.gob != b.gob || a.contact_link != b.contact_link || a.g.size() != b.g.size()) {
     return false;
@@ -424,72 +416,29 @@ OutlierReport CleanOutliers(MeasuredData& data, double threshold) {
   return report;
 }
 
-NoiseFloor EstimateNoiseFloor(const MeasuredData& data) {
-  // Groups of repeats (indices into data.runs), each led by its first run.
-  std::vector<std::vector<int>> groups;
-  for (int r = 0; r < static_cast<int>(data.runs.size()); ++r) {
-    const auto it = std::find_if(groups.begin(), groups.end(), [&](const std::vector<int>& g) {
-      return Repeats(data.runs[g.front()], data.runs[r]);
-    });
-    if (it == groups.end()) {
-      groups.push_back({r});
-    } else {
-      it->push_back(r);
+NoiseFloor EstimateNoiseFloor(const MeasuredData& data, double spike_sigmas) {
+  // Each run's repeat_of: the first earlier run it repeats.
+  std::vector<int> repeat_of(data.runs.size());
+  std::vector<DiagnosisRun> runs;
+  bool repeated = false;
+  for (size_t r = 0; r < data.runs.size(); ++r) {
+    const MeasuredRun& run = data.runs[r];
+    repeat_of[r] = static_cast<int>(r);
+    for (size_t s = 0; s < r; ++s) {
+      if (repeat_of[s] == static_cast<int>(s) && Repeats(data.runs[s], run)) {
+        repeat_of[r] = static_cast<int>(s);
+        repeated = true;
+        break;
+      }
     }
+    runs.push_back(DiagnosisRun{run.label, run.g, {run.theta[0], run.theta[1], run.theta[2]}});
   }
-  const bool repeated = std::any_of(groups.begin(), groups.end(),
-                                    [](const std::vector<int>& g) { return g.size() >= 2; });
-
+  const ChannelNoise noise = EstimateChannelNoise(runs, repeat_of, spike_sigmas);
   NoiseFloor floor;
-  if (repeated) {
-    floor.method = "repeated_runs";
-    for (int j = 0; j < 3; ++j) {
-      double sum_squares = 0.0;
-      int dof = 0;
-      for (const std::vector<int>& group : groups) {
-        if (group.size() < 2) continue;
-        const size_t samples = data.runs[group.front()].g.size();
-        for (size_t i = 0; i < samples; ++i) {
-          double sum = 0.0;
-          bool complete = true;
-          for (const int r : group) {
-            const double x = data.runs[r].theta[j][i];
-            complete = complete && !std::isnan(x);
-            sum += x;
-          }
-          if (!complete) continue;
-          const double mean = sum / static_cast<double>(group.size());
-          for (const int r : group) {
-            const double d = data.runs[r].theta[j][i] - mean;
-            sum_squares += d * d;
-          }
-          dof += static_cast<int>(group.size()) - 1;
-        }
-      }
-      floor.dof[j] = dof;
-      floor.variance[j] = dof > 0 ? sum_squares / dof : 0.0;
-    }
-    return floor;
-  }
-
-  floor.method = "second_differences";
-  for (int j = 0; j < 3; ++j) {
-    std::vector<double> deviations;  // |d - median of the run's d|, all runs
-    for (const MeasuredRun& run : data.runs) {
-      const std::vector<double>& x = run.theta[j];
-      std::vector<double> d;
-      for (size_t k = 1; k + 1 < x.size(); ++k) {
-        if (std::isnan(x[k - 1]) || std::isnan(x[k]) || std::isnan(x[k + 1])) continue;
-        d.push_back(x[k + 1] - 2.0 * x[k] + x[k - 1]);
-      }
-      if (d.empty()) continue;
-      const double median = Median(d);
-      for (const double v : d) deviations.push_back(std::abs(v - median));
-    }
-    floor.dof[j] = static_cast<int>(deviations.size());
-    if (deviations.empty()) continue;
-    const double sigma_d = 1.4826 * Median(std::move(deviations));
-    floor.variance[j] = sigma_d * sigma_d / 6.0;
+  floor.method = repeated ? "repeated_runs" : "second_differences";
+  for (size_t j = 0; j < 3 && j < noise.variance.size(); ++j) {
+    floor.variance[j] = noise.variance[j];
+    floor.dof[j] = noise.dof[j];
   }
   return floor;
 }

@@ -53,6 +53,7 @@
 #include "commands/bundled_files.h"
 #include "commands/check_command.h"
 #include "commands/command_error.h"
+#include "commands/diagnose_model_command.h"
 #include "commands/info_command.h"
 #include "commands/output.h"
 #include "commands/simulate_command.h"
@@ -65,6 +66,7 @@
 #include "hybrid/gripper/finger_closed_form.h"
 #include "hybrid/gripper/finger_parameters.h"
 #include "hybrid/gripper/measured_data.h"
+#include "hybrid/model_diagnosis/trace_data.h"
 #include "hybrid/simulation/simulator.h"
 #include "hybrid/spaceex/spaceex_import.h"
 
@@ -718,6 +720,19 @@ std::string DiagnoseJsonText(const std::string& data, const std::optional<std::s
   return RunStoppable([&] { return cli::DiagnoseReport(args).dump(); });
 }
 
+// `hybrid diagnose MODEL DATA --json` (a trace of any model) with the curves, as JSON text.
+std::string DiagnoseModelJsonText(const std::string& model, const std::string& data,
+                                  double significance, int threads,
+                                  const std::vector<std::string>& noise) {
+  cli::DiagnoseModelArgs args;
+  args.model = model;
+  args.data = data;
+  args.significance = significance;
+  args.threads = threads;
+  args.noise = noise;
+  return RunStoppable([&] { return cli::DiagnoseModelReport(args, true).dump(); });
+}
+
 // set_log_level: the engines' log (include/hybrid/automaton/log.h) on standard error from `level`
 // ("debug", "info" or "warning") up, or none (None). Standard error rather than Python's logging:
 // engines log from worker threads and from the child processes of RunStoppable, where Python
@@ -782,6 +797,9 @@ PYBIND11_MODULE(_hybrid, m) {
         py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"));
   m.def("diagnose_json", &DiagnoseJsonText, py::arg("data"), py::arg("model"),
         py::arg("significance"), py::arg("threads"));
+  m.def("diagnose_model_json", &DiagnoseModelJsonText, py::arg("model"), py::arg("data"),
+        py::arg("significance"), py::arg("threads"), py::arg("noise"));
+  m.def("is_trace_file", &hybrid::IsTraceFile, py::arg("path"));
   py::class_<Model>(m, "Model")
       .def(py::init<std::string>(), py::arg("path"))
       .def_property_readonly("path", &Model::path)

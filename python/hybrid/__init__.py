@@ -211,22 +211,55 @@ def hand(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c
     return _json.loads(report)
 
 
-def diagnose(data, model=None, significance=25.0, threads=2):
-    """Measured finger data against the model (``hybrid diagnose DATA --json``; docs/diagnosis.md).
+def diagnose(*files, model=None, significance=25.0, threads=2, noise=None):
+    """Measured data against a model (``hybrid diagnose [MODEL] DATA --json``; docs/diagnosis.md).
+
+    ``diagnose(model, data)``: a trace of any model (a CSV with columns ``run``, ``time``, the
+    model's inputs and variables); ``diagnose(data)`` or ``diagnose(data, model=...)``: the
+    finger's measured runs (default model: the bundled spec/finger.ha).
 
     Args:
-        data: the measured CSV (the format of docs/diagnosis.md; data/finger_demo.csv).
-        model: the finger automaton (default: the bundled spec/finger.ha).
+        files: ``model, data`` or ``data``.
+        model: the model, when ``data`` is given alone.
         significance: how much a cause must improve the fit to be named.
         threads: worker threads.
+        noise: {variable: standard deviation} in place of the estimated noise (traces only).
 
     Returns:
-        The report of ``hybrid diagnose --json``: residuals per joint, mode and direction, the
-        cause named, the fitted parameters and the held-out gain. Nothing is written.
+        The report of ``hybrid diagnose --json``: the cause named (``cause``, a list), the fitted
+        parameters, held-out errors and where the residual is. For a trace of any model also
+        ``curves``: per run a dict with ``run``, ``time`` (a numpy array) and ``measured``,
+        ``baseline``, ``extended`` ({variable: numpy array}, NaN where missing). Nothing is
+        written.
 
     Raises:
         DataError: bad data (a ValueError naming the file, line and column).
     """
+    if len(files) not in (1, 2):
+        raise TypeError("diagnose() takes (model, data) or (data)")
+    if len(files) == 2:
+        if model is not None:
+            raise TypeError("diagnose(): the model is given twice")
+        model, data = files
+    else:
+        data = files[0]
+    if _hybrid.is_trace_file(str(data)):
+        if model is None:
+            raise ValueError(f"{data} is a trace (it has a 'time' column): give its model, "
+                             "diagnose(model, data)")
+        items = [f"{k}={v!r}" for k, v in (noise or {}).items()]
+        report = _json.loads(_hybrid.diagnose_model_json(str(model), str(data),
+                                                         float(significance), int(threads),
+                                                         items))
+        import numpy
+        for curve in report["curves"]:
+            curve["time"] = numpy.asarray(curve["time"], dtype=float)
+            for key in ("measured", "baseline", "extended"):
+                curve[key] = {name: numpy.array([numpy.nan if v is None else v for v in values])
+                              for name, values in curve[key].items()}
+        return report
+    if noise:
+        raise ValueError("noise applies to a trace of any model, not to the finger's data")
     report = _hybrid.diagnose_json(str(data), None if model is None else str(model),
                                    float(significance), int(threads))
     return _json.loads(report)

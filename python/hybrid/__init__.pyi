@@ -59,9 +59,10 @@ def hand(
     g_c: float | None = ...,
 ) -> dict[str, Any]: ...
 def diagnose(
-    data: Union[str, PathLike[str]],
+    *files: Union[str, PathLike[str]],
     model: Union[str, PathLike[str], None] = ...,
     significance: float = ...,
     threads: int = ...,
+    noise: dict[str, float] | None = ...,
 ) -> dict[str, Any]: ...
 def set_log_level(level: Literal["debug", "info", "warning"] | None) -> None: ...

@@ -712,7 +712,13 @@ TEST(EstimateNoiseFloor, PoolsTheVarianceOfRepeatedRuns) {
   const NoiseFloor floor = EstimateNoiseFloor(MakeData(std::move(runs)));
   EXPECT_EQ(floor.method, "repeated_runs");
   const int dof = 500 * 3 + 600 * 2;
-  EXPECT_EQ(floor.dof, (std::array<int, 3>{dof - 2 * 3, dof, dof}));
+  // The spike rule (SpikeMask at 4 sigma) leaves out the rare Gaussian samples it flags: a few
+  // per thousand at most.
+  const std::array<int, 3> all = {dof - 2 * 3, dof, dof};
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_LE(floor.dof[j], all[j]);
+    EXPECT_GE(floor.dof[j], 0.99 * all[j]);
+  }
   ExpectNearNoise(floor);
 }
 
@@ -740,7 +746,10 @@ TEST(EstimateNoiseFloor, UsesSecondDifferencesWithoutRepeats) {
   const MeasuredData data = MakeData(std::move(runs));
   const NoiseFloor floor = EstimateNoiseFloor(data);
   EXPECT_EQ(floor.method, "second_differences");
-  EXPECT_EQ(floor.dof, (std::array<int, 3>{5 * 998, 5 * 998, 5 * 998}));
+  for (int j = 0; j < 3; ++j) {  // but for the rare samples the spike rule flags
+    EXPECT_LE(floor.dof[j], 5 * 998);
+    EXPECT_GE(floor.dof[j], 0.99 * 5 * 998);
+  }
   ExpectNearNoise(floor);
 
   // Robust: three spikes of 30 degrees per run (each in 3 of the 998 second differences, which

@@ -268,6 +268,33 @@ def test_diagnose_is_the_command_lines():
     assert report == cli
 
 
+def test_diagnose_any_model_is_the_command_lines_with_arrays():
+    import numpy
+    model = os.path.join(SOURCE, "spec", "thermostat_urgent.ha")
+    data = os.path.join(SOURCE, "data", "thermostat_threshold.csv")
+    report = hybrid.diagnose(model, data)
+    out = run("diagnose", model, data, "--json")
+    assert out.returncode == 0, out.stderr
+    cli = json.loads(out.stdout)
+    curves = report.pop("curves")
+    del report["seconds"], cli["seconds"]  # wall times
+    assert report == cli
+    # One array per run and variable, as long as the run's rows in the CSV.
+    with open(data) as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))][1:]
+    per_run = {}
+    for r in rows:
+        per_run[r[0]] = per_run.get(r[0], 0) + 1
+    assert [c["run"] for c in curves] == list(per_run)
+    for c in curves:
+        assert isinstance(c["time"], numpy.ndarray) and len(c["time"]) == per_run[c["run"]]
+        for key in ("measured", "baseline", "extended"):
+            assert c[key]["x"].shape == c["time"].shape
+    # A trace without its model is refused, naming what to do.
+    with pytest.raises(ValueError, match="give its model"):
+        hybrid.diagnose(data)
+
+
 def test_diagnose_bad_data_names_the_row(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("nothing,useful\n1,2\n")

@@ -47,7 +47,8 @@ def load_schemas():
 
 SCHEMAS = load_schemas()
 DOCUMENTS = ["info.schema.json", "simulate.schema.json", "check.schema.json", "finger.schema.json",
-             "finger_batch.schema.json", "hand.schema.json", "diagnose.schema.json"]
+             "finger_batch.schema.json", "hand.schema.json", "diagnose.schema.json",
+             "diagnose_model.schema.json"]
 
 
 def validator(name):
@@ -309,6 +310,20 @@ def test_diagnose(diagnosis):
                        where={"joint": "theta3", "mode": "c100_l010", "direction": "closing",
                               "g_range": [180.0, 230.0], "mean_residual": 2.5, "excess": 3.0})
     assert_valid("diagnose.schema.json", unexplained)
+
+
+def test_diagnose_model():
+    # A trace of any model: the thermostat with a shifted threshold, named with a parameter.
+    report = run("diagnose", os.path.join(SPEC, "thermostat_urgent.ha"),
+                 os.path.join(SOURCE, "data", "thermostat_threshold.csv"), "--json")
+    assert_valid("diagnose_model.schema.json", report)
+    assert report["cause"] == ["switch_on.threshold"]
+    # The other branches: unexplained with `where`, and a remainder.
+    located = {"variable": "x", "mode": "on", "time_range": [1.0, 2.0], "mean_residual": 0.3,
+               "excess": 4.0}
+    other = copy.deepcopy(report)
+    other.update(cause=["unexplained"], parameters={}, where=located, remainder=located)
+    assert_valid("diagnose_model.schema.json", other)
 
 
 def test_the_python_modules_dicts(tmp_path):

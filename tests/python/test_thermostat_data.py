@@ -13,6 +13,7 @@ their generator, tools/thermostat_trace.py, run by ctest (thermostat_data):
 import ast
 import csv
 import glob
+import json
 import os
 import shlex
 import subprocess
@@ -143,3 +144,18 @@ def test_noiseless_generator_agrees_with_simulate(tmp_path, case):
         assert len(closed) == len(switches) >= 10, (closed, switches)
         assert [m for _, m in closed] == [m for _, m in switches]
         assert max(abs(t - ts) for (t, _), (ts, _) in zip(closed, switches)) <= TOLERANCE
+
+
+def test_diagnose_names_a_moved_invariant_of_the_lazy_thermostat(tmp_path):
+    # The lazy thermostat switches where its invariants end: a heater that starts at 18.5 instead
+    # of 18 is the invariant threshold `off.invariant`, found from a trace the generator makes.
+    trace = tmp_path / "lazy_threshold.csv"
+    trace.write_text(subprocess.run(
+        [sys.executable, GENERATOR, "--switch-on", "18.5", "--seed", "7"],
+        cwd=SOURCE, check=True, capture_output=True, text=True).stdout)
+    out = subprocess.run([BINARY, "diagnose", os.path.join(SOURCE, "spec", "thermostat.ha"),
+                          str(trace), "--json"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    report = json.loads(out.stdout)
+    assert report["cause"] == ["off.invariant"]
+    assert abs(report["parameters"]["off.invariant"] - 18.5) < 0.025

@@ -88,6 +88,25 @@ std::array<double, 3> RigAngles(double q, const RigFinger& finger, const RigObje
   return theta;
 }
 
+namespace {
+
+// RigMeasurement's outliers on theta3, from their own stream.
+void AddOutliers(const RigMeasurement& m, std::vector<RigSample>& samples) {
+  if (m.outlier_fraction <= 0.0) return;
+  std::mt19937_64 random(m.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::bernoulli_distribution start(m.outlier_fraction), pair(m.outlier_pair_fraction), up(0.5);
+  std::uniform_real_distribution<double> size(m.outlier_min, m.outlier_max);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    if (!start(random)) continue;
+    const size_t count = pair(random) && k + 1 < samples.size() ? 2 : 1;
+    for (size_t i = k; i < k + count; ++i)
+      samples[i].theta[2] += (up(random) ? 1 : -1) * size(random);
+    k += count - 1;
+  }
+}
+
+}  // namespace
+
 std::vector<RigSample> RigRun(const std::vector<double>& requests, const RigFinger& finger,
                               const RigObject& object, const RigEffects& effects,
                               const RigMeasurement& measurement) {
@@ -116,6 +135,7 @@ std::vector<RigSample> RigRun(const std::vector<double>& requests, const RigFing
     }
     samples.push_back(sample);
   }
+  AddOutliers(measurement, samples);
   return samples;
 }
 

@@ -78,6 +78,15 @@ struct RigMeasurement {
   double noise_deg = 0.0;       ///< standard deviation of Gaussian noise on each angle
   double missing_fraction = 0;  ///< probability that an angle cell is missing
   std::uint64_t seed = 1;
+  /// Outliers on theta3 (the report's section 5: its sensor's): each sample is the first of an
+  /// outlier with this probability, of a size drawn uniformly from [outlier_min, outlier_max]
+  /// degrees with a random sign, added to the measured angle; with probability
+  /// `outlier_pair_fraction` the next sample gets one too (an adjacent pair). Drawn from their
+  /// own stream (seeded from `seed`), so that noise and missing cells are those of a run without
+  /// outliers.
+  double outlier_fraction = 0.0;
+  double outlier_min = 10.0, outlier_max = 25.0;
+  double outlier_pair_fraction = 0.0;
 };
 
 /// The settled samples of a run that commands `requests` in order, starting from the open finger

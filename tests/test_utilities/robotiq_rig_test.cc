@@ -169,6 +169,32 @@ TEST(RobotiqRig, BiasNoiseAndMissingCells) {
   EXPECT_NEAR(std::sqrt(sum2 / n), 0.3, 0.06);
 }
 
+// Outliers on theta3 only, of the sizes asked for, some in adjacent pairs; the other angles and
+// the noise are those of the run without outliers.
+TEST(RobotiqRig, OutliersOnTheta3InPairs) {
+  RigMeasurement m;
+  m.noise_deg = 0.5;
+  m.seed = 9;
+  const auto requests = RigSweep(0, 255, 0.25);
+  const auto clean = RigRun(requests, RigFinger{}, {}, {}, m);
+  m.outlier_fraction = 0.02;
+  m.outlier_pair_fraction = 0.5;
+  const auto dirty = RigRun(requests, RigFinger{}, {}, {}, m);
+  int outliers = 0, pairs = 0;
+  for (size_t k = 0; k < clean.size(); ++k) {
+    EXPECT_EQ(clean[k].theta[0], dirty[k].theta[0]);
+    EXPECT_EQ(clean[k].theta[1], dirty[k].theta[1]);
+    const double d = std::abs(dirty[k].theta[2] - clean[k].theta[2]);
+    if (d == 0) continue;
+    EXPECT_GE(d, 10.0);
+    EXPECT_LE(d, 25.0);
+    ++outliers;
+    if (k > 0 && dirty[k - 1].theta[2] != clean[k - 1].theta[2]) ++pairs;
+  }
+  EXPECT_NEAR(outliers / static_cast<double>(clean.size()), 0.03, 0.012);  // 2% x 1.5
+  EXPECT_GE(pairs, 3);
+}
+
 TEST(RobotiqRig, SweepAndCsv) {
   const auto up = RigSweep(250, 255, 2);
   EXPECT_EQ(up, (std::vector<double>{250, 252, 254, 255}));

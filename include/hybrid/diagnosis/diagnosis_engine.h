@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hybrid/diagnosis/diagnosis_model.h"
+#include "hybrid/diagnosis/noise_floor.h"
 
 namespace hybrid {
 
@@ -23,11 +24,31 @@ struct DiagnosisOptions {
   /// `systematic_sigmas` standard errors plus `systematic_margin` (relative).
   double systematic_sigmas = 4.0;
   double systematic_margin = 0.05;
-  /// Grid points of the first, coarse pass over a parameter's range (a second, fine pass adds
-  /// points around the best one).
+  /// Grid points of the coarse grid over a parameter's range (the bracketing search then adds
+  /// points around its starts, DiagnoseModel step 2).
   int grid_points = 9;
   /// The same for the second parameter of a pair (the first one fixed).
   int pair_grid_points = 7;
+  /// Horizons of the search: fractions of each run's samples (a horizon h keeps the first
+  /// ceil(h n) samples of a run of n), ascending in (0, 1], the last 1. Every coarse grid point
+  /// is scored at every horizon from the same prediction; the best point of each horizon is a
+  /// start of the bracketing. Short horizons find the narrow basins of switching systems, whose
+  /// residuals are discontinuous in a threshold: {1} (the default) searches the full runs only.
+  std::vector<double> horizons = {1.0};
+  /// Further starts of the bracketing: the best other local minima of the full-horizon loss on
+  /// the coarse grid.
+  int extra_starts = 0;
+  /// The most predictions (Predict calls, one run each) the search may make: once exceeded, no
+  /// further candidate is searched (a note says which were not).
+  long max_predictions = 200000;
+  /// The outlier rule (SpikeMask): a residual more than this many noise standard deviations
+  /// from the median of its 5-sample window is a spike, left out of the test for systematic
+  /// residuals, of explained_fraction and of `where`; EstimateChannelNoise applies the same rule.
+  double spike_sigmas = kDefaultSpikeSigmas;
+  /// When the best extension still leaves a systematic residual but explains at least this
+  /// fraction of the baseline's excess (ModelDiagnosis::explained_fraction), its causes are
+  /// named all the same, with the remainder located; below it the verdict is "unexplained".
+  double main_fraction = 0.9;
   /// Refine the selected parameters with Ceres (robust loss, from the cross-validated values).
   bool refine = true;
   /// Worker threads for the simulations (>= 1).
@@ -35,13 +56,6 @@ struct DiagnosisOptions {
   /// If set, called on the calling thread before each candidate is fitted: the stage ("single
   /// causes", "pairs"), the candidates done and their number (for a progress report).
   std::function<void(const std::string& stage, int done, int total)> progress;
-};
-
-/// The noise floor of each channel: variance (unit^2) and the degrees of freedom it was
-/// estimated from (its standard error enters the test for systematic residuals).
-struct ChannelNoise {
-  std::vector<double> variance;
-  std::vector<int> dof;
 };
 
 /// One candidate extension as judged by cross-validation.
@@ -110,9 +124,27 @@ struct ModelDiagnosis {
   std::vector<ResidualJump> change_points;
   /// Mean baseline residual with the input rising minus falling, per channel.
   std::vector<double> direction_difference;
+  /// Where the residual no candidate explains is ("unexplained" only): located on the best
+  /// extension's predictions (the baseline's when no candidate is significant).
   std::optional<SystematicResidual> where;
+  /// The fraction of the baseline's excess over the noise that the named causes explain:
+  /// (E_base - E_ext) / E_base, clamped to [0, 1], E = sum over channels of
+  /// n_c (ms_c / sigma_c^2 - 1) of the held-out residuals that are not spikes (n_c of them, mean
+  /// square ms_c); 0 when E_base <= 0 or no candidate is significant. Also set for
+  /// "unexplained" when a candidate was significant (the best extension's fraction).
+  double explained_fraction = 0.0;
+  /// When causes are named but the extension still leaves a systematic residual (it explains
+  /// at least DiagnosisOptions::main_fraction): where that remainder is, on the extension's
+  /// predictions.
+  std::optional<SystematicResidual> remainder;
+  /// What the search could not do, in words: a candidate that could not be simulated
+  /// ("<cause> (<parameter name>): could not be simulated: <message>", at every value: left out
+  /// of the selection and of `candidates`; or at some values: "... could not be simulated at K
+  /// of N run predictions (loss +inf there): <message>"), the prediction budget spent.
+  std::vector<std::string> notes;
   /// Every single candidate, then the pairs with the first cause (if one was significant and
-  /// left a systematic residual).
+  /// left a systematic residual): the best three of them (by held-out loss with the first fixed)
+  /// fitted jointly, the others with the first fixed at its single-cause value.
   std::vector<ParameterFit> candidates;
   /// The baseline's and the extended model's predictions of every run.
   std::vector<RunPrediction> baseline, extended;
@@ -123,18 +155,35 @@ struct ModelDiagnosis {
 ///    Huber function with threshold DiagnosisOptions::huber, and groups its residuals per
 ///    channel, mode and direction of travel (bias, trend, excess over the noise; change points
 ///    where the mode switches; the difference between directions);
-/// 2. fits every candidate parameter on its grid (a coarse pass, then a fine one around the
-///    best point, each refined by the parabola through the best point and its neighbours),
-///    cross-validates it leaving one run out, and names the best one when its held-out gain is
-///    significant (DiagnosisOptions::significance; BIC breaks ties); when that one leaves a
-///    systematic residual, tries each other candidate with it and names a second cause when it
-///    adds a significant held-out gain;
+/// 2. searches every candidate parameter (SearchProfile, solvers/diagnosis/profile_search.h):
+///    a coarse grid scored at every horizon, then from the best grid point of each horizon (and
+///    `extra_starts` further local minima) a bracketing between the start's grid neighbours,
+///    golden-section steps with parabolic ones where they help, on the full-horizon loss of all
+///    runs; every value tried is recorded. Each run's fold (the candidate fitted without it) is
+///    the recorded value of least training loss, refined by a parabola when its neighbours are
+///    close; the held-out run is predicted there. The candidate of least held-out loss is named
+///    when its gain over the baseline is significant (DiagnosisOptions::significance; BIC breaks
+///    ties). When it leaves a systematic residual, each other candidate is searched with it
+///    fixed, the best three of those are fitted jointly with it (coordinate search: the first
+///    given the second, then the second given the first, around the best point so far; every
+///    point recorded) and cross-validated (each fold at the recorded point of least training
+///    loss), and a second cause is named when the pair's held-out gain over the first alone is
+///    significant. A prediction that throws (std::exception) scores +inf at that value (notes);
+///    a candidate with no finite value is left out; the search stops at max_predictions;
 /// 3. refines the named parameters on all runs with Ceres (Huber loss per sample, bounds = the
-///    search ranges);
-/// 4. calls the result "unexplained" (with `where`) when the extended model's held-out residual
-///    is still systematic against the noise floor, and "none" when the baseline's is not.
+///    search ranges), kept only when the all-data loss drops;
+/// 4. the verdict: "none" when nothing is significant and the baseline's residual is not
+///    systematic; "unexplained" (with `where` on the best extension's predictions, no
+///    parameters adopted) when the best extension (or the baseline) leaves a systematic residual
+///    and explains less than main_fraction of the baseline's excess (explained_fraction); else
+///    the causes, with `remainder` when a systematic residual is left. Systematic: on some
+///    channel the mean square of the held-out residuals that are not spikes (SpikeMask,
+///    spike_sigmas) exceeds the noise floor by more than systematic_sigmas standard errors plus
+///    systematic_margin.
 /// Throws std::invalid_argument when `runs` is empty, when `noise` or a run does not have one
-/// entry per channel, or when the model cannot predict a run.
+/// entry per channel, when the horizons or main_fraction are out of range, or when the model
+/// cannot predict a run of the baseline; std::logic_error when a prediction does not have its
+/// run's shape.
 ModelDiagnosis DiagnoseModel(const DiagnosisModel& model, const std::vector<DiagnosisRun>& runs,
                              const ChannelNoise& noise, const DiagnosisOptions& options = {});
 

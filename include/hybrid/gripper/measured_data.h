@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "hybrid/diagnosis/data_error.h"
+#include "hybrid/diagnosis/spike_filter.h"
 
 namespace hybrid {
 
@@ -146,21 +147,24 @@ struct NoiseFloor {
 };
 
 /// Estimates the noise variance of each joint angle, assuming independent noise of equal
-/// variance on every sample.
+/// variance on every sample: EstimateChannelNoise (include/hybrid/diagnosis/noise_floor.h) on the
+/// three angles, so with the diagnosis's one outlier rule (SpikeMask, 4 noise standard
+/// deviations from the median of a 5-sample window: spikes are left out) and its two estimators.
 /// Runs are repeats when they have the same gob and contact_link (both empty, or equal), the same
 /// number of samples and the same g at every sample (within 1e-9); each run joins the group of
 /// the first earlier run it repeats.
 /// With at least one group of two or more repeats, method "repeated_runs": the pooled
 /// within-group variance over the groups of two or more runs, at the samples where every run of
-/// the group has the angle: the sum over those samples of the squared deviations from the group's
-/// mean at the sample, divided by dof = the sum over them of (runs in the group - 1). Outliers
-/// inflate this estimate: clean the data first (CleanOutliers).
+/// the group has the angle (and none has a spike there): the sum over those samples of the
+/// squared deviations from the group's mean at the sample, divided by dof = the sum over them of
+/// (runs in the group - 1).
 /// Otherwise, method "second_differences": from the second differences
 /// d_k = x[k+1] - 2 x[k] + x[k-1] over consecutive samples of a run where all three are present
-/// (Var d = 6 sigma^2 for independent noise on a curve whose second differences are negligible).
-/// Each run's d are centred on their median, the absolute deviations of all runs are pooled, and
-/// variance = (1.4826 * their median)^2 / 6 (a robust, median-absolute-deviation estimate);
-/// dof is the number of second differences used.
-NoiseFloor EstimateNoiseFloor(const MeasuredData& data);
+/// and none is a spike (Var d = 6 sigma^2 for independent noise on a curve whose second
+/// differences are negligible). Each run's d are centred on their median, the absolute
+/// deviations of all runs are pooled, and variance = (1.4826 * their median)^2 / 6 (a robust,
+/// median-absolute-deviation estimate); dof is the number of second differences used.
+/// `spike_sigmas` is the outlier rule's threshold (DiagnosisOptions::spike_sigmas).
+NoiseFloor EstimateNoiseFloor(const MeasuredData& data, double spike_sigmas = kDefaultSpikeSigmas);
 
 }  // namespace hybrid

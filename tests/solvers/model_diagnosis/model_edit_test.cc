@@ -1,0 +1,160 @@
+#include "hybrid/model_diagnosis/model_edit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "hybrid/automaton/parser.h"
+#include "hybrid/automaton/printer.h"
+#include "hybrid/simulation/simulator.h"
+#include "tests/test_utilities/models.h"
+
+namespace hybrid {
+namespace {
+
+System Spec(const std::string& name) { return ParseModel(testing::SpecText(name), name + ".ha"); }
+
+TraceData Trace(const System& model) {
+  std::string text = "run,time,u,x\n";
+  for (int k = 0; k < 20; ++k)
+    text += "a," + std::to_string(k) + ",10," + std::to_string(18 + 0.2 * k) + "\n";
+  std::istringstream in(text);
+  return ReadTraceData(in, "t.csv", model);
+}
+
+std::vector<std::string> Names(const CandidateSet& set) {
+  std::vector<std::string> names;
+  for (const ModelEdit& e : set.edits) names.push_back(e.name);
+  return names;
+}
+
+const ModelEdit& Find(const CandidateSet& set, const std::string& name) {
+  for (const ModelEdit& e : set.edits) {
+    if (e.name == name) return e;
+  }
+  throw std::invalid_argument("no edit " + name);
+}
+
+// x at every 0.5 time units of the model's scenario, with `parameters` set per run.
+std::vector<double> Samples(const System& s,
+                            std::vector<std::pair<std::string, double>> parameters = {},
+                            const std::string& variable = "x") {
+  const Simulator sim(s);
+  SimulationOptions o;
+  o.sample_step = 0.5;
+  o.parameters = std::move(parameters);
+  const SimulationResult r = sim.Run(o);
+  EXPECT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  const auto& names = sim.variable_names();
+  const size_t i = std::find(names.begin(), names.end(), variable) - names.begin();
+  std::vector<double> xs;
+  for (const StateSample& sample : r.samples) {
+    if (sample.kind == StateSample::Kind::kSample) xs.push_back(sample.x[i]);
+  }
+  return xs;
+}
+
+void ExpectNear(const std::vector<double>& a, const std::vector<double>& b, double tol) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], tol) << "sample " << k;
+}
+
+TEST(CandidateEdits, ThermostatVocabulary) {
+  const System s = Spec("thermostat");
+  const CandidateSet set = CandidateEdits(s.components()[0].automaton, Trace(s));
+  EXPECT_EQ(Names(set),
+            (std::vector<std::string>{"a", "p", "x_bias", "x_gain", "off.x_gain", "on.x_gain",
+                                      "off.invariant", "on.invariant", "u_offset"}));
+  // Both guards are lazy: left out, with a note each.
+  ASSERT_EQ(set.notes.size(), 2u);
+  EXPECT_NE(set.notes[0].find("lazy transition 'switch_on'"), std::string::npos);
+  const ModelEdit& inv = Find(set, "off.invariant");
+  EXPECT_EQ(inv.identifier, "off_invariant");
+  EXPECT_EQ(inv.neutral, 18.0);
+  // A quarter of the measured range of x (18 to 21.8) either side.
+  EXPECT_NEAR(inv.hi - inv.lo, 0.5 * 3.8, 1e-9);
+  EXPECT_NEAR(Find(set, "x_bias").hi, 1.9, 1e-9);
+  EXPECT_NEAR(Find(set, "p").lo, 1.5, 1e-12);  // no declared range: +-50%
+}
+
+TEST(CandidateEdits, UrgentGuardsAreThresholds) {
+  const System s = Spec("thermostat_urgent");
+  const CandidateSet set = CandidateEdits(s.components()[0].automaton, Trace(s));
+  const ModelEdit& on = Find(set, "switch_on.threshold");
+  EXPECT_EQ(on.kind, EditKind::kGuardThreshold);
+  EXPECT_EQ(on.owner, "switch_on");
+  EXPECT_EQ(on.neutral, 18.0);
+  EXPECT_TRUE(set.notes.empty());
+}
+
+// Oracle 1: every dynamic edit at its neutral value leaves the model's runs as they were.
+TEST(ApplyEdits, NeutralEditsSimulateAsTheModel) {
+  for (const char* name : {"thermostat", "thermostat_urgent"}) {
+    const System s = Spec(name);
+    const Automaton& a = s.components()[0].automaton;
+    std::vector<std::pair<ModelEdit, double>> neutral;
+    for (const ModelEdit& e : CandidateEdits(a, Trace(s)).edits) {
+      if (!e.cheap && e.kind != EditKind::kParameter) neutral.emplace_back(e, e.neutral);
+    }
+    ASSERT_GE(neutral.size(), 4u);
+    ExpectNear(Samples(System::Of(ApplyEdits(a, neutral))), Samples(s), 1e-9);
+  }
+}
+
+// Oracle 2: the extended model, printed and parsed back, simulates as the instrumented model with
+// the values set per run; and the measured variable is gain * x + bias.
+TEST(ApplyEdits, ExtendedModelRoundTripsAndEqualsPerRunValues) {
+  const System s = Spec("thermostat_urgent");
+  const Automaton& a = s.components()[0].automaton;
+  const CandidateSet set = CandidateEdits(a, Trace(s));
+  const std::vector<std::pair<ModelEdit, double>> edits = {{Find(set, "switch_on.threshold"), 18.5},
+                                                           {Find(set, "on.x_gain"), 0.9},
+                                                           {Find(set, "u_offset"), -1.0},
+                                                           {Find(set, "x_bias"), 0.4},
+                                                           {Find(set, "x_gain"), 1.01}};
+  const std::string text = PrintSystem(System::Of(ApplyEdits(a, edits)));
+  const System extended = ParseModel(text, "extended.ha");
+  std::vector<std::pair<ModelEdit, double>> neutral;
+  for (const auto& [e, v] : edits) {
+    if (!e.cheap) neutral.emplace_back(e, e.neutral);
+  }
+  const System instrumented = System::Of(ApplyEdits(a, neutral));
+  const std::vector<double> x = Samples(
+      instrumented, {{"switch_on_threshold", 18.5}, {"on_x_gain", 0.9}, {"u_offset", -1.0}});
+  // The extended model integrates one more variable (x_measured): the error control differs.
+  ExpectNear(Samples(extended), x, 1e-7);
+  const std::vector<double> measured = Samples(extended, {}, "x_measured");
+  ASSERT_EQ(measured.size(), x.size());
+  for (size_t k = 0; k < x.size(); ++k) EXPECT_NEAR(measured[k], 1.01 * x[k] + 0.4, 1e-6);
+  // And the edits change the run (the comparison can fail).
+  EXPECT_GT(std::abs(Samples(s).back() - x.back()), 0.1);
+}
+
+// Oracle 3: the printed edits, written by hand.
+TEST(ApplyEdits, PrintedEdits) {
+  const System s = Spec("thermostat_urgent");
+  const Automaton& a = s.components()[0].automaton;
+  const CandidateSet set = CandidateEdits(a, Trace(s));
+  const std::vector<std::pair<ModelEdit, double>> edits = {{Find(set, "switch_on.threshold"), 18.5},
+                                                           {Find(set, "x_bias"), 0.4}};
+  const std::string text = PrintSystem(System::Of(ApplyEdits(a, edits)));
+  for (const char* line :
+       {"param switch_on_threshold = 18.5;", "param x_bias = 0.4;", "var x_measured [degC];",
+        "guard x <= switch_on_threshold;", "x_measured' = a * (u - x);",
+        "x_measured' = a * (u - x) + p;", "init off { x = 20; x_measured = 20 + x_bias; }"}) {
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
+  }
+}
+
+TEST(ApplyEdits, RefusesAnEditThatDoesNotFit) {
+  const System s = Spec("thermostat_urgent");
+  const Automaton& a = s.components()[0].automaton;
+  ModelEdit e = Find(CandidateEdits(a, Trace(s)), "switch_on.threshold");
+  e.atom = 3;
+  const std::vector<std::pair<ModelEdit, double>> edits = {{e, 18.5}};
+  EXPECT_THROW(ApplyEdits(a, edits), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hybrid
