@@ -94,6 +94,9 @@ void Translate(const ModelDiagnosis& m, const FingerDiagnosisModel& model, const
   d.change_points = m.change_points;
   d.direction_difference = Joints(m.direction_difference);
   d.where = m.where;
+  d.explained_fraction = m.explained_fraction;
+  d.remainder = m.remainder;
+  d.notes = m.notes;
   for (const ParameterFit& f : m.candidates) d.candidates.push_back(AsCandidateFit(f, model));
   for (size_t r = 0; r < data.runs.size(); ++r) {
     d.curves.push_back(RunCurves{data.runs[r].label, data.runs[r].g, data.runs[r].theta,

@@ -50,6 +50,13 @@ json PerJoint(const std::array<double, 3>& v) {
 
 std::string Direction(int d) { return d > 0 ? "closing" : "opening"; }
 
+json Located(const std::optional<ResidualLocation>& w) {
+  if (!w) return nullptr;
+  return {{"joint", kJoints[w->channel]},         {"mode", w->mode},
+          {"direction", Direction(w->direction)}, {"g_range", {w->input_min, w->input_max}},
+          {"mean_residual", w->mean_residual},    {"excess", w->excess}};
+}
+
 json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   json out;
   out["data"] = {{"file", args.data},
@@ -78,16 +85,10 @@ json ToJson(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
       {"theta1", d.noise.dof[0]}, {"theta2", d.noise.dof[1]}, {"theta3", d.noise.dof[2]}};
   out["noise_floor"] = noise;
   out["mse_unit"] = "deg^2";
-  if (d.where) {
-    out["where"] = {{"joint", kJoints[d.where->channel]},
-                    {"mode", d.where->mode},
-                    {"direction", Direction(d.where->direction)},
-                    {"g_range", {d.where->input_min, d.where->input_max}},
-                    {"mean_residual", d.where->mean_residual},
-                    {"excess", d.where->excess}};
-  } else {
-    out["where"] = nullptr;
-  }
+  out["where"] = Located(d.where);
+  out["explained_fraction"] = d.explained_fraction;
+  out["remainder"] = Located(d.remainder);
+  out["notes"] = d.notes;
   json candidates = json::array();
   for (const CandidateFit& c : d.candidates) {
     json names = json::array(), values = json::object();
@@ -142,6 +143,12 @@ std::string Fixed(double v, int digits) {
   return s.str();
 }
 
+std::string WhereText(const ResidualLocation& w) {
+  return std::string(kJoints[w.channel]) + ", mode " + w.mode + ", " + Direction(w.direction) +
+         ", g in [" + Fixed(w.input_min, 1) + ", " + Fixed(w.input_max, 1) + "], mean residual " +
+         Fixed(w.mean_residual, 2) + " deg";
+}
+
 std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds) {
   std::ostringstream out;
   out << "data: " << args.data << ": " << d.curves.size() << " runs, " << d.samples
@@ -158,12 +165,12 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
   for (const auto& [p, v] : d.parameters) {
     out << "  " << ParameterName(p) << " = " << Fixed(v, 4) << " " << ParameterUnit(p) << "\n";
   }
-  if (d.where) {
-    out << "where: " << kJoints[d.where->channel] << ", mode " << d.where->mode << ", "
-        << Direction(d.where->direction) << ", g in [" << Fixed(d.where->input_min, 1) << ", "
-        << Fixed(d.where->input_max, 1) << "], mean residual " << Fixed(d.where->mean_residual, 2)
-        << " deg\n";
+  if (!d.parameters.empty()) {
+    out << "explained: " << Fixed(100 * d.explained_fraction, 1)
+        << "% of the baseline's excess over the noise floor\n";
   }
+  if (d.remainder) out << "unexplained remainder: " << WhereText(*d.remainder) << "\n";
+  if (d.where) out << "where: " << WhereText(*d.where) << "\n";
   out << "held-out MSE (deg^2)      theta1    theta2    theta3\n";
   auto row = [&](const char* name, const std::array<double, 3>& v) {
     out << "  " << name;
@@ -183,6 +190,7 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
     }
     out << "  " << (c.significant ? "*" : " ") << " " << name << ": " << Fixed(c.gain, 1) << "\n";
   }
+  for (const std::string& note : d.notes) out << "note: " << note << "\n";
   out << "time: " << Fixed(seconds, 2) << " s\n";
   return out.str();
 }

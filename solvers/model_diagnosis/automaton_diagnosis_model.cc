@@ -127,6 +127,7 @@ RunPrediction AutomatonDiagnosisModel::Simulated(
   RunPrediction p;
   p.channels.assign(channel_index_.size(), {});
   for (const StateSample& s : result.samples) {
+    if (!s.modes.empty()) p.visited.push_back(s.modes[0]);
     if (s.kind != StateSample::Kind::kSample) continue;
     for (size_t c = 0; c < channel_index_.size(); ++c)
       p.channels[c].push_back(s.x[channel_index_[c]]);
@@ -137,6 +138,8 @@ RunPrediction AutomatonDiagnosisModel::Simulated(
                            "' did not record one state per sample");
   }
   p.direction.assign(trace.time.size(), 1);
+  std::sort(p.visited.begin(), p.visited.end());
+  p.visited.erase(std::unique(p.visited.begin(), p.visited.end()), p.visited.end());
   return p;
 }
 
@@ -190,7 +193,9 @@ bool AutomatonDiagnosisModel::Affects(int parameter, int run,
   } else if (e.kind != EditKind::kFlowGain && e.kind != EditKind::kInvariantThreshold) {
     return true;
   }
-  for (int m : reference.mode) {
+  // Every mode the reference visits, also at the instant of a jump (a mode left at the instant
+  // it is entered has no sample).
+  for (int m : reference.visited.empty() ? reference.mode : reference.visited) {
     if (m >= 0 && ModeName(m) == mode) return true;
   }
   return false;

@@ -26,6 +26,9 @@ struct RunPrediction {
   std::vector<int> mode;
   /// Direction of travel of the input at each sample: +1 or -1.
   std::vector<int> direction;
+  /// Every mode the prediction visits, also between samples and at the instant of a jump
+  /// (sorted, each once); empty when the model records only `mode`. For Affects.
+  std::vector<int> visited;
 };
 
 /// One number a candidate extension of the model fits.

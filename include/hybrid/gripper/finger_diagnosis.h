@@ -69,6 +69,12 @@ struct Diagnosis {
   /// Mean baseline residual closing minus opening, per joint (deg).
   std::array<double, 3> direction_difference = {0, 0, 0};
   std::optional<ResidualLocation> where;
+  /// The fraction of the baseline's held-out excess over the noise floor the named causes remove
+  /// (ModelDiagnosis::explained_fraction), and where the systematic remainder they leave is.
+  double explained_fraction = 0.0;
+  std::optional<ResidualLocation> remainder;
+  /// Candidates dropped or searched in part (ModelDiagnosis::notes).
+  std::vector<std::string> notes;
   /// Every single candidate, then the pairs with the first cause (if one was significant).
   std::vector<CandidateFit> candidates;
   std::vector<RunCurves> curves;

@@ -35,7 +35,8 @@ class AutomatonDiagnosisModel : public DiagnosisModel {
   /// not complete.
   RunPrediction Predict(int run, const ParameterValues& values) const override;
   /// False for a flow gain or invariant threshold of a mode, or a guard threshold of a
-  /// transition out of a mode, that `reference` never visits.
+  /// transition out of a mode, that `reference` never visits (RunPrediction::visited: also a
+  /// mode left at the instant it is entered).
   bool Affects(int parameter, int run, const RunPrediction& reference) const override;
   std::string ModeName(int mode) const override;
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <sstream>
 
 #include "hybrid/automaton/parser.h"
 #include "hybrid/automaton/printer.h"
@@ -62,6 +64,30 @@ TEST(ThermostatExamples, ShiftedThresholdWrittenAsALiteral) {
   const std::string text = PrintSystem(d.extended);
   EXPECT_NE(text.find("guard x <= switch_on_threshold;"), std::string::npos) << text;
   EXPECT_NO_THROW(ParseModel(text, "extended.ha"));
+}
+
+// The model leaves its initial mode at t = 0 (no sample is ever in it); the data never leave it
+// (x = 0.65 + t, the closed form of r's flow): the guard's threshold is the cause, though the
+// mode that decides it has no sample. Found by the property test (draws 32 and 53).
+TEST(AutomatonDiagnosis, AModeLeftAtTheInstantItIsEnteredStillCounts) {
+  const System model = ParseModel(
+      "automaton t0 { var x; mode r { x' = 1; } mode s { x' = -1; }\n"
+      "  transition go: r -> s { guard x <= 1.3; } init r { x = 0.65; } }\n",
+      "t0.ha");
+  std::string csv = "run,time,x\n";
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (int run = 1; run <= 3; ++run) {
+    for (int k = 0; k <= 60; ++k) {
+      const double t = 0.1 * k;
+      csv += std::to_string(run) + "," + std::to_string(t) + "," +
+             std::to_string(0.65 + t + noise(rng)) + "\n";
+    }
+  }
+  std::istringstream in(csv);
+  const AutomatonDiagnosis d = DiagnoseAutomaton(model, ReadTraceData(in, "t0.csv", model));
+  ASSERT_EQ(d.result.cause, std::vector<std::string>{"go.threshold"}) << Causes(d);
+  EXPECT_LT(d.named[0].second, 0.65);  // any threshold below the start keeps r
 }
 
 TEST(AutomatonDiagnosis, RefusesSeveralComponents) {
