@@ -345,7 +345,9 @@ void Summarise(const Engine& e, double reference_loss, double in_sample, Evaluat
 // Cross-validation of one candidate parameter `p` against `ref` (DiagnoseModel, step 2).
 class CandidateEvaluation {
  public:
-  CandidateEvaluation(const Engine& engine, int p, const Reference& ref)
+  // `threads` (>= 1): the worker threads of its own simulations (1 when candidates are
+  // evaluated side by side).
+  CandidateEvaluation(const Engine& engine, int p, const Reference& ref, int threads)
       : e_(engine), p_(p), ref_(ref), param_(engine.parameter(p)) {
     affected_.resize(e_.runs());
     reference_losses_.resize(e_.runs());
@@ -353,7 +355,7 @@ class CandidateEvaluation {
       affected_[r] = e_.model().Affects(p, r, ref.predictions[r]);
       if (!affected_[r]) reference_losses_[r] = e_.HorizonLoss(r, ref.predictions[r]);
     }
-    threads_ = param_.cheap ? 1 : e_.options().threads;
+    threads_ = param_.cheap ? 1 : threads;
   }
 
   // The candidate's evaluation, or nullopt (with a note) when it could not be predicted at any
@@ -730,37 +732,60 @@ struct Selection {
   std::vector<RunScore> scores;
 };
 
-// Whether the prediction budget is spent; if so, a note that `left` candidates from `next` on
-// were not searched.
-bool BudgetSpent(const Engine& e, int left, int next, std::vector<std::string>& notes) {
-  if (!e.OverBudget()) return false;
-  notes.push_back("prediction budget spent (" + std::to_string(e.predictions()) +
-                  " predictions, max_predictions " + std::to_string(e.options().max_predictions) +
-                  "): " + std::to_string(left) + " candidates not searched, from " +
-                  Describe(e, next) + " on");
-  return true;
+// The evaluations of `candidates` against `ref` (nullopt for one that could not be evaluated
+// or was not searched), side by side on the engine's threads (each candidate's simulations on
+// one): the candidates' searches are sequential (a bracket evaluates one value after another),
+// so parallel candidates keep both threads busy where parallel runs of one value do not.
+// Progress is reported from the worker threads, one call at a time; notes are appended in
+// candidate order. Results do not depend on the threads, except which candidates are left out
+// once the prediction budget is spent.
+std::vector<std::optional<Evaluated>> EvaluateAll(const Engine& e,
+                                                  const std::vector<int>& candidates,
+                                                  const Reference& ref, const std::string& stage,
+                                                  std::vector<std::string>& notes) {
+  const int n = static_cast<int>(candidates.size());
+  std::vector<std::optional<Evaluated>> out(n);
+  std::vector<std::vector<std::string>> own_notes(n);
+  std::atomic<int> started{0};
+  std::mutex progress_mutex;
+  ParallelFor(n, e.options().threads, [&](int i) {
+    if (e.OverBudget()) {
+      own_notes[i].push_back("prediction budget spent (max_predictions " +
+                             std::to_string(e.options().max_predictions) +
+                             "): " + Describe(e, candidates[i]) + " not searched");
+      return;
+    }
+    if (e.options().progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      e.options().progress(stage, started++, n);
+    }
+    out[i] = CandidateEvaluation(e, candidates[i], ref, 1).Run(own_notes[i]);
+  });
+  for (const auto& list : own_notes) notes.insert(notes.end(), list.begin(), list.end());
+  return out;
 }
 
 // Every single candidate against the baseline `base` (those that could be evaluated).
 std::vector<Evaluated> Singles(const Engine& e, const Reference& base, ModelDiagnosis& d) {
-  const int count = static_cast<int>(e.model().Parameters().size());
+  std::vector<int> all(e.model().Parameters().size());
+  for (size_t p = 0; p < all.size(); ++p) all[p] = static_cast<int>(p);
   std::vector<Evaluated> singles;
-  for (int p = 0; p < count; ++p) {
-    if (BudgetSpent(e, count - p, p, d.notes)) break;
-    if (e.options().progress) e.options().progress("single causes", p, count);
-    if (auto ev = CandidateEvaluation(e, p, base).Run(d.notes)) {
-      singles.push_back(std::move(*ev));
-      d.candidates.push_back(singles.back().fit);
-    }
+  for (std::optional<Evaluated>& ev : EvaluateAll(e, all, base, "single causes", d.notes)) {
+    if (!ev) continue;
+    singles.push_back(std::move(*ev));
+    d.candidates.push_back(singles.back().fit);
   }
   return singles;
 }
 
 constexpr size_t kJointPairs = 3;
 
-// Every other candidate with `one` (the first cause) fixed, the best kJointPairs of them (by
-// held-out loss, those with a positive held-out gain) then fitted jointly; the pairs' fits appended
-// to the candidates. Returns the joint fits.
+// Every other candidate with `one` (the first cause) fixed, the best of them (by held-out loss)
+// and its rivals (at most kJointPairs in all, each within `significance` of the best's held-out
+// loss and with a positive gain) then fitted jointly; the pairs' fits appended to the
+// candidates. Returns the joint fits. (A pair whose screen is beaten by more than the
+// significance cannot overtake the best by a joint fit that starts from its screen unless the
+// screen was far off; the rivals bound the cost: a joint fit costs about 3 screens.)
 std::vector<Evaluated> Pairs(const Engine& e, const Evaluated& one, ModelDiagnosis& d) {
   const int first = one.fit.parameters[0];
   Reference ref;
@@ -769,16 +794,14 @@ std::vector<Evaluated> Pairs(const Engine& e, const Evaluated& one, ModelDiagnos
   for (const std::vector<double>& fold : one.fold_values) ref.first_folds.push_back(fold[0]);
   ref.scores = one.heldout;
   ref.predictions = e.PredictAll(ref.base);
-  const int count = static_cast<int>(e.model().Parameters().size());
+  std::vector<int> others;
+  for (int p = 0; p < static_cast<int>(e.model().Parameters().size()); ++p) {
+    if (p != first) others.push_back(p);
+  }
   std::vector<Evaluated> screens;
-  for (int p = 0; p < count; ++p) {
-    if (p == first) continue;
-    if (BudgetSpent(e, count - p, p, d.notes)) break;
-    if (e.options().progress) {
-      e.options().progress("pairs with the best single cause", static_cast<int>(screens.size()),
-                           count - 1);
-    }
-    if (auto ev = CandidateEvaluation(e, p, ref).Run(d.notes)) screens.push_back(std::move(*ev));
+  for (std::optional<Evaluated>& ev :
+       EvaluateAll(e, others, ref, "pairs with the best single cause", d.notes)) {
+    if (ev) screens.push_back(std::move(*ev));
   }
   std::vector<size_t> order(screens.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -789,6 +812,10 @@ std::vector<Evaluated> Pairs(const Engine& e, const Evaluated& one, ModelDiagnos
   for (size_t k = 0; k < order.size() && k < kJointPairs; ++k) {
     // A second cause that does not help with the first fixed is not fitted jointly.
     if (!std::isfinite(screens[order[k]].fit.heldout_loss) || !(screens[order[k]].fit.gain > 0)) {
+      break;
+    }
+    if (k > 0 && screens[order[k]].fit.heldout_loss >
+                     screens[order[0]].fit.heldout_loss + e.options().significance) {
       break;
     }
     joint.push_back(PairFit(e, one, screens[order[k]], ref).Run());

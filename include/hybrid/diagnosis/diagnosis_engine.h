@@ -51,10 +51,12 @@ struct DiagnosisOptions {
   double main_fraction = 0.9;
   /// Refine the selected parameters with Ceres (robust loss, from the cross-validated values).
   bool refine = true;
-  /// Worker threads for the simulations (>= 1).
+  /// Worker threads (>= 1): the candidates are fitted side by side, and a joint fit or a
+  /// refinement simulates its runs in parallel.
   int threads = 2;
-  /// If set, called on the calling thread before each candidate is fitted: the stage ("single
-  /// causes", "pairs"), the candidates done and their number (for a progress report).
+  /// If set, called before each candidate is fitted: the stage ("single causes", "pairs"), the
+  /// candidates started before it and their number (for a progress report). Candidates are
+  /// fitted side by side on the worker threads: it is called from them, one call at a time.
   std::function<void(const std::string& stage, int done, int total)> progress;
 };
 
