@@ -200,6 +200,22 @@ class Editor {
     return *slot;
   }
 
+  // The side of the edited comparison that reads no variable or input.
+  Expression ConstantSide(const ModelEdit& e) const {
+    const Constraint* c = nullptr;
+    for (const Transition& t : a_.transitions()) {
+      if (e.kind == EditKind::kGuardThreshold && t.name == e.owner) c = &t.guard;
+    }
+    for (const Mode& m : a_.modes()) {
+      if (e.kind == EditKind::kInvariantThreshold && m.name == e.owner) c = &m.invariant;
+    }
+    if (!c || e.atom < 0 || e.atom >= static_cast<int>(c->comparisons.size())) {
+      throw std::invalid_argument("edit '" + e.name + "' names no comparison of '" + e.owner + "'");
+    }
+    const Comparison& cmp = c->comparisons[e.atom];
+    return ReadsOnlyParameters(a_, cmp.lhs) ? cmp.lhs : cmp.rhs;
+  }
+
   Expression Parameter(const std::string& name) const {
     return Expression::Symbol(name, *out_.symbols().Find(name));
   }
@@ -215,9 +231,15 @@ class Editor {
               out_.AddParameter(e.identifier, Expression::Constant(value));
           break;
         case EditKind::kFlowGain:
+          out_.AddParameter(e.identifier, Expression::Constant(value));
+          break;
         case EditKind::kGuardThreshold:
         case EditKind::kInvariantThreshold:
-          out_.AddParameter(e.identifier, Expression::Constant(value));
+          // At its neutral value the threshold is the comparison's own side (`param
+          // on_invariant = high;`), so that it follows the parameters it reads when they are
+          // set per run, as the guards that read them do.
+          out_.AddParameter(e.identifier,
+                            value == e.neutral ? ConstantSide(e) : Expression::Constant(value));
           break;
         default:
           break;

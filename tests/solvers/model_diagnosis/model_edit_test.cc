@@ -8,6 +8,7 @@
 #include "hybrid/automaton/parser.h"
 #include "hybrid/automaton/printer.h"
 #include "hybrid/simulation/simulator.h"
+#include "hybrid/spaceex/spaceex_import.h"
 #include "tests/test_utilities/models.h"
 
 namespace hybrid {
@@ -39,9 +40,10 @@ const ModelEdit& Find(const CandidateSet& set, const std::string& name) {
 // x at every 0.5 time units of the model's scenario, with `parameters` set per run.
 std::vector<double> Samples(const System& s,
                             std::vector<std::pair<std::string, double>> parameters = {},
-                            const std::string& variable = "x") {
+                            const std::string& variable = "x", double until = 0.0) {
   const Simulator sim(s);
   SimulationOptions o;
+  if (until > 0) o.until = until;
   o.sample_step = 0.5;
   o.parameters = std::move(parameters);
   const SimulationResult r = sim.Run(o);
@@ -145,6 +147,35 @@ TEST(ApplyEdits, PrintedEdits) {
         "x_measured' = a * (u - x) + p;", "init off { x = 20; x_measured = 20 + x_bias; }"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line << "\n" << text;
   }
+}
+
+// A threshold that reads a parameter (`inv y <= high`, `guard y == high` in the SpaceEx water tank)
+// follows it at its neutral value: the instrumented model with `high` set per run simulates as the
+// model with `high` changed (found diagnosing a trace of the tank: every value of `high` failed).
+TEST(ApplyEdits, NeutralThresholdsFollowTheParametersTheyRead) {
+  System s =
+      spaceex::ReadModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/water_tank.xml");
+  const Automaton& a = s.components()[0].automaton;
+  std::vector<std::pair<ModelEdit, double>> neutral;
+  std::string text = "run,time,y\n";
+  for (int k = 0; k < 20; ++k)
+    text += "a," + std::to_string(k) + "," + std::to_string(5 + 0.3 * k) + "\n";
+  std::istringstream in(text);
+  for (const ModelEdit& e : CandidateEdits(a, ReadTraceData(in, "t.csv", s)).edits) {
+    if (e.kind == EditKind::kInvariantThreshold) neutral.emplace_back(e, e.neutral);
+  }
+  ASSERT_EQ(neutral.size(), 4u);
+  const System instrumented = System::Of(ApplyEdits(a, neutral));
+  const std::vector<double> per_run = Samples(instrumented, {{"high", 11.0}}, "y", 30.0);
+  s.SetParameter("high", 11.0);
+  ExpectNear(per_run, Samples(s, {}, "y", 30.0), 1e-9);
+  // And `high` matters (the comparison can fail).
+  const std::vector<double> neutral_run = Samples(instrumented, {}, "y", 30.0);
+  double most = 0.0;
+  for (size_t k = 0; k < per_run.size() && k < neutral_run.size(); ++k) {
+    most = std::max(most, std::abs(per_run[k] - neutral_run[k]));
+  }
+  EXPECT_GT(most, 0.5);
 }
 
 TEST(ApplyEdits, RefusesAnEditThatDoesNotFit) {
