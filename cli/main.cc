@@ -78,8 +78,8 @@ struct Commands {
   hybrid::cli::FingerArgs finger_args;
   hybrid::cli::HandArgs hand_args;
   hybrid::cli::DiagnoseArgs diagnose_args;
-  std::vector<std::string> diagnose_files;  // [MODEL] DATA
-  std::vector<std::string> diagnose_noise;  // --noise NAME=SD (any model)
+  std::string diagnose_first, diagnose_data;  // MODEL DATA, or DATA alone
+  std::vector<std::string> diagnose_noise;    // --noise NAME=SD (any model)
   hybrid::cli::SynthesizeArgs synthesize_args;
   std::string log;  // --log LEVEL: debug, info or warning; empty: no log
 };
@@ -292,12 +292,12 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
       "compliance, theta3_law), or none, or unexplained; an extended model and its held-out "
       "gain");
   diagnose
-      ->add_option("FILES", c.diagnose_files,
-                   "MODEL DATA.csv: a model and a trace of it (columns run,time,inputs,variables; "
-                   "docs/diagnosis.md), or DATA alone: the finger's measured runs "
+      ->add_option("FILE", c.diagnose_first,
+                   "A model file, then its trace DATA.csv (columns run,time, the model's inputs "
+                   "and variables; docs/diagnosis.md); or, alone, the finger's measured runs "
                    "(run,g,theta1,theta2,theta3[,gob,contact_link])")
-      ->required()
-      ->expected(1, 2);
+      ->required();
+  diagnose->add_option("DATA", c.diagnose_data, "The trace of the model FILE");
   diagnose->add_option("--model", d.model,
                        "The model (default for the finger's data: the bundled finger.ha)");
   diagnose
@@ -353,15 +353,17 @@ ExitCode RunDiagnosis(Commands& c) {
   using hybrid::cli::Arg;
   using hybrid::cli::OptionError;
   hybrid::cli::DiagnoseArgs& d = c.diagnose_args;
-  if (c.diagnose_files.size() == 2) {
+  if (!c.diagnose_data.empty()) {
     if (!d.model.empty()) {
       throw OptionError("model",
                         "the model is given twice: write `hybrid diagnose MODEL DATA` or "
                         "`hybrid diagnose DATA --model MODEL`");
     }
-    d.model = c.diagnose_files[0];
+    d.model = c.diagnose_first;
+    d.data = c.diagnose_data;
+  } else {
+    d.data = c.diagnose_first;
   }
-  d.data = c.diagnose_files.back();
   if (hybrid::IsTraceFile(d.data)) {
     if (d.model.empty()) {
       throw OptionError("model", d.data +
