@@ -288,7 +288,8 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
       "diagnose",
       "Compare measured data with a model: residuals per variable and mode, the cause (a "
       "parameter, a sensor bias or gain, a flow gain, a moved guard or invariant threshold, an "
-      "input offset; for the finger backlash, motor_offset, joint_range, sensor_bias, "
+      "input offset, a delayed transition; for the finger backlash, motor_offset, joint_range, "
+      "sensor_bias, "
       "compliance, theta3_law), or none, or unexplained; an extended model and its held-out "
       "gain");
   diagnose

@@ -73,10 +73,11 @@ def spell(value):
     return text[:-2] if text.endswith(".0") else text
 
 
-def events(u, p, s_on, s_off, until, x0=X_INIT, a=A):
+def events(u, p, s_on, s_off, until, x0=X_INIT, a=A, on_delay=0.0):
     """The piecewise closed form of one run with constant input u: a list of segments
     (t_start, t_end, mode, x_start, x_eq), t_end = until for the last one. A segment starting at or
-    beyond its switching level switches at once (the urgent guard holds on entry)."""
+    beyond its switching level switches at once (the urgent guard holds on entry). With on_delay,
+    the heater starts that long after x reaches s_on (x keeps cooling meanwhile)."""
     segments = []
     t, mode, x = 0.0, "off", x0
     for _ in range(100000):
@@ -88,12 +89,18 @@ def events(u, p, s_on, s_off, until, x0=X_INIT, a=A):
             t_switch = t + math.log((x - x_eq) / (level - x_eq)) / a
         else:
             t_switch = math.inf  # the equilibrium does not reach the level
+        if mode == "off" and on_delay > 0:
+            t_switch += on_delay
         if t_switch >= until:
             segments.append((t, until, mode, x, x_eq))
             return segments
         if t_switch > t:
             segments.append((t, t_switch, mode, x, x_eq))
-        t, x = t_switch, level
+        if mode == "off" and on_delay > 0:
+            x = x_eq + (x - x_eq) * math.exp(-a * (t_switch - t))
+        else:
+            x = level
+        t = t_switch
         mode = "on" if mode == "off" else "off"
     raise RuntimeError("more than 100000 switches in one run (chattering thresholds?)")
 
@@ -120,6 +127,9 @@ def main(argv):
                         help="level where heating starts (default 18)")
     parser.add_argument("--switch-off", type=number, default=None, metavar="S",
                         help="level where heating stops (default 22)")
+    parser.add_argument("--switch-on-delay", type=number, default=0.0, metavar="D",
+                        help="urgent model: the heater starts D min after x reaches the switch-on "
+                             "level (default 0)")
     parser.add_argument("--noise", type=number, default=0.1, metavar="SIGMA",
                         help="standard deviation of the Gaussian noise on x (default 0.1)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the noise (default 1)")
@@ -144,6 +154,9 @@ def main(argv):
                      % (spell(s_off), spell(off_range[0]), spell(off_range[1]), spec))
     if not s_on < s_off:
         parser.error("--switch-on must be below --switch-off")
+    if args.switch_on_delay < 0 or (args.switch_on_delay > 0 and args.model != "urgent"):
+        parser.error("--switch-on-delay must be >= 0, and only the urgent model has one (a lazy "
+                     "transition already fires at the invariant's boundary)")
     if args.heater <= 0 or args.noise < 0 or args.until <= 0 or args.step <= 0:
         parser.error("--heater, --until and --step must be positive, --noise not negative")
     samples = int(round(args.until / args.step))
@@ -156,6 +169,8 @@ def main(argv):
     command = ["/usr/bin/python3", "tools/thermostat_trace.py", "--model", args.model,
                "--heater", spell(args.heater), "--bias", spell(args.bias),
                "--switch-on", spell(s_on), "--switch-off", spell(s_off)]
+    if args.switch_on_delay > 0:
+        command += ["--switch-on-delay", spell(args.switch_on_delay)]
     if args.noiseless:
         command += ["--noiseless"]
     else:
@@ -173,7 +188,7 @@ def main(argv):
     rng = random.Random(args.seed)
     x_format = "%.10f" if args.noiseless else "%.4f"
     for run, u in enumerate(args.runs, start=1):
-        segments = events(u, args.heater, s_on, s_off, args.until)
+        segments = events(u, args.heater, s_on, s_off, args.until, on_delay=args.switch_on_delay)
         for k in range(samples + 1):
             t = min(k * args.step, args.until)
             x = temperature(segments, t) + args.bias

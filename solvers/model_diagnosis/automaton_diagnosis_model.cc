@@ -185,7 +185,7 @@ bool AutomatonDiagnosisModel::Affects(int parameter, int run,
   (void)run;
   const ModelEdit& e = edits_.at(parameter);
   std::string mode = e.owner;
-  if (e.kind == EditKind::kGuardThreshold) {
+  if (e.kind == EditKind::kGuardThreshold || e.kind == EditKind::kDelay) {
     const Automaton& a = system_.components()[0].automaton;
     for (const Transition& t : a.transitions()) {
       if (t.name == e.owner) mode = a.mode(t.source).name;

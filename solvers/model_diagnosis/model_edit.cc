@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -61,7 +62,11 @@ std::map<std::string, std::pair<double, double>> MeasuredRanges(const TraceData&
 class Generator {
  public:
   Generator(const Automaton& a, const TraceData& data)
-      : a_(a), names_(a), env_(a.ParameterEnvironment()), ranges_(MeasuredRanges(data)) {}
+      : a_(a), names_(a), env_(a.ParameterEnvironment()), ranges_(MeasuredRanges(data)) {
+    for (const TraceRun& run : data.runs) {
+      if (!run.time.empty()) duration_ = std::max(duration_, run.time.back());
+    }
+  }
 
   CandidateSet Run(const TraceData& data) {
     AddParameters();
@@ -83,6 +88,12 @@ class Generator {
       AddThresholds(EditKind::kInvariantThreshold, m.name, ".invariant", m.invariant);
     }
     for (const InputInfo& in : a_.inputs()) AddInputOffset(in);
+    for (const Transition& t : a_.transitions()) {
+      if (t.urgency == Urgency::kUrgent && duration_ > 0) {
+        Add(ModelEdit{EditKind::kDelay, t.name + ".delay", "", "", t.name, 0, 0.0, 0.0,
+                      0.1 * duration_});
+      }
+    }
     return std::move(set_);
   }
 
@@ -168,6 +179,7 @@ class Generator {
   Names names_;
   std::vector<double> env_;
   std::map<std::string, std::pair<double, double>> ranges_;
+  double duration_ = 0.0;  // of the longest run
   CandidateSet set_;
 };
 
@@ -180,8 +192,10 @@ class Editor {
   Automaton Run() {
     DeclareParameters();
     DeclareMeasured();
+    DeclareDelays();
     for (const Mode& m : a_.modes()) out_.AddMode(EditedMode(m));
-    for (const Transition& t : a_.transitions()) out_.AddTransition(EditedTransition(t));
+    AddPendingModes();
+    for (const Transition& t : a_.transitions()) AddTransition(t);
     for (const InitialState& s : a_.initial_states()) out_.AddInitialState(EditedStart(s));
     for (const Property& p : a_.properties()) out_.AddProperty(p);
     if (a_.scenario()) out_.SetScenario(*a_.scenario());
@@ -193,6 +207,87 @@ class Editor {
   struct Sensor {
     int measured = -1, bias = -1, gain = -1;
   };
+
+  // A delayed transition's parameter, clock and pending mode.
+  struct Delay {
+    int parameter = -1, clock = -1;
+    ModeId pending;
+  };
+
+  void DeclareDelays() {
+    for (const auto& [e, value] : edits_) {
+      if (e.kind != EditKind::kDelay) continue;
+      if (!(value >= 0)) throw std::invalid_argument("delay '" + e.name + "' must be >= 0");
+      Delay& d = delays_[e.owner];
+      d.parameter = out_.AddParameter(e.identifier, Expression::Constant(value));
+      d.clock = out_.AddVariable(names_.Unique(e.owner + "_clock"));
+    }
+  }
+
+  // `base`, or base_2, base_3, ... if `taken` says it is taken.
+  static std::string Fresh(const std::string& base,
+                           const std::function<bool(const std::string&)>& taken) {
+    std::string name = base;
+    for (int k = 2; taken(name); ++k) name = base + "_" + std::to_string(k);
+    return name;
+  }
+
+  Expression SlotSymbol(int slot) const {
+    return Expression::Symbol(out_.symbols()[slot].name, slot);
+  }
+
+  // The pending mode of each delayed transition: its source's flows and discrete values, the
+  // clock running, staying while the clock is below the delay.
+  void AddPendingModes() {
+    for (auto& [name, d] : delays_) {
+      const Transition* t = FindTransition(name);
+      Mode pending = EditedMode(a_.mode(t->source));
+      pending.name = Fresh(name + "_pending", [&](const std::string& n) {
+        for (const Mode& m : out_.modes()) {
+          if (m.name == n) return true;
+        }
+        return false;
+      });
+      pending.flows.emplace_back(d.clock, Expression::Constant(1.0));
+      pending.invariant = Constraint{
+          {Comparison{SlotSymbol(d.clock), Relation::kLessEqual, SlotSymbol(d.parameter)}}};
+      d.pending = out_.AddMode(std::move(pending));
+    }
+  }
+
+  const Transition* FindTransition(const std::string& name) const {
+    for (const Transition& t : a_.transitions()) {
+      if (t.name == name) return &t;
+    }
+    throw std::invalid_argument("the model has no transition '" + name + "'");
+  }
+
+  // Transition `t` edited; a delayed one into its pending mode (resetting the clock), then out
+  // of it (its resets and label) once the clock reaches the delay.
+  void AddTransition(const Transition& t) {
+    Transition edited = EditedTransition(t);
+    const auto it = delays_.find(t.name);
+    if (it == delays_.end()) {
+      out_.AddTransition(std::move(edited));
+      return;
+    }
+    const Delay& d = it->second;
+    Transition done = edited;
+    done.name = Fresh(t.name + "_done", [&](const std::string& n) {
+      for (const Transition& other : a_.transitions()) {
+        if (other.name == n) return true;
+      }
+      return false;
+    });
+    done.source = d.pending;
+    done.guard = Constraint{
+        {Comparison{SlotSymbol(d.clock), Relation::kGreaterEqual, SlotSymbol(d.parameter)}}};
+    edited.target = d.pending;
+    edited.label.clear();
+    edited.resets = {Reset{d.clock, Expression::Constant(0.0)}};
+    out_.AddTransition(std::move(edited));
+    out_.AddTransition(std::move(done));
+  }
 
   int SlotOf(const std::string& name) const {
     const std::optional<int> slot = a_.symbols().Find(name);
@@ -330,6 +425,11 @@ class Editor {
 
   InitialState EditedStart(const InitialState& s) const {
     InitialState out = s;
+    std::vector<InitialValue> clocks;
+    for (const auto& [name, d] : delays_) {
+      const Range zero{Expression::Constant(0.0), Expression::Constant(0.0)};
+      clocks.push_back(InitialValue{d.clock, zero, true});
+    }
     for (const auto& [slot, sensor] : sensors_) {
       for (const InitialValue& v : s.values) {
         if (v.slot != slot) continue;
@@ -338,6 +438,9 @@ class Editor {
         out.values.push_back(InitialValue{sensor.measured, r, v.is_point});
       }
     }
+    out.values.insert(out.values.end(), clocks.begin(), clocks.end());
+    std::sort(out.values.begin(), out.values.end(),
+              [](const InitialValue& a, const InitialValue& b) { return a.slot < b.slot; });
     return out;
   }
 
@@ -345,8 +448,9 @@ class Editor {
   std::span<const std::pair<ModelEdit, double>> edits_;
   Automaton out_;
   Names names_;
-  std::map<int, int> offsets_;     // input slot -> offset parameter slot
-  std::map<int, Sensor> sensors_;  // variable slot -> its sensor
+  std::map<int, int> offsets_;           // input slot -> offset parameter slot
+  std::map<int, Sensor> sensors_;        // variable slot -> its sensor
+  std::map<std::string, Delay> delays_;  // transition name -> its delay
 };
 
 }  // namespace

@@ -159,3 +159,18 @@ def test_diagnose_names_a_moved_invariant_of_the_lazy_thermostat(tmp_path):
     report = json.loads(out.stdout)
     assert report["cause"] == ["off.invariant"]
     assert abs(report["parameters"]["off.invariant"] - 18.5) < 0.025
+
+
+def test_diagnose_names_a_delayed_switch_of_the_urgent_thermostat(tmp_path):
+    # The heater starts 0.5 min after x reaches 18 (the generator's closed form with a delay):
+    # the candidate `switch_on.delay` (a pending mode with a clock) is named with its value.
+    trace = tmp_path / "delay.csv"
+    trace.write_text(subprocess.run(
+        [sys.executable, GENERATOR, "--model", "urgent", "--switch-on-delay", "0.5", "--seed", "9"],
+        cwd=SOURCE, check=True, capture_output=True, text=True).stdout)
+    out = subprocess.run([BINARY, "diagnose", os.path.join(SOURCE, "spec", "thermostat_urgent.ha"),
+                          str(trace), "--json"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    report = json.loads(out.stdout)
+    assert report["cause"] == ["switch_on.delay"]
+    assert abs(report["parameters"]["switch_on.delay"] - 0.5) < 0.025

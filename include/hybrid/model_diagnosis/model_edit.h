@@ -28,6 +28,11 @@ enum class EditKind {
   kInvariantThreshold,
   /// Input u is read as u + u_offset everywhere (name `u_offset`).
   kInputOffset,
+  /// Urgent transition T takes effect T_delay after its guard holds (name `T.delay`): it leads
+  /// to a new mode `T_pending` (the source's flows, a clock `T_clock` from 0, invariant
+  /// `T_clock <= T_delay`), left by a new transition `T_done` (guard `T_clock >= T_delay`, T's
+  /// resets and label) to T's target.
+  kDelay,
 };
 
 /// One candidate cause: an edit of the model with one number, its neutral value (the model as
@@ -68,7 +73,8 @@ struct CandidateSet {
 /// 1.5]); per comparison of an urgent transition's guard and of a mode's invariant with one side
 /// that reads no variable or input, a threshold (the value of that side +- a quarter of the
 /// measured range of the other side's variable, scaled by its coefficient; +- max(1, 25%) when it
-/// is not observed); per input, an offset (+- a quarter of its bounds' width). Guards of lazy
+/// is not observed); per input, an offset (+- a quarter of its bounds' width); per urgent
+/// transition, a delay ([0, a tenth of the longest run's duration]). Guards of lazy
 /// transitions are left out with a note (a simulation takes a lazy transition at its source's
 /// invariant boundary, so its guard threshold never decides a trace).
 CandidateSet CandidateEdits(const Automaton& automaton, const TraceData& data);
@@ -78,6 +84,8 @@ CandidateSet CandidateEdits(const Automaton& automaton, const TraceData& data);
 /// - kFlowGain, k*Threshold, kInputOffset: the parameter ModelEdit::identifier is declared with
 ///   the value and read where the edit says (x' = M_x_gain * (f); the comparison's constant side
 ///   replaced; every u read as (u + u_offset));
+/// - kDelay: as EditKind::kDelay says (at delay 0 the pending mode is entered and left at one
+///   instant, so the model's runs are unchanged);
 /// - kSensorBias, kSensorGain on x: a variable `x_measured` (name made unique like identifiers)
 ///   with the parameters x_bias (0 unless given) and x_gain (1 unless given), flow x_gain * f
 ///   where x has flow f, initial value x_gain * x0 + x_bias and reset x_gain * r + x_bias where x
