@@ -39,6 +39,9 @@ run_sanitized() {
   # Taylor steps are many times slower unoptimised (30 models and 5 systems in the Release stage).
   export HYBRID_FLOWPIPE_SOUNDNESS_MODELS="${HYBRID_FLOWPIPE_SOUNDNESS_MODELS:-6}"
   export HYBRID_FLOWPIPE_SYSTEMS_MODELS="${HYBRID_FLOWPIPE_SYSTEMS_MODELS:-2}"
+  # The diagnosis property test over random models (automaton_diagnosis_property_test.cc): 56
+  # draws in the Release stage.
+  export HYBRID_MODEL_DIAGNOSE_DRAWS="${HYBRID_MODEL_DIAGNOSE_DRAWS:-12}"
   (cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" --timeout 900)
 }
 

@@ -80,6 +80,7 @@ AutomatonDiagnosisModel::AutomatonDiagnosisModel(const System& instrumented, con
                                                  std::vector<ModelEdit> edits)
     : system_(instrumented), simulator_(instrumented), data_(data), edits_(std::move(edits)) {
   for (const ModelEdit& e : edits_) {
+    delays_ = delays_ || e.kind == EditKind::kDelay;
     candidates_.push_back(
         CandidateParameter{e.name, e.name, e.lo, e.hi, e.cheap ? 121 : 33, e.cheap});
   }
@@ -119,6 +120,12 @@ RunPrediction AutomatonDiagnosisModel::Simulated(
   // the diagnosis simulates each run some hundreds of times.
   options.relative_tolerance = 1e-8;
   options.absolute_tolerance = 1e-10;
+  if (delays_) {
+    // Every jump of a delayed transition is two (into its pending mode and out): the same runs
+    // of the model as given need twice the events at one instant and in the Zeno window.
+    options.zeno_events *= 2;
+    options.max_event_iterations *= 2;
+  }
   const SimulationResult result = simulator_.Run(options, signals_[run]);
   if (result.status != SimulationStatus::kCompleted) {
     throw std::invalid_argument("the model stopped on run '" + trace.label +

@@ -19,7 +19,9 @@ namespace hybrid {
 /// dynamic edit declared at its neutral value, compiled once) with the edits' values set per run
 /// (SimulationOptions::parameters), sampled at the run's times, driven by the run's inputs
 /// (piecewise linear; inputs the trace lacks follow the model's scenario, else 0), the sensor
-/// edits applied to the sampled variables (gain, then bias). Every sample's direction is +1 (the
+/// edits applied to the sampled variables (gain, then bias); with delay edits, twice the
+/// simulator's Zeno and event-iteration bounds (each jump of a delayed transition is two). Every
+/// sample's direction is +1 (the
 /// engine's input is time). Simulations of runs that repeat an earlier one (the same times and
 /// inputs) and of repeated settings are shared; thread-safe.
 class AutomatonDiagnosisModel : public DiagnosisModel {
@@ -57,6 +59,7 @@ class AutomatonDiagnosisModel : public DiagnosisModel {
   std::vector<int> channel_index_;                 // observed c -> simulator variable
   std::vector<std::vector<InputSignal>> signals_;  // per run
   std::vector<int> representative_;
+  bool delays_ = false;  // some edit is a delay (its pending modes double the jumps)
   mutable std::mutex memo_mutex_;
   mutable std::map<std::string, std::shared_ptr<const RunPrediction>> memo_;
 };
