@@ -13,7 +13,8 @@
 #   --fresh        start from the seeds alone (delete the corpus the previous runs grew)
 #   --no-build     use the harnesses already built
 #   harness...     some of: fuzz_model_parser fuzz_round_trip fuzz_signal fuzz_object
-#                  fuzz_measured_data fuzz_numbers fuzz_options fuzz_spaceex (default: all)
+#                  fuzz_measured_data fuzz_numbers fuzz_options fuzz_spaceex fuzz_trace_data
+#                  (default: all)
 # Each harness runs with -max_total_time=N -rss_limit_mb=2048 -timeout=10 (seconds per input),
 # (HYBRID_FUZZ_RSS_MB overrides the 2048 MB of -rss_limit_mb and -malloc_limit_mb: long runs),
 # leak detection on and -print_final_stats=1; its corpus is DIR/fuzz/corpus/HARNESS (seeds copied
@@ -25,7 +26,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 
 all_harnesses=(fuzz_model_parser fuzz_round_trip fuzz_signal fuzz_object fuzz_measured_data
-               fuzz_numbers fuzz_options fuzz_spaceex)
+               fuzz_numbers fuzz_options fuzz_spaceex fuzz_trace_data)
 seconds=20
 runs=""
 jobs=1

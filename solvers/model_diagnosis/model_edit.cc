@@ -106,7 +106,9 @@ class Generator {
   void AddParameters() {
     for (const auto& [slot, value] : a_.parameters()) {
       if (!value.is_constant()) continue;  // defined from other parameters: follows them
-      ModelEdit e{EditKind::kParameter, a_.symbols()[slot].name, a_.symbols()[slot].name};
+      ModelEdit e;
+      e.kind = EditKind::kParameter;
+      e.name = e.identifier = a_.symbols()[slot].name;
       e.neutral = value.constant();
       if (const std::optional<Range> r = a_.ParameterRange(slot)) {
         e.lo = r->lo.Evaluate(env_);
@@ -163,7 +165,8 @@ class Generator {
       const Expression& side = lhs_constant ? cmp.rhs : cmp.lhs;
       const double value = constant.Evaluate(env_);
       const double h = ThresholdHalfWidth(side, value);
-      const std::string name = owner + suffix + (k == 0 ? "" : "_" + std::to_string(k));
+      std::string name = owner + suffix;
+      if (k > 0) name.append("_").append(std::to_string(k));
       Add(ModelEdit{kind, name, "", "", owner, static_cast<int>(k), value, value - h, value + h});
     }
   }
