@@ -1,5 +1,6 @@
 #include "hybrid/model_diagnosis/automaton_diagnosis.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "hybrid/model_diagnosis/automaton_diagnosis_model.h"
