@@ -12,6 +12,7 @@
 #include "commands/output.h"
 #include "hybrid/automaton/printer.h"
 #include "hybrid/model_diagnosis/automaton_diagnosis.h"
+#include "hybrid/plotting/svg_plot.h"
 #include "hybrid/spaceex/spaceex_import.h"
 
 namespace hybrid::cli {
@@ -108,13 +109,7 @@ json ToJson(const AutomatonDiagnosis& d, const DiagnoseModelArgs& args, double s
   return out;
 }
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
+std::string Fixed(double v, int digits) { return plotting::FormatFixed(v, digits); }
 
 std::string Where(const AutomatonDiagnosis& d, const SystematicResidual& w) {
   return d.channels[w.channel] + ", mode " + w.mode + ", time in [" + Fixed(w.input_min, 3) + ", " +
@@ -167,15 +162,6 @@ std::string ToText(const AutomatonDiagnosis& d, const DiagnoseModelArgs& args, d
   for (const std::string& note : d.notes) out << "note: " << note << "\n";
   out << "time: " << Fixed(seconds, 2) << " s\n";
   return out.str();
-}
-
-void CheckOptions(const DiagnoseModelArgs& args) {
-  if (args.threads < 1 || args.threads > 64) {
-    throw OptionError("threads", Arg("threads") + " must lie in [1, 64]");
-  }
-  if (!(args.significance > 0) || !std::isfinite(args.significance)) {
-    throw OptionError("significance", Arg("significance") + " must be positive");
-  }
 }
 
 std::map<std::string, double> NoiseOption(const DiagnoseModelArgs& args) {
@@ -260,8 +246,17 @@ json Curves(const AutomatonDiagnosis& d) {
 
 }  // namespace
 
+void CheckDiagnosisOptions(int threads, double significance) {
+  if (threads < 1 || threads > 64) {
+    throw OptionError("threads", Arg("threads") + " must lie in [1, 64]");
+  }
+  if (!(significance > 0) || !std::isfinite(significance)) {
+    throw OptionError("significance", Arg("significance") + " must be positive");
+  }
+}
+
 nlohmann::ordered_json DiagnoseModelReport(const DiagnoseModelArgs& args, bool curves) {
-  CheckOptions(args);
+  CheckDiagnosisOptions(args.threads, args.significance);
   double seconds = 0.0;
   const AutomatonDiagnosis d = Diagnosed(args, seconds);
   json report = ToJson(d, args, seconds);
@@ -270,7 +265,7 @@ nlohmann::ordered_json DiagnoseModelReport(const DiagnoseModelArgs& args, bool c
 }
 
 ExitCode RunDiagnoseModel(const DiagnoseModelArgs& args) {
-  CheckOptions(args);
+  CheckDiagnosisOptions(args.threads, args.significance);
   NoiseOption(args);
   std::vector<NamedFile> inputs = {{"data", args.data}};
   for (NamedFile& f : ModelInputs("model", args.model)) inputs.push_back(std::move(f));

@@ -25,6 +25,10 @@ struct DiagnoseModelArgs {
   ProgressMode progress = ProgressMode::kOff;
 };
 
+/// Checks the options both `hybrid diagnose` forms share (the finger's too): OptionError (exit 2)
+/// unless `threads` lies in [1, 64] and `significance` is finite and positive.
+void CheckDiagnosisOptions(int threads, double significance);
+
 /// The report `--json` prints for `args` (model, data, significance, threads, noise; nothing is
 /// written). With `curves`, also "curves": per run its label, "time", and per observed variable
 /// the "measured", "baseline" and "extended" values at those times (null where missing), for

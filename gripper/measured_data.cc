@@ -14,6 +14,7 @@
 #include <system_error>
 #include <utility>
 
+#include "automaton/csv_cells.h"
 #include "automaton/number_syntax.h"
 #include "automaton/quoted_text.h"
 #include "hybrid/diagnosis/noise_floor.h"
@@ -34,8 +35,6 @@ constexpr double kMaxCounts = 255.0;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-bool IsBlank(char c) { return c == ' ' || c == '\t'; }
-
 // Whether `cell` is a sign and "nan", "inf" or "infinity" in any case (refused as not finite,
 // a friendlier message than "not a number").
 bool NamesNonFinite(std::string_view cell) {
@@ -43,24 +42,6 @@ bool NamesNonFinite(std::string_view cell) {
   std::string lower(cell);
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return lower == "nan" || lower == "inf" || lower == "infinity";
-}
-
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> SplitCells(std::string_view line) {
-  std::vector<std::string_view> cells;
-  while (true) {
-    const size_t comma = line.find(',');
-    if (comma == std::string_view::npos) break;
-    cells.push_back(Trim(line.substr(0, comma)));
-    line.remove_prefix(comma + 1);
-  }
-  cells.push_back(Trim(line));
-  return cells;
 }
 
 // `cell` in single quotes for messages, its control characters escaped.
@@ -91,7 +72,7 @@ class Reader {
       std::string_view line = text;
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       if (line_ == 1 && line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimBlanks(line);
       if (trimmed.empty() || trimmed.front() == '#') continue;
       if (!header_read) {
         ReadHeader(line);
@@ -134,7 +115,7 @@ class Reader {
   void ReadHeader(std::string_view line) {
     header_line_ = line_;
     column_of_.fill(-1);
-    const std::vector<std::string_view> names = SplitCells(line);
+    const std::vector<std::string_view> names = SplitCsvCells(line);
     for (int c = 0; c < static_cast<int>(names.size()); ++c) {
       const std::string_view name = names[c];
       if (name.find('"') != std::string_view::npos) {
@@ -262,7 +243,7 @@ class Reader {
   }
 
   void ReadRow(std::string_view line) {
-    const std::vector<std::string_view> cells = SplitCells(line);
+    const std::vector<std::string_view> cells = SplitCsvCells(line);
     if (cells.size() != fields_.size()) {
       Fail(line_, 0,
            std::string(cells.size() < fields_.size() ? "too few" : "too many") +

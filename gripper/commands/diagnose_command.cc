@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "commands/command_error.h"
+#include "commands/diagnose_model_command.h"
 #include "commands/output.h"
 #include "commands/progress.h"
 #include "gripper/commands/diagnosis_report.h"
@@ -200,12 +201,7 @@ std::string ToText(const Diagnosis& d, const DiagnoseArgs& args, double seconds)
 namespace {
 
 void CheckDiagnoseOptions(const DiagnoseArgs& args) {
-  if (args.threads < 1 || args.threads > 64) {
-    throw OptionError("threads", Arg("threads") + " must lie in [1, 64]");
-  }
-  if (!(args.significance > 0) || !std::isfinite(args.significance)) {
-    throw OptionError("significance", Arg("significance") + " must be positive");
-  }
+  CheckDiagnosisOptions(args.threads, args.significance);
 }
 
 // The diagnosis of args.data (its model, the options) and how long it took.

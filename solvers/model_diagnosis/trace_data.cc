@@ -11,6 +11,7 @@
 #include <string_view>
 #include <utility>
 
+#include "automaton/csv_cells.h"
 #include "automaton/number_syntax.h"
 #include "automaton/quoted_text.h"
 
@@ -18,24 +19,6 @@ namespace hybrid {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> SplitCells(std::string_view line) {
-  std::vector<std::string_view> cells;
-  while (true) {
-    const size_t comma = line.find(',');
-    if (comma == std::string_view::npos) break;
-    cells.push_back(Trim(line.substr(0, comma)));
-    line.remove_prefix(comma + 1);
-  }
-  cells.push_back(Trim(line));
-  return cells;
-}
 
 // What a header column holds.
 struct Column {
@@ -59,13 +42,13 @@ class TraceReader {
       std::string_view line = text;
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       if (line_ == 1 && line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimBlanks(line);
       if (trimmed.empty() || trimmed.front() == '#') continue;
       if (!header_read) {
-        ReadHeader(SplitCells(line));
+        ReadHeader(SplitCsvCells(line));
         header_read = true;
       } else {
-        ReadRow(SplitCells(line));
+        ReadRow(SplitCsvCells(line));
       }
     }
     if (in_.bad()) Fail(line_, 0, "read error");
@@ -290,9 +273,9 @@ bool IsTraceFile(const std::string& path) {
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (first && line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);
     first = false;
-    const std::string_view trimmed = Trim(line);
+    const std::string_view trimmed = TrimBlanks(line);
     if (trimmed.empty() || trimmed.front() == '#') continue;
-    for (std::string_view cell : SplitCells(line)) {
+    for (std::string_view cell : SplitCsvCells(line)) {
       if (cell == "time") return true;
     }
     return false;

@@ -146,17 +146,21 @@ def test_noiseless_generator_agrees_with_simulate(tmp_path, case):
         assert max(abs(t - ts) for (t, _), (ts, _) in zip(closed, switches)) <= TOLERANCE
 
 
+def diagnose_generated(tmp_path, spec, generator_args):
+    """`hybrid diagnose spec/SPEC.ha` on a trace the generator makes with `generator_args`."""
+    trace = tmp_path / "trace.csv"
+    trace.write_text(subprocess.run([sys.executable, GENERATOR, *generator_args], cwd=SOURCE,
+                                    check=True, capture_output=True, text=True).stdout)
+    out = subprocess.run([BINARY, "diagnose", os.path.join(SOURCE, "spec", spec + ".ha"),
+                          str(trace), "--json"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
 def test_diagnose_names_a_moved_invariant_of_the_lazy_thermostat(tmp_path):
     # The lazy thermostat switches where its invariants end: a heater that starts at 18.5 instead
     # of 18 is the invariant threshold `off.invariant`, found from a trace the generator makes.
-    trace = tmp_path / "lazy_threshold.csv"
-    trace.write_text(subprocess.run(
-        [sys.executable, GENERATOR, "--switch-on", "18.5", "--seed", "7"],
-        cwd=SOURCE, check=True, capture_output=True, text=True).stdout)
-    out = subprocess.run([BINARY, "diagnose", os.path.join(SOURCE, "spec", "thermostat.ha"),
-                          str(trace), "--json"], capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
-    report = json.loads(out.stdout)
+    report = diagnose_generated(tmp_path, "thermostat", ["--switch-on", "18.5", "--seed", "7"])
     assert report["cause"] == ["off.invariant"]
     assert abs(report["parameters"]["off.invariant"] - 18.5) < 0.025
 
@@ -164,13 +168,7 @@ def test_diagnose_names_a_moved_invariant_of_the_lazy_thermostat(tmp_path):
 def test_diagnose_names_a_delayed_switch_of_the_urgent_thermostat(tmp_path):
     # The heater starts 0.5 min after x reaches 18 (the generator's closed form with a delay):
     # the candidate `switch_on.delay` (a pending mode with a clock) is named with its value.
-    trace = tmp_path / "delay.csv"
-    trace.write_text(subprocess.run(
-        [sys.executable, GENERATOR, "--model", "urgent", "--switch-on-delay", "0.5", "--seed", "9"],
-        cwd=SOURCE, check=True, capture_output=True, text=True).stdout)
-    out = subprocess.run([BINARY, "diagnose", os.path.join(SOURCE, "spec", "thermostat_urgent.ha"),
-                          str(trace), "--json"], capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
-    report = json.loads(out.stdout)
+    report = diagnose_generated(tmp_path, "thermostat_urgent",
+                                ["--model", "urgent", "--switch-on-delay", "0.5", "--seed", "9"])
     assert report["cause"] == ["switch_on.delay"]
     assert abs(report["parameters"]["switch_on.delay"] - 0.5) < 0.025
