@@ -46,7 +46,6 @@ class AutomatonDiagnosisModel : public DiagnosisModel {
   std::vector<DiagnosisRun> Runs() const;
   /// repeat_of[r]: the first run with run r's times and inputs (r itself if none).
   const std::vector<int>& RepeatOf() const { return representative_; }
-  const std::vector<ModelEdit>& edits() const { return edits_; }
 
  private:
   RunPrediction Simulated(int run, const std::vector<std::pair<std::string, double>>& p) const;
