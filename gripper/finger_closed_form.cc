@@ -352,6 +352,22 @@ void FingerClosedForm::AnglesAt(std::span<const double> g, std::span<double> the
   }
 }
 
+Eigen::Vector3d FingerClosedForm::VariationBound(double a, double b) const {
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  const double m3_scale = parameters_.m3_scale();
+  for (const Piece& piece : pieces_) {
+    const double lo = std::max(a, piece.g0), hi = std::min(b, piece.g1);
+    if (!(hi > lo)) continue;
+    total += piece.rate.cwiseAbs() * (hi - lo);
+    if (piece.span3 != 0.0) {
+      const double grown = Phase3Fraction(hi - piece.g0, parameters_.motor_max - hi, m3_scale) -
+                           Phase3Fraction(lo - piece.g0, parameters_.motor_max - lo, m3_scale);
+      total[2] += std::abs(piece.span3) * std::abs(grown);
+    }
+  }
+  return total;
+}
+
 FingerConfiguration FingerClosedForm::At(double g) const {
   CheckMotorRange(g, parameters_.motor_max);
   const Piece& piece = PieceAt(g);

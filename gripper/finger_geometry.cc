@@ -1,5 +1,6 @@
 #include "hybrid/gripper/finger_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -70,6 +71,19 @@ std::array<Segment2, 3> FingerGeometry::ContactSegments(const Eigen::Vector3d& t
     links[k] = Segment2{Place(a), Place(p[k + 1])};
   }
   return links;
+}
+
+std::array<double, 3> FingerGeometry::LinkMotionBounds(const Eigen::Vector3d& variation) const {
+  const double scale = std::max(1.0, std::abs(placement_.x_scale)) * std::numbers::pi / 180.0;
+  const std::array<double, 3> length = {lengths_.proximal, lengths_.medial, lengths_.distal};
+  std::array<double, 3> bounds;
+  double reach = 0.0, turn = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    reach += length[k];
+    turn += std::abs(variation[k]);
+    bounds[k] = scale * reach * turn;
+  }
+  return bounds;
 }
 
 }  // namespace hybrid::gripper

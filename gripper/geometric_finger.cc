@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <ranges>
 #include <stdexcept>
 #include <string>
 
@@ -34,35 +36,50 @@ void RequireClearOfOpenFinger(const std::vector<Obstacle>& objects,
   }
 }
 
-// Sample points of the path of `cf` in [g, end]: every kResolution counts, except in phase 3,
-// where theta3's rate grows without bound towards g = 255 and the samples are every
-// kResolution * m1 degrees of theta3 instead (so no joint turns more than 0.045 degrees between
-// samples); plus every breakpoint. Sorted, without duplicates.
-std::vector<double> SearchGrid(const FingerClosedForm& cf, const FingerParameters& parameters,
-                               double g, double end) {
-  constexpr double kResolution = GeometricFinger::kResolution;
-  std::vector<double> grid = {g, end};
-  for (const auto& piece : cf.pieces()) {
-    const double lo = std::max(piece.g0, g), hi = std::min(piece.g1, end);
-    if (lo >= hi) continue;
-    grid.push_back(lo);
-    grid.push_back(hi);
-    if (piece.phase != FingerPhase::k3) {
-      for (double s = lo; s < hi; s += kResolution) grid.push_back(s);
-      continue;
+// The search grid of one piece of a closed form's path clipped to [lo, hi]: lo, the interior
+// points, hi. Outside phase 3 the interior points are every kResolution counts from lo; in phase 3,
+// where theta3's rate grows without bound towards g = 255, they are every kResolution * m1 degrees
+// of theta3 (uniform in phase 3's fraction F, g = (g0 + 255 phi) / (1 + phi) with phi = F /
+// m3_scale), so no joint turns more than 0.045 degrees between two points.
+class PieceGrid {
+ public:
+  PieceGrid(const FingerClosedForm::Piece& piece, const FingerParameters& parameters, double lo,
+            double hi)
+      : piece_(piece), parameters_(parameters), lo_(lo), hi_(hi) {
+    constexpr double kResolution = GeometricFinger::kResolution;
+    phase3_ = piece.phase == FingerPhase::k3 && piece.span3 > 0.0;
+    if (!phase3_) {
+      count_ = static_cast<long>(std::ceil((hi - lo) / kResolution)) - 1;
+    } else {
+      step_ = kResolution * parameters.m1() / piece.span3;
+      const double f_lo = Fraction(lo), f_hi = std::min(Fraction(hi), 1.0);
+      first_ = static_cast<long>(std::floor(f_lo / step_)) + 1;
+      count_ = static_cast<long>(std::ceil(f_hi / step_)) - first_;
     }
-    // theta3 = theta3_s + span3 phi with phi = (g - g0) / (255 - g), so g = (g0 + 255 phi) /
-    // (1 + phi).
-    const double step = kResolution * parameters.m1() / piece.span3;
-    for (double phi = 0.0; phi < 1.0; phi += step) {
-      const double s = (piece.g0 + parameters.motor_max * phi) / (1.0 + phi);
-      if (s > lo && s < hi) grid.push_back(s);
-    }
+    count_ = std::max(count_, 0L);
   }
-  std::sort(grid.begin(), grid.end());
-  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-  return grid;
-}
+  /// Number of points (at least 2: lo and hi).
+  long size() const { return count_ + 2; }
+  double operator[](long k) const {
+    if (k <= 0) return lo_;
+    if (k > count_) return hi_;
+    if (!phase3_) return std::min(lo_ + static_cast<double>(k) * GeometricFinger::kResolution, hi_);
+    const double phi = static_cast<double>(first_ + k - 1) * step_ / parameters_.m3_scale();
+    return std::clamp((piece_.g0 + parameters_.motor_max * phi) / (1.0 + phi), lo_, hi_);
+  }
+
+ private:
+  double Fraction(double g) const {
+    return parameters_.m3_scale() * (g - piece_.g0) /
+           std::max(parameters_.motor_max - g, std::numeric_limits<double>::min());
+  }
+  const FingerClosedForm::Piece& piece_;
+  const FingerParameters& parameters_;
+  double lo_, hi_;
+  bool phase3_ = false;
+  double step_ = 0.0;
+  long first_ = 0, count_ = 0;
+};
 
 // The obstacles a link can touch: the objects (0, 1, ...) and the palm (kPalm).
 struct Obstacles {
@@ -104,17 +121,65 @@ void FindTouch(const FingerClosedForm& cf, const Obstacles& obstacles, double lo
   if (!first || hi < first->g) first = Hit{hi, i, k};
 }
 
-// The first contact of a link not blocked yet (in `contacts`) with an obstacle along `grid`.
+// Per link not blocked yet (in `contacts`), its smallest signed distance to an obstacle at g;
+// +inf for a blocked link.
+std::array<double, 3> Slack(const FingerClosedForm& cf, const Obstacles& obstacles, double g,
+                            const FingerContacts& contacts) {
+  const auto links = obstacles.geometry.ContactSegments(cf.At(g).theta);
+  std::array<double, 3> slack;
+  slack.fill(std::numeric_limits<double>::infinity());
+  for (int i = 0; i < 3; ++i) {
+    if (contacts.gob[i] != FingerContacts::kNone) continue;
+    slack[i] = obstacles.palm.Distance(links[i]);
+    for (const Obstacle& o : obstacles.objects) slack[i] = std::min(slack[i], o.Distance(links[i]));
+  }
+  return slack;
+}
+
+// Whether no link can touch an obstacle anywhere in (g_eval, g]: each link either cannot move
+// that far (FingerGeometry::LinkMotionBounds of FingerClosedForm::VariationBound) from its slack
+// at g_eval, or does not move at all.
+bool ProvedClear(const FingerClosedForm& cf, const FingerGeometry& geometry, double g_eval,
+                 double g, const std::array<double, 3>& slack) {
+  const std::array<double, 3> moved = geometry.LinkMotionBounds(cf.VariationBound(g_eval, g));
+  for (int i = 0; i < 3; ++i) {
+    if (moved[i] != 0.0 && !(moved[i] < slack[i] * (1.0 - 1e-9))) return false;
+  }
+  return true;
+}
+
+// The first contact of a link not blocked yet (in `contacts`) with an obstacle as g goes from g0
+// to end along the search grid (PieceGrid). The grid's points that the step bound proves clear
+// (ProvedClear from the last point evaluated) are skipped, so the result is the full grid's: the
+// same first step with a touch, bisected by FindTouch.
 std::optional<Hit> FirstGeometricContact(const FingerClosedForm& cf, const Obstacles& obstacles,
-                                         const std::vector<double>& grid,
-                                         const FingerContacts& contacts) {
+                                         double g0, double end, const FingerContacts& contacts) {
+  const int num_objects = static_cast<int>(obstacles.objects.size());
+  double g_eval = g0;
+  std::array<double, 3> slack = Slack(cf, obstacles, g0, contacts);
   std::optional<Hit> first;
-  for (size_t s = 1; s < grid.size() && !first; ++s) {
-    for (int i = 0; i < 3; ++i) {
-      if (contacts.gob[i] != FingerContacts::kNone) continue;
-      for (int k = kPalm; k < static_cast<int>(obstacles.objects.size()); ++k) {
-        FindTouch(cf, obstacles, grid[s - 1], grid[s], i, k, first);
+  for (const auto& piece : cf.pieces()) {
+    const double lo = std::max(piece.g0, g0), hi = std::min(piece.g1, end);
+    if (!(hi > lo)) continue;
+    const PieceGrid grid(piece, cf.parameters(), lo, hi);
+    for (long k = 1; k < grid.size(); ++k) {
+      // The first grid point from k on not proved clear (the bound grows with the point).
+      k = *std::ranges::partition_point(std::views::iota(k, grid.size()), [&](long j) {
+        return ProvedClear(cf, obstacles.geometry, g_eval, grid[j], slack);
+      });
+      if (k >= grid.size()) break;
+      const std::array<double, 3> at_k = Slack(cf, obstacles, grid[k], contacts);
+      if (std::ranges::min(at_k) <= 0.0) {
+        for (int i = 0; i < 3; ++i) {
+          if (contacts.gob[i] != FingerContacts::kNone) continue;
+          for (int o = kPalm; o < num_objects; ++o) {
+            FindTouch(cf, obstacles, grid[k - 1], grid[k], i, o, first);
+          }
+        }
+        if (first) return first;
       }
+      g_eval = grid[k];
+      slack = at_k;
     }
   }
   return first;
@@ -150,8 +215,7 @@ GeometricFinger::GeometricFinger(std::vector<Obstacle> objects, const FingerGeom
   for (int round = 0; round < 3; ++round) {
     const FingerClosedForm cf(contacts, parameters_);
     const double end = std::min({cf.stop(), parameters_.motor_max, up_to});
-    std::optional<Hit> first =
-        FirstGeometricContact(cf, obstacles, SearchGrid(cf, parameters_, g, end), contacts);
+    std::optional<Hit> first = FirstGeometricContact(cf, obstacles, g, end, contacts);
     TakeEarlierImposedContact(imposed, contacts, g, end, first);
     if (!first) break;
     // The palm touches the fingertip at the free-space stop by construction (G1): not a contact.

@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <ranges>
 #include <stdexcept>
 
 namespace hybrid::gripper {
@@ -84,7 +85,7 @@ namespace {
 
 // Joints 1 to 3 and the fingertip of fingers A, B and C in space.
 using HandLinks = std::array<std::array<Eigen::Vector3d, 4>, 3>;
-// closest[f1][l1][f2][l2]: the smallest distance between two links of different fingers.
+// [f1][l1][f2][l2]: a distance between link l1 of finger f1 and link l2 of finger f2.
 using ClosestLinks = std::array<std::array<std::array<std::array<double, 3>, 3>, 3>, 3>;
 
 // Throws std::invalid_argument unless the spread position and the motor commands are in
@@ -153,21 +154,75 @@ void FindPairTouch(const Hand& hand, const HandLinks& previous, const HandLinks&
   if (!first || hi < first->g) first = Hand::FingerTouch{f1, l1, f2, l2, hi};
 }
 
-// The first touch between links of different fingers as the sweep goes on from g0, sampled
-// every GeometricFinger::kResolution counts up to 255; nullopt if none.
+// Separations of every pair of links of different fingers at `p` (<= 0: touching), indexed
+// [f1][l1][f2][l2] (both orders).
+ClosestLinks Separations(const HandLinks& p, double link_width) {
+  ClosestLinks out{};
+  for (int f1 = 0; f1 < 3; ++f1) {
+    for (int f2 = f1 + 1; f2 < 3; ++f2) {
+      for (int l1 = 0; l1 < 3; ++l1) {
+        for (int l2 = 0; l2 < 3; ++l2) {
+          out[f1][l1][f2][l2] = out[f2][l2][f1][l1] = Separation(p, f1, l1, f2, l2, link_width);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// Whether no two links of different fingers can touch anywhere in (a, b]: for each pair, the
+// links cannot move that far (FingerGeometry::LinkMotionBounds of each finger's
+// FingerClosedForm::VariationBound up to its command) from their separation at a, or neither
+// moves.
+bool ProvedApart(const Hand& hand, double a, double b, const ClosestLinks& separation) {
+  std::array<std::array<double, 3>, 3> moved;
+  for (int f = 0; f < 3; ++f) {
+    const double command = hand.commands()[f];
+    moved[f] = hand.finger(f).geometry().LinkMotionBounds(
+        hand.finger(f).closed_form().VariationBound(std::min(a, command), std::min(b, command)));
+  }
+  for (int f1 = 0; f1 < 3; ++f1) {
+    for (int f2 = f1 + 1; f2 < 3; ++f2) {
+      for (int l1 = 0; l1 < 3; ++l1) {
+        for (int l2 = 0; l2 < 3; ++l2) {
+          const double m = moved[f1][l1] + moved[f2][l2];
+          if (m != 0.0 && !(m < separation[f1][l1][f2][l2] * (1.0 - 1e-9))) return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+// The first touch between links of different fingers as the sweep goes on from g0, on the grid
+// of every GeometricFinger::kResolution counts up to 255; nullopt if none. Grid points that
+// ProvedApart from the last point evaluated are skipped, so the result is the full grid's.
 std::optional<Hand::FingerTouch> FirstTouch(const Hand& hand, double g0) {
-  std::vector<double> grid;
-  for (double g = g0; g < 255.0; g += GeometricFinger::kResolution) grid.push_back(g);
-  grid.push_back(255.0);
+  const long count = static_cast<long>(std::ceil((255.0 - g0) / GeometricFinger::kResolution));
+  const auto at = [&](long j) {
+    return std::min(g0 + static_cast<double>(j) * GeometricFinger::kResolution, 255.0);
+  };
+  const double width = hand.layout().link_width;
   std::optional<Hand::FingerTouch> first;
-  HandLinks previous = LinksAt(hand, grid[0]);
-  for (size_t k = 1; k < grid.size() && !first; ++k) {
-    const HandLinks current = LinksAt(hand, grid[k]);
+  HandLinks previous = LinksAt(hand, g0);
+  double g_eval = g0;
+  ClosestLinks separation = Separations(previous, width);
+  for (long k = 1; k <= count && !first; ++k) {
+    const long next = *std::ranges::partition_point(std::views::iota(k, count + 1), [&](long j) {
+      return ProvedApart(hand, g_eval, at(j), separation);
+    });
+    if (next > count) break;
+    if (next > k) previous = LinksAt(hand, at(next - 1));
+    k = next;
+    const HandLinks current = LinksAt(hand, at(k));
+    separation = Separations(current, width);
+    g_eval = at(k);
     for (int f1 = 0; f1 < 3; ++f1) {
       for (int f2 = f1 + 1; f2 < 3; ++f2) {
         for (int l1 = 0; l1 < 3; ++l1) {
           for (int l2 = 0; l2 < 3; ++l2) {
-            FindPairTouch(hand, previous, current, grid[k - 1], grid[k], f1, l1, f2, l2, first);
+            if (separation[f1][l1][f2][l2] > 0.0) continue;
+            FindPairTouch(hand, previous, current, at(k - 1), at(k), f1, l1, f2, l2, first);
           }
         }
       }
@@ -234,7 +289,6 @@ Hand::Hand(std::vector<Obstacle> objects, double spread, const std::array<double
     fingers_ = BuildFingers(*this, imposed);
     g0 = first->g;
   }
-  closest_ = ClosestApproaches(*this);
 }
 
 FingerConfiguration Hand::At(int f, double g) const {
@@ -324,6 +378,7 @@ System Hand::ComposedAutomata(const System& hand_model, bool shared_command) con
                                 "' has no automaton named 'finger'");
   }
   const std::string names = "ABC";
+  const ClosestLinks closest = ClosestApproaches(*this);
   System system("hand");
   if (shared_command) system.Share("u");
   for (int o = 0; o < 3; ++o) {
@@ -361,7 +416,7 @@ System Hand::ComposedAutomata(const System& hand_model, bool shared_command) con
       for (int o = 0; o < 3; ++o) {
         if (o == f) continue;
         for (int j = 0; j < 3; ++j) {
-          if (closest_[f][i][o][j] > layout_.link_width + kCandidateMargin) continue;
+          if (closest[f][i][o][j] > layout_.link_width + kCandidateMargin) continue;
           const E d = SegmentDistanceExpression(points[f][i], points[f][i + 1], points[o][j],
                                                 points[o][j + 1]);
           nearest = nearest ? E::Binary(Op::kMin, *nearest, d) : d;

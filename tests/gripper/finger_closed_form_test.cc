@@ -391,3 +391,37 @@ RC_GTEST_PROP(FingerClosedFormProperty, EqualsTheIndependentRig, ()) {
 
 }  // namespace
 }  // namespace hybrid::gripper
+
+namespace hybrid::gripper {
+namespace {
+
+// VariationBound against the total variation measured by differencing At on a fine grid: never
+// below it, and equal to it (the report's pieces are monotone in every angle) within what the
+// grid can miss at a turn (twice its largest step).
+RC_GTEST_PROP(FingerClosedFormVariation, BoundsAndMatchesTheSampledVariation, ()) {
+  FingerContacts contacts;
+  for (int i = 0; i < 3; ++i) {
+    if (*rc::gen::inRange(0, 2)) contacts.gob[i] = *rc::gen::inRange(0, 2550) / 10.0;
+  }
+  const FingerClosedForm cf(contacts);
+  const double a = *rc::gen::inRange(0, 2550) / 10.0;
+  const double b = std::min(255.0, a + *rc::gen::inRange(0, 1000) / 10.0);
+  constexpr int kSamples = 20000;
+  Eigen::Vector3d sampled = Eigen::Vector3d::Zero(), largest = Eigen::Vector3d::Zero();
+  Eigen::Vector3d before = cf.At(a).theta;
+  for (int k = 1; k <= kSamples; ++k) {
+    const Eigen::Vector3d now = cf.At(a + (b - a) * k / kSamples).theta;
+    sampled += (now - before).cwiseAbs();
+    largest = largest.cwiseMax((now - before).cwiseAbs());
+    before = now;
+  }
+  const Eigen::Vector3d bound = cf.VariationBound(a, b);
+  for (int i = 0; i < 3; ++i) {
+    RC_ASSERT(bound[i] >= sampled[i] - 1e-9);
+    RC_ASSERT(bound[i] <= sampled[i] + 2.0 * largest[i] + 1e-9);
+  }
+  RC_ASSERT(cf.VariationBound(b, a).isZero());
+}
+
+}  // namespace
+}  // namespace hybrid::gripper

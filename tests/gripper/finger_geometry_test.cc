@@ -64,5 +64,34 @@ TEST(FingerGeometryTest, ContactSegmentsAndPlacement) {
   EXPECT_THROW(FingerGeometry(FingerLengths{0.05, -1, 0.03}), std::invalid_argument);
 }
 
+// LinkMotionBounds against the motion measured on sampled configurations: every link's contact
+// segment ends (and so every point between them) stay within the bound of where they started
+// when the joints turn by at most the given angles, in the placed frame too.
+RC_GTEST_PROP(FingerGeometryMotion, LinkMotionBoundsHoldOnSampledTurns, ()) {
+  const double scale = *rc::gen::element(1.0, -1.0, -0.8, 1.5);
+  const FingerGeometry geometry(FingerLengths{}, FingerPlacement{0.01, scale});
+  Eigen::Vector3d start, turn;
+  for (int i = 0; i < 3; ++i) {
+    start[i] = *rc::gen::inRange(-600, 900) / 10.0;
+    turn[i] = *rc::gen::inRange(-300, 300) / 10.0;
+  }
+  const std::array<double, 3> bound = geometry.LinkMotionBounds(turn);
+  const auto from = geometry.ContactSegments(start);
+  for (int k = 0; k <= 50; ++k) {
+    // Each joint turns monotonically by up to its variation (fractions of each at random).
+    Eigen::Vector3d theta = start;
+    for (int i = 0; i < 3; ++i) theta[i] += turn[i] * *rc::gen::inRange(0, 1001) / 1000.0;
+    const auto to = geometry.ContactSegments(theta);
+    for (int l = 0; l < 3; ++l) {
+      RC_ASSERT((to[l].a - from[l].a).norm() <= bound[l] + 1e-12);
+      RC_ASSERT((to[l].b - from[l].b).norm() <= bound[l] + 1e-12);
+    }
+  }
+  // No turn, no motion; a turn of link 3's joint alone does not move links 1 and 2.
+  EXPECT_EQ(geometry.LinkMotionBounds(Eigen::Vector3d::Zero())[2], 0.0);
+  const auto distal = geometry.LinkMotionBounds(Eigen::Vector3d(0.0, 0.0, 5.0));
+  RC_ASSERT(distal[0] == 0.0 && distal[1] == 0.0 && distal[2] > 0.0);
+}
+
 }  // namespace
 }  // namespace hybrid::gripper

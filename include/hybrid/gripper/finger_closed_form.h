@@ -94,6 +94,14 @@ class FingerClosedForm {
   /// checked in the same pass), std::invalid_argument on sizes.
   void AnglesAt(std::span<const double> g, std::span<double> theta) const;
 
+  /// Upper bounds, in degrees, on each joint angle's total variation while g goes from a to b
+  /// (0 <= a <= b <= motor_max): per piece, |rate_i| times the length it shares with [a, b], plus
+  /// for theta3 |span3| times the growth of phase 3's fraction there (exact where every angle is
+  /// monotone on each piece, as in the report's phases). Zero for b <= a. With
+  /// FingerGeometry::LinkMotionBounds, how far each link can move on the way: the step bound by
+  /// which the contact searches skip (GeometricFinger, Hand).
+  Eigen::Vector3d VariationBound(double a, double b) const;
+
   /// The motor position where the finger stops (phase 4), or nullopt-like +inf when it is still
   /// moving at motor_max.
   double stop() const { return stop_; }

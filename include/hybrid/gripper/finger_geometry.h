@@ -65,6 +65,12 @@ class FingerGeometry {
   /// expressions `theta` (degrees): {x, y} of joint 1, joint 2, joint 3 and the fingertip.
   std::array<std::array<Expression, 2>, 4> LocalPointExpressions(
       const std::array<Expression, 3>& theta) const;
+  /// How far any point of each link (its contact segment included) can move, in the placed
+  /// frame, while the joints turn by at most `variation` degrees each (FingerClosedForm::
+  /// VariationBound): a point of link k is joint 1 plus sum_{j<k} L_j u(phi_j) plus s u(phi_k)
+  /// with phi_j = theta1 + ... + thetaj and |u(p) - u(q)| <= |p - q|, so it moves at most
+  /// (L_1 + ... + L_k) (|dtheta_1| + ... + |dtheta_k|) (radians), times max(1, |x_scale|).
+  std::array<double, 3> LinkMotionBounds(const Eigen::Vector3d& variation) const;
   /// Height of the palm surface (negative: below joint 1).
   double palm_y() const { return palm_y_; }
   const FingerLengths& lengths() const { return lengths_; }

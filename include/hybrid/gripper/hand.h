@@ -114,9 +114,6 @@ class Hand {
 
   std::vector<Obstacle> objects_;
   HandLayout layout_;
-  // closest_[f1][l1][f2][l2]: smallest distance between the centre lines of link l1 of finger f1
-  // and link l2 of finger f2 over the closing (sampled every 0.25 counts).
-  std::array<std::array<std::array<std::array<double, 3>, 3>, 3>, 3> closest_;
   std::array<double, 3> commands_;
   double phi_;
   std::vector<GeometricFinger> fingers_;
