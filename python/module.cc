@@ -58,6 +58,7 @@
 #include "commands/output.h"
 #include "commands/simulate_command.h"
 #include "gripper/commands/diagnose_command.h"
+#include "gripper/commands/grasp_sweep.h"
 #include "gripper/commands/gripper_command.h"
 #include "hybrid/automaton/dot_writer.h"
 #include "hybrid/automaton/log.h"
@@ -709,6 +710,89 @@ std::string HandJsonText(const std::vector<std::string>& objects, const std::str
   return cli::HandReport(args).dump();
 }
 
+// A numpy array of `shape` holding `values` (row-major).
+py::array_t<double> ArrayOf(const std::vector<double>& values, std::vector<py::ssize_t> shape) {
+  py::array_t<double> out(shape);
+  std::copy(values.begin(), values.end(), out.mutable_data());
+  return out;
+}
+
+// The (n, 2) offsets of a sweep as rows.
+std::vector<std::array<double, 2>> OffsetRows(
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& offsets) {
+  if (offsets.ndim() != 2 || offsets.shape(1) != 2) {
+    throw cli::OptionError("offsets", cli::Arg("offsets") + " must be an array of shape (n, 2)");
+  }
+  std::vector<std::array<double, 2>> rows(offsets.shape(0));
+  const double* data = offsets.data();
+  for (size_t r = 0; r < rows.size(); ++r) rows[r] = {data[2 * r], data[2 * r + 1]};
+  return rows;
+}
+
+// A grasp sweep as a dict of numpy arrays (numbers) and lists (strings), shaped per row, finger
+// and link.
+py::dict SweepDict(const cli::GraspSweep& s) {
+  const py::ssize_t n = static_cast<py::ssize_t>(s.status.size()), f = s.fingers;
+  py::dict out;
+  out["status"] = s.status;
+  out["message"] = s.message;
+  out["first_contact"] = ArrayOf(s.first_contact, {n});
+  out["motor"] = ArrayOf(s.motor, {n, f});
+  out["theta"] = ArrayOf(s.theta, {n, f, 3});
+  out["phase"] = s.phase;
+  out["mode"] = s.mode;
+  out["contact_g"] = ArrayOf(s.contact_g, {n, f, 3});
+  out["contact_by"] = s.contact_by;
+  out["stop"] = ArrayOf(s.stop, {n, f});
+  return out;
+}
+
+py::dict HandSweepDict(
+    const std::vector<std::string>& objects,
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& offsets,
+    const std::string& mode, std::optional<double> spread, double g, std::optional<double> g_a,
+    std::optional<double> g_b, std::optional<double> g_c, int threads) {
+  cli::HandArgs args;
+  args.objects = objects;
+  args.mode = mode;
+  args.spread = spread;
+  args.g = g;
+  args.g_a = g_a;
+  args.g_b = g_b;
+  args.g_c = g_c;
+  const std::vector<std::array<double, 2>> rows = OffsetRows(offsets);
+  cli::GraspSweep sweep;
+  {
+    py::gil_scoped_release release;
+    sweep = cli::HandSweep(args, rows, threads);
+  }
+  return SweepDict(sweep);
+}
+
+py::dict FingerSweepDict(
+    const std::vector<std::string>& objects,
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& offsets, double g,
+    int threads) {
+  const std::vector<std::array<double, 2>> rows = OffsetRows(offsets);
+  cli::GraspSweep sweep;
+  {
+    py::gil_scoped_release release;
+    sweep = cli::FingerSweep(objects, g, rows, threads);
+  }
+  return SweepDict(sweep);
+}
+
+// `hybrid finger --g G [--gob1..3] [--object ...] --json`: the report as JSON text.
+std::string FingerJsonText(double g, std::optional<double> gob1, std::optional<double> gob2,
+                           std::optional<double> gob3, const std::vector<std::string>& objects) {
+  cli::FingerArgs args;
+  args.g = g;
+  args.gob = {gob1, gob2, gob3};
+  args.objects = objects;
+  py::gil_scoped_release release;
+  return cli::FingerReportJson(args).dump();
+}
+
 // `hybrid diagnose DATA --json`: the report as JSON text (the bundled finger without a model).
 std::string DiagnoseJsonText(const std::string& data, const std::optional<std::string>& model,
                              double significance, int threads) {
@@ -793,6 +877,13 @@ PYBIND11_MODULE(_hybrid, m) {
   m.def("set_log_level", &SetLogLevel, py::arg("level"));
   m.def("finger_angles", &FingerAngles, py::arg("g"), py::arg("gob1") = py::none(),
         py::arg("gob2") = py::none(), py::arg("gob3") = py::none(), py::arg("model") = py::none());
+  m.def("hand_sweep", &HandSweepDict, py::arg("objects"), py::arg("offsets"), py::arg("mode"),
+        py::arg("spread"), py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"),
+        py::arg("threads"));
+  m.def("finger_sweep", &FingerSweepDict, py::arg("objects"), py::arg("offsets"), py::arg("g"),
+        py::arg("threads"));
+  m.def("finger_json", &FingerJsonText, py::arg("g"), py::arg("gob1"), py::arg("gob2"),
+        py::arg("gob3"), py::arg("objects"));
   m.def("hand_json", &HandJsonText, py::arg("objects"), py::arg("mode"), py::arg("spread"),
         py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"));
   m.def("diagnose_json", &DiagnoseJsonText, py::arg("data"), py::arg("model"),

@@ -312,7 +312,7 @@ FingerParameters ModelParameters(const std::optional<Automaton>& model, const st
 }
 
 // The finger with `parameters` closing on `objects` (none without objects); throws InputError if
-// the objects are invalid or the finger cannot reach them.
+// the objects are invalid (a finger that cannot reach them is valid: FingerStatus).
 std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& objects,
                                                const FingerParameters& parameters) {
   std::optional<GeometricFinger> geometric;
@@ -322,14 +322,28 @@ std::optional<GeometricFinger> FingerOnObjects(const std::vector<Obstacle>& obje
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
-  if (!geometric->touches_object()) {
-    throw InputError("the finger cannot reach the object(s): it closes to g = " +
-                     FormatNumber(std::min(255.0, geometric->closed_form().stop())) +
-                     " without touching " +
-                     (objects.size() == 1 ? objects[0].ToString() : "any of them"));
-  }
   return geometric;
 }
+
+}  // namespace
+
+double FirstObjectContact(const GeometricFinger& finger) {
+  double first = std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < 3; ++i) {
+    const auto& by = finger.blocked_by()[i];
+    if (!by || *by < 0) continue;
+    const double g = finger.contacts().gob[i];
+    if (!(first <= g)) first = g;
+  }
+  return first;
+}
+
+std::string ContactStatus(double first_contact, double g) {
+  if (std::isnan(first_contact)) return "out_of_reach";
+  return first_contact <= g ? "contact" : "free";
+}
+
+namespace {
 
 // The settled state after each request of --requests: the controller drives the motor to the
 // request and stops it where the finger stalls (closed.stop()); it stays there until a request
@@ -361,6 +375,11 @@ json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
   if (!args.requests.empty()) report["requests"] = RequestHistoryJson(args.requests, closed);
   report["contacts"] = ContactsJson(closed, by, {"", "", ""});
   report["stop"] = StopJson(closed.stop());
+  if (geometric) {
+    const double first = FirstObjectContact(*geometric);
+    report["status"] = ContactStatus(first, args.g.value_or(255.0));
+    report["first_contact"] = std::isnan(first) ? json(nullptr) : json(first);
+  }
   if (!objects.empty()) {
     json list = json::array();
     for (const Obstacle& o : objects) list.push_back(o.ToString());
@@ -513,42 +532,88 @@ double HandSpread(const HandArgs& args) {
   return spread;
 }
 
-// The hand closing on `objects`; throws InputError if the hand cannot be built or no finger
-// reaches the objects.
+// The hand closing on `objects`; throws InputError if the hand cannot be built (an object that
+// overlaps the palm or an open finger). A hand that does not reach the objects is valid: its
+// status says so (HandOutcomeOf).
 gripper::Hand HandOnObjects(const std::vector<Obstacle>& objects, double spread,
                             const std::array<double, 3>& commands) {
-  std::optional<gripper::Hand> hand;
   try {
-    hand.emplace(objects, spread, commands);
+    return gripper::Hand(objects, spread, commands);
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
-  bool touched = false;
-  for (int f = 0; f < 3; ++f) touched |= hand->finger(f).touches_object();
-  if (!objects.empty() && !touched) {
-    throw InputError("no finger reaches the object(s): the hand closes without touching them");
-  }
-  return *std::move(hand);
 }
+
+// The first motor position at which a finger of `hand` touches an object (not the palm or
+// another finger); NaN if none does before its command.
+double FirstHandContact(const gripper::Hand& hand) {
+  double first = std::numeric_limits<double>::quiet_NaN();
+  for (int f = 0; f < 3; ++f) {
+    const double g = FirstObjectContact(hand.finger(f));
+    if (!(first <= g)) first = g;
+  }
+  return first;
+}
+
+}  // namespace
+
+HandFinger HandFingerOf(const gripper::Hand& hand, int f) {
+  const double command = hand.commands()[f];
+  std::array<std::string, 3> imposed;
+  for (const auto& t : hand.touches()) {
+    if (t.finger_a == f) imposed[t.link_a] = std::string("finger ") + kFingerNames[t.finger_b];
+    if (t.finger_b == f) imposed[t.link_b] = std::string("finger ") + kFingerNames[t.finger_a];
+  }
+  HandFinger out{command, hand.At(f, 255.0)};
+  const FingerClosedForm& closed = hand.finger(f).closed_form();
+  const FingerContacts& contacts = closed.contacts();
+  for (int i = 0; i < 3; ++i) {
+    // The contacts that take effect while closing (see ContactsJson).
+    if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
+    out.contacts.push_back(
+        {i + 1, contacts.gob[i], BlockerName(hand.finger(f).blocked_by()[i], imposed[i])});
+  }
+  // Where the finger stops by itself (phase 4), if before its command; else +inf.
+  const double stop = closed.stop();
+  out.stop = stop <= command ? stop : std::numeric_limits<double>::infinity();
+  return out;
+}
+
+HandOutcome HandOutcomeOf(const gripper::Hand& hand, double spread) {
+  HandOutcome out;
+  out.first_contact = FirstHandContact(hand);
+  if (!std::isnan(out.first_contact)) {
+    out.status = "contact";
+    return out;
+  }
+  if (hand.objects().empty()) {
+    out.status = "free";
+    return out;
+  }
+  // Not touched at these commands: where closing all the way would first touch.
+  const gripper::Hand closed(hand.objects(), spread, {255.0, 255.0, 255.0}, hand.layout());
+  out.first_contact = FirstHandContact(closed);
+  out.status = std::isnan(out.first_contact) ? "out_of_reach" : "free";
+  return out;
+}
+
+namespace {
 
 // The "fingers" array of the hand report: per finger its command, its configuration at the end of
 // the closing, the contacts that take effect (other fingers named) and where it stops by itself.
-json HandFingersJson(const gripper::Hand& hand, const std::array<double, 3>& commands) {
+json HandFingersJson(const gripper::Hand& hand) {
   json fingers = json::array();
   for (int f = 0; f < 3; ++f) {
-    std::array<std::string, 3> imposed;
-    for (const auto& t : hand.touches()) {
-      if (t.finger_a == f) imposed[t.link_a] = std::string("finger ") + kFingerNames[t.finger_b];
-      if (t.finger_b == f) imposed[t.link_b] = std::string("finger ") + kFingerNames[t.finger_a];
-    }
-    json j = {{"finger", std::string(1, kFingerNames[f])}, {"command", commands[f]}};
-    j.update(ConfigurationJson(commands[f], hand.At(f, 255.0)));
+    const HandFinger finger = HandFingerOf(hand, f);
+    json j = {{"finger", std::string(1, kFingerNames[f])}, {"command", finger.command}};
+    j.update(ConfigurationJson(finger.command, finger.configuration));
     j.erase("g");
-    j["contacts"] =
-        ContactsJson(hand.finger(f).closed_form(), hand.finger(f).blocked_by(), imposed);
-    // Where the finger stops by itself (phase 4), if before its command; else null.
-    const double stop = hand.finger(f).closed_form().stop();
-    j["stop"] = StopJson(stop <= commands[f] ? stop : std::numeric_limits<double>::infinity());
+    json contacts = json::array();
+    for (const auto& c : finger.contacts) {
+      contacts.push_back({{"link", c.link}, {"g", c.g}, {"by", c.by}});
+    }
+    j["contacts"] = std::move(contacts);
+    j["stop"] = StopJson(finger.stop);
     fingers.push_back(j);
   }
   return fingers;
@@ -620,6 +685,14 @@ std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spr
     }
     out << "\n";
   }
+  const std::string status = report.at("status").get<std::string>();
+  if (status == "out_of_reach") {
+    out << "out of reach: the fingers closing all the way touch no object\n";
+  } else if (status == "free" && !objects.empty()) {
+    out << "no finger touches an object at these commands; closing further, the first contact "
+           "is at g = "
+        << Fixed(report.at("first_contact").get<double>(), 4) << "\n";
+  }
   for (const auto& t : report.at("finger_touches")) {
     out << "fingers " << t["fingers"][0].get<std::string>() << t["fingers"][1].get<std::string>()
         << " touch (links " << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
@@ -673,24 +746,65 @@ ExitCode RunFinger(const FingerArgs& args_in) {
 namespace {
 
 // The report of `hybrid hand` before any simulation (the spread, each finger, their touches).
-json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread,
-              const std::array<double, 3>& commands) {
+json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread) {
   // With --spread the spread is set directly: no operating mode applies.
+  const HandOutcome outcome = HandOutcomeOf(hand, spread);
   return {{"mode", args.spread ? json(nullptr) : json(args.mode)},
           {"spread", spread},
           {"spread_angle_deg", hand.spread_angle()},
-          {"fingers", HandFingersJson(hand, commands)},
+          {"status", outcome.status},
+          {"first_contact",
+           std::isnan(outcome.first_contact) ? json(nullptr) : json(outcome.first_contact)},
+          {"fingers", HandFingersJson(hand)},
           {"finger_touches", HandTouchesJson(hand)}};
 }
 
 }  // namespace
 
-nlohmann::ordered_json HandReport(const HandArgs& args) {
+nlohmann::ordered_json FingerReportJson(const FingerArgs& args_in) {
+  FingerArgs args = args_in;
+  const FingerContacts contacts = CheckFingerArgs(args);
+  const std::vector<Obstacle> objects = ParseObjects(args.objects);
+  const std::optional<Automaton> model = FingerModel(args);
+  const FingerParameters parameters = ModelParameters(model, args.model);
+  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
+  const FingerClosedForm closed =
+      geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
+  return FingerReport(args, closed, geometric, objects);
+}
+
+HandSettings CheckedHandSettings(const HandArgs& args) {
   CheckMotor("g", args.g);
-  const std::array<double, 3> commands = HandCommands(args);
-  const double spread = HandSpread(args);
-  const gripper::Hand hand = HandOnObjects(ParseObjects(args.objects), spread, commands);
-  return HandJson(args, hand, spread, commands);
+  HandSettings out;
+  out.commands = HandCommands(args);
+  out.spread = HandSpread(args);
+  out.objects = ParseObjects(args.objects);
+  return out;
+}
+
+void CheckMotorPosition(const std::string& argument, double g) { CheckMotor(argument, g); }
+
+std::vector<gripper::Obstacle> ParseObjectList(const std::vector<std::string>& texts) {
+  return ParseObjects(texts);
+}
+
+HandFinger FingerAt(const GeometricFinger& finger, double g) {
+  const FingerClosedForm& closed = finger.closed_form();
+  HandFinger out{g, closed.At(g)};
+  const FingerContacts& contacts = closed.contacts();
+  for (int i = 0; i < 3; ++i) {
+    // The contacts that take effect while closing (see ContactsJson).
+    if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
+    out.contacts.push_back({i + 1, contacts.gob[i], BlockerName(finger.blocked_by()[i], "")});
+  }
+  out.stop = closed.stop();
+  return out;
+}
+
+nlohmann::ordered_json HandReport(const HandArgs& args) {
+  const HandSettings settings = CheckedHandSettings(args);
+  const gripper::Hand hand = HandOnObjects(settings.objects, settings.spread, settings.commands);
+  return HandJson(args, hand, settings.spread);
 }
 
 ExitCode RunHand(const HandArgs& args) {
@@ -704,7 +818,7 @@ ExitCode RunHand(const HandArgs& args) {
   for (double g : args.draw_at) CheckMotor("draw_at", g);
   const std::vector<Obstacle> objects = ParseObjects(args.objects);
   const gripper::Hand hand = HandOnObjects(objects, spread, commands);
-  json report = HandJson(args, hand, spread, commands);
+  json report = HandJson(args, hand, spread);
   ExitCode code = ExitCode::kOk;
   if (args.simulate) {
     const Comparison c = SimulateHand(args, hand, commands, per_finger);

@@ -25,12 +25,13 @@ thread, the first three compute in a child process that is killed (docs/python.m
 import json as _json
 
 from . import _hybrid
+from ._version import __version__
 
 ModelError = _hybrid.ModelError
 DataError = _hybrid.DataError
 
-__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger_angles", "hand", "load",
-           "set_log_level"]
+__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger", "finger_angles",
+           "finger_sweep", "hand", "hand_sweep", "load", "set_log_level"]
 
 
 def set_log_level(level):
@@ -205,10 +206,81 @@ def hand(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c
         ``finger_touches``.
 
     Raises:
-        ValueError: a malformed object or a position out of range, or objects no finger reaches.
+        ValueError: a malformed object or a position out of range, or an object that overlaps
+            the palm or an open finger. Objects out of reach are an outcome: ``status`` (see
+            :func:`hand_sweep`).
     """
     report = _hybrid.hand_json(list(objects), mode, spread, float(g), g_a, g_b, g_c)
     return _json.loads(report)
+
+
+def finger(g=255.0, objects=(), gob1=None, gob2=None, gob3=None):
+    """One finger closing to motor position g, on contact positions or objects by geometry
+    (``hybrid finger --g G --json``).
+
+    Args:
+        g: the motor position in [0, 255].
+        objects: object descriptions in the finger's plane (metres), as :func:`hand` takes them.
+        gob1, gob2, gob3: the motor positions at which links 1..3 meet an object (instead of
+            objects).
+
+    Returns:
+        The report of ``hybrid finger --json``: the configuration at g (``motor``,
+        ``theta1..3``, ``phase``, ``mode``, ``discrete``), ``contacts``, ``stop``; with objects
+        also ``status`` ("contact", "free": the first contact comes after g, "out_of_reach")
+        and ``first_contact``.
+
+    Raises:
+        ValueError: a malformed object, a position out of range, or an object that overlaps the
+            palm or the open finger.
+    """
+    return _json.loads(_hybrid.finger_json(float(g), gob1, gob2, gob3, list(objects)))
+
+
+def _sweep_arrays(result, fingers):
+    import numpy
+    n = len(result["status"])
+    result["status"] = numpy.array(result["status"], dtype=str).reshape(n)
+    result["message"] = numpy.array(result["message"], dtype=str).reshape(n)
+    for key in ("phase", "mode"):
+        result[key] = numpy.array(result[key], dtype=str).reshape(n, fingers)
+    result["contact_by"] = numpy.array(result["contact_by"], dtype=str).reshape(n, fingers, 3)
+    return result
+
+
+def hand_sweep(objects, offsets, mode="basic", spread=None, g=255.0, g_a=None, g_b=None,
+               g_c=None, threads=2):
+    """A grasp sweep: :func:`hand` with its objects moved by each row of ``offsets``, in C++ on
+    ``threads`` worker threads (docs/python.md, "Grasp sweeps").
+
+    Args:
+        objects: object descriptions in the palm's x-y plane (metres), as :func:`hand` takes them.
+        offsets: an array of shape (n, 2): each row moves every object by (dx, dy) metres.
+        mode, spread, g, g_a, g_b, g_c: as for :func:`hand`.
+        threads: worker threads (1 to 64); the result does not depend on it.
+
+    Returns:
+        A dict of numpy arrays, one row per offset, each row what :func:`hand` reports for the
+        moved objects: ``status`` (n,) "contact", "free", "out_of_reach" or "invalid" (objects
+        overlapping the palm or an open finger; ``message`` (n,) says why), ``first_contact``
+        (n,), and per finger A, B, C: ``motor`` (n, 3), ``theta`` (n, 3, 3) degrees, ``phase``
+        and ``mode`` (n, 3), ``stop`` (n, 3) (inf: none), per link ``contact_g`` (n, 3, 3) (NaN:
+        none) and ``contact_by`` (n, 3, 3) ("object 1", "palm", "finger B" or "").
+
+    Raises:
+        ValueError: bad settings (as :func:`hand`), offsets that are not (n, 2) or not finite.
+    """
+    result = _hybrid.hand_sweep(list(objects), offsets, mode, spread, float(g), g_a, g_b, g_c,
+                                int(threads))
+    return _sweep_arrays(result, 3)
+
+
+def finger_sweep(objects, offsets, g=255.0, threads=2):
+    """A grasp sweep of one finger: :func:`finger` at motor position g with its objects moved by
+    each row of ``offsets`` ((n, 2), metres, the finger's plane). Returns the arrays of
+    :func:`hand_sweep` with one finger: ``motor`` (n, 1), ``theta`` (n, 1, 3), ...; ``status``
+    is relative to g ("free": the first contact comes later)."""
+    return _sweep_arrays(_hybrid.finger_sweep(list(objects), offsets, float(g), int(threads)), 1)
 
 
 def diagnose(*files, model=None, significance=25.0, threads=2, noise=None):

@@ -6,6 +6,8 @@ import numpy.typing as npt
 
 Signal = Union[float, Sequence[tuple[float, float]], str]
 
+__version__: str
+
 class ModelError(ValueError): ...
 class DataError(ValueError): ...
 
@@ -57,6 +59,27 @@ def hand(
     g_a: float | None = ...,
     g_b: float | None = ...,
     g_c: float | None = ...,
+) -> dict[str, Any]: ...
+def finger(
+    g: float = ...,
+    objects: Sequence[str] = ...,
+    gob1: float | None = ...,
+    gob2: float | None = ...,
+    gob3: float | None = ...,
+) -> dict[str, Any]: ...
+def hand_sweep(
+    objects: Sequence[str],
+    offsets: npt.ArrayLike,
+    mode: str = ...,
+    spread: float | None = ...,
+    g: float = ...,
+    g_a: float | None = ...,
+    g_b: float | None = ...,
+    g_c: float | None = ...,
+    threads: int = ...,
+) -> dict[str, Any]: ...
+def finger_sweep(
+    objects: Sequence[str], offsets: npt.ArrayLike, g: float = ..., threads: int = ...
 ) -> dict[str, Any]: ...
 def diagnose(
     *files: Union[str, PathLike[str]],

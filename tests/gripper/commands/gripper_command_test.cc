@@ -475,10 +475,17 @@ TEST(HybridFinger, MalformedObjectsAreExit2WithTheColumn) {
 }
 
 // Objects the finger cannot hold: overlapping the palm (G1) or the open finger, or out of reach.
-TEST(HybridFinger, ObjectsTheFingerCannotHoldAreExit1) {
+TEST(HybridFinger, ObjectsTheFingerCannotHoldAreExit1ButUnreachedOnesAreNot) {
   ExpectRejected("finger --g 100 --object circle:0.05,-0.03,0.01", 1, {"overlaps the palm"});
   ExpectRejected("finger --g 100 --object circle:0,0.05,0.01", 1, {"overlaps", "open finger"});
-  ExpectRejected("finger --g 100 --object circle:-0.2,0.05,0.01", 1, {"cannot reach"});
+  // Out of reach is an outcome, not an error; so is a command before the first contact.
+  const json far = RunJson("finger --g 100 --object circle:-0.2,0.05,0.01");
+  EXPECT_EQ(Field(far, "status"), "out_of_reach");
+  EXPECT_TRUE(Field(far, "first_contact").is_null());
+  const json early = RunJson("finger --g 20 --object circle:0.06,0.08,0.01");
+  EXPECT_EQ(Field(early, "status"), "free");
+  EXPECT_EQ(Field(RunJson("finger --g 255 --object circle:0.06,0.08,0.01"), "first_contact"),
+            Field(early, "first_contact"));
   // Inside the open finger at the knuckle of joint 2 (0.05715 m up), where contact segments
   // leave a 2 mm gap: still an overlap.
   ExpectRejected("finger --g 100 --object circle:0,0.05815,0.0005", 1, {"overlaps", "open finger"});
@@ -577,10 +584,28 @@ TEST(HybridHand, NoObjectClosesFreely) {
 }
 
 // Bad options (exit 2) and an object overlapping the palm (exit 1).
-// Each finger's contacts are searched only up to its command: with g = 10 no finger reaches the
-// cylinder (link 2 meets it at about 43), so the hand is rejected as not reaching it.
+// Each finger's contacts are searched only up to its command: with g = 10 no finger touches the
+// cylinder yet (link 2 meets it at about 43), a valid state ("free") whose report says where the
+// first contact of the full closing is.
 TEST(HybridHand, ContactsBeyondTheCommandDoNotCount) {
-  ExpectRejected("hand --g 10 --object " + kHandObject, 1, {"no finger reaches"});
+  const json before = RunJson("hand --g 10 --object " + kHandObject);
+  EXPECT_EQ(Field(before, "status"), "free");
+  const json full = RunJson("hand --object " + kHandObject);
+  EXPECT_EQ(Field(full, "status"), "contact");
+  double first = 255.0;
+  for (const auto& finger : Field(full, "fingers")) {
+    for (const auto& c : finger.at("contacts")) first = std::min(first, c.at("g").get<double>());
+  }
+  EXPECT_GT(first, 10.0);
+  EXPECT_EQ(Field(before, "first_contact").get<double>(), first);
+  EXPECT_EQ(Field(full, "first_contact").get<double>(), first);
+  for (const auto& finger : Field(before, "fingers")) {
+    EXPECT_TRUE(finger.at("contacts").empty());
+    EXPECT_EQ(finger.at("motor").get<double>(), 10.0);
+  }
+  const Result text = RunHybrid("hand --g 10 --object " + kHandObject);
+  EXPECT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("the first contact is at g = 42.8"), std::string::npos) << text.out;
   const json j = RunJson("hand --g-a 30 --object " + kHandObject);
   EXPECT_TRUE(Field(j, "fingers", 0, "contacts").empty()) << Field(j, "fingers", 0).dump(2);
   EXPECT_TRUE(Field(j, "fingers", 0, "stop").is_null());
@@ -600,7 +625,10 @@ TEST(HybridHand, BadInputIsRejected) {
   EXPECT_EQ(Field(json::parse(RunHybrid("hand --mode pinch --json").out), "mode"), "pinch");
   ExpectRejected("hand --object circle:0,-0.01,0.02", 1, {"overlaps the palm"});
   ExpectRejected("hand --object circle:0,0.06,abc", 2, {"--object", "column 15"});
-  ExpectRejected("hand --object circle:0.3,0.5,0.01", 1, {"no finger reaches"});
+  // An object out of reach is an outcome, not an error.
+  const json far = RunJson("hand --object circle:0.3,0.5,0.01");
+  EXPECT_EQ(Field(far, "status"), "out_of_reach");
+  EXPECT_TRUE(Field(far, "first_contact").is_null());
   for (const std::string option : {"--spread", "--g", "--g-a", "--g-b", "--g-c"}) {
     ExpectRejected("hand " + option + " ''", 2, {option + ": empty"});
     ExpectRejected("hand " + option + " 0x10", 2, {option + ": '0x10' is not a decimal number"});
