@@ -19,6 +19,7 @@
 #include "hybrid/gripper/geometric_finger.h"
 #include "hybrid/gripper/hand.h"
 #include "hybrid/gripper/measured_data.h"
+#include "hybrid/gripper/robot_frames.h"
 #include "hybrid/gripper/svg_figures.h"
 #include "hybrid/simulation/simulator.h"
 
@@ -698,6 +699,20 @@ std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spr
         << " touch (links " << t["links"][0].get<int>() << ", " << t["links"][1].get<int>()
         << ") at g = " << Fixed(t["g"].get<double>(), 4) << "\n";
   }
+  if (args.joint_state) {
+    const json& js = report.at("joint_state");
+    out << "joint state (ROS description, rad):";
+    for (size_t k = 0; k < js["name"].size(); ++k) {
+      out << (k % 4 == 0 ? "\n  " : "  ") << js["name"][k].get<std::string>() << " "
+          << Fixed(js["position"][k].get<double>(), 4);
+    }
+    out << "\n";
+    if (!js["clamped"].empty()) {
+      out << "  clamped into the description's limits:";
+      for (const auto& name : js["clamped"]) out << " " << name.get<std::string>();
+      out << "\n";
+    }
+  }
   if (args.simulate) {
     const json& s = report.at("simulation");
     out << "simulation of the composed automata: " << s["status"].get<std::string>()
@@ -745,18 +760,31 @@ ExitCode RunFinger(const FingerArgs& args_in) {
 
 namespace {
 
+// The hand's configuration at the end of its closing as the ROS description's joint state.
+json JointStateJson(const gripper::Hand& hand) {
+  std::array<Eigen::Vector3d, 3> theta;
+  for (int f = 0; f < 3; ++f) theta[f] = hand.At(f, 255.0).theta;
+  const gripper::JointState state = gripper::RosJointState(theta, hand.spread_angle());
+  return {{"name", state.name},
+          {"position", state.position},
+          {"model_position", state.model_position},
+          {"clamped", state.clamped}};
+}
+
 // The report of `hybrid hand` before any simulation (the spread, each finger, their touches).
 json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread) {
   // With --spread the spread is set directly: no operating mode applies.
   const HandOutcome outcome = HandOutcomeOf(hand, spread);
-  return {{"mode", args.spread ? json(nullptr) : json(args.mode)},
-          {"spread", spread},
-          {"spread_angle_deg", hand.spread_angle()},
-          {"status", outcome.status},
-          {"first_contact",
-           std::isnan(outcome.first_contact) ? json(nullptr) : json(outcome.first_contact)},
-          {"fingers", HandFingersJson(hand)},
-          {"finger_touches", HandTouchesJson(hand)}};
+  json report = {{"mode", args.spread ? json(nullptr) : json(args.mode)},
+                 {"spread", spread},
+                 {"spread_angle_deg", hand.spread_angle()},
+                 {"status", outcome.status},
+                 {"first_contact",
+                  std::isnan(outcome.first_contact) ? json(nullptr) : json(outcome.first_contact)},
+                 {"fingers", HandFingersJson(hand)},
+                 {"finger_touches", HandTouchesJson(hand)}};
+  if (args.joint_state) report["joint_state"] = JointStateJson(hand);
+  return report;
 }
 
 }  // namespace

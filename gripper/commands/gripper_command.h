@@ -43,7 +43,8 @@ struct HandArgs {
   double g = kDefaultMotorCommand;      ///< one motor command for all fingers
   std::optional<double> g_a, g_b, g_c;  ///< per-finger commands (override g)
   bool json = false;
-  std::string draw;  ///< SVG of the hand at `draw_at`
+  bool joint_state = false;  ///< also the ROS description's joints (gripper/robot_frames.h)
+  std::string draw;          ///< SVG of the hand at `draw_at`
   std::vector<double> draw_at;
   bool simulate = false;  ///< also simulate the composed automata
   std::string model;      ///< spec/hand.ha (its finger and spread automata)

@@ -129,3 +129,23 @@ def test_sweep_errors_in_the_api_words():
     with pytest.raises(ValueError) as e:
         hybrid.finger_sweep(["circle:0,0.06"], np.zeros((1, 2)))
     assert "objects" in str(e.value) and "--object" not in str(e.value)
+
+
+def test_joint_state_equals_the_program_and_stays_within_the_limits():
+    js = hybrid.joint_state(["circle:0,0.06,0.02"])
+    out = subprocess.run([BINARY, "hand", "--object", "circle:0,0.06,0.02", "--joint-state",
+                          "--json"], capture_output=True, text=True, check=True).stdout
+    assert json.loads(out)["joint_state"] == js
+    # The xacro's limits, typed from ros-industrial/robotiq's visualization package.
+    limits = {"palm_finger_1_joint": (-0.1784, 0.192), "palm_finger_2_joint": (-0.192, 0.1784)}
+    for finger in ("finger_1", "finger_2", "finger_middle"):
+        limits.update({finger + "_joint_1": (0.0495, 1.2218), finger + "_joint_2": (0.0, 1.5708),
+                       finger + "_joint_3": (-1.2217, -0.0523)})
+    assert sorted(js["name"]) == sorted(limits)
+    for name, value in zip(js["name"], js["position"]):
+        assert limits[name][0] <= value <= limits[name][1], name
+    report = hybrid.hand(["circle:0,0.06,0.02"])
+    model = dict(zip(js["name"], js["model_position"]))
+    import math
+    assert model["finger_middle_joint_3"] == pytest.approx(math.radians(report["fingers"][0]["theta3"]), abs=1e-15)
+    assert model["finger_1_joint_1"] == pytest.approx(math.radians(report["fingers"][1]["theta1"]), abs=1e-15)
