@@ -78,6 +78,32 @@ std::pair<Eigen::VectorXd, std::vector<int>> StartState(const CompiledModel& mod
   return {std::move(x), std::move(modes)};
 }
 
+// SimulationOptions::start_modes and start_x, checked against `model`: x as StartState gives it.
+std::pair<Eigen::VectorXd, std::vector<int>> GivenStart(const CompiledModel& model,
+                                                        const SimulationOptions& options) {
+  const std::vector<CompiledComponent>& components = model.components();
+  const std::vector<int>& modes = options.start_modes;
+  bool fits = modes.size() == components.size();
+  for (size_t c = 0; c < modes.size() && fits; ++c) {
+    fits = modes[c] >= 0 && modes[c] < static_cast<int>(components[c].modes.size());
+  }
+  const int n = static_cast<int>(model.variable_slots().size());
+  if (!fits || options.start_x.size() != n) {
+    throw std::invalid_argument("the start state does not fit the model (" +
+                                std::to_string(components.size()) + " modes and " +
+                                std::to_string(n) + " variables expected)");
+  }
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(std::max(n, 1));
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(options.start_x[i])) {
+      throw std::invalid_argument("start value of '" + model.variable_names()[i] +
+                                  "' is not finite");
+    }
+    x[i] = options.start_x[i];
+  }
+  return {std::move(x), modes};
+}
+
 }  // namespace
 
 SimulationResult Simulator::Run(const SimulationOptions& options,
@@ -89,7 +115,8 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   const std::vector<InputSignal> inputs = MergedInputs(system, signals);
   ValidateInputs(system, inputs);
   std::vector<double> breakpoints = Breakpoints(inputs, until, options.lazy_schedule);
-  auto [x, modes] = StartState(*model_);
+  auto [x, modes] =
+      options.start_modes.empty() ? StartState(*model_) : GivenStart(*model_, options);
 
   RunState run(*model_, ParameterEnvironment(options.parameters), inputs, options);
   const double t = 0.0;
@@ -97,8 +124,9 @@ SimulationResult Simulator::Run(const SimulationOptions& options,
   run.SetModes(modes);
   run.Load(t, x.data());
   if (auto violated = run.ViolatedInvariant()) {
-    throw std::invalid_argument("the initial state violates the invariant '" + *violated +
-                                "' of mode " + ModeLabel(modes));
+    throw std::invalid_argument(
+        std::string(options.start_modes.empty() ? "the initial" : "the start") +
+        " state violates the invariant '" + *violated + "' of mode " + ModeLabel(modes));
   }
   EventLoop loop(*model_, run, options, until, std::move(breakpoints), std::move(x));
   return loop.Simulate();

@@ -101,6 +101,15 @@ struct SimulationOptions {
   /// lazy ones at invariant boundaries fire as usual. Times must be finite, non-decreasing and
   /// in [0, until].
   std::vector<ScheduledJump> lazy_schedule;
+  /// A start state in place of the model's initial one: the mode of each component and the
+  /// continuous variables in the order of Simulator::variable_names() (a recorded
+  /// StateSample's `modes` and `x`); empty `modes`: the model's. The run starts from it at time 0,
+  /// so a model whose flows, guards and resets do not read the time continues a run that reached
+  /// this state (with the inputs shifted by that run's time): a stateful emulator steps a run
+  /// this way. Run throws std::invalid_argument for modes or variables that do not fit the model,
+  /// a value that is not finite, or a state outside its modes' invariants.
+  std::vector<int> start_modes;
+  Eigen::VectorXd start_x;
 };
 
 /// Throws std::invalid_argument, with a message for the user, if the horizon `until` (the one the

@@ -401,6 +401,41 @@ TEST(SimulatorTest, BallBounceTimesMatchTheAnalyticSolution) {
   ExpectConsistent(m, r);
 }
 
+// A run continued step by step from its last state (SimulationOptions::start_modes, start_x),
+// as a stateful emulator does: the bounces fall at the analytic times.
+TEST(SimulatorTest, ARunContinuedFromItsStateMatchesTheAnalyticBounces) {
+  const BallParameters p;
+  const Model m(BallText(p));
+  const auto impacts = BallImpacts(p, 200);
+  const double scale = BallZenoTime(p);
+  constexpr double kStep = 0.1;
+  SimulationOptions options;
+  options.until = kStep;
+  std::vector<double> bounces;
+  for (int k = 0; k < 150; ++k) {
+    const SimulationResult r = m.Run(options);
+    ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+    for (const EventRecord& e : r.events) {
+      if (e.label == "bounce") bounces.push_back(k * kStep + e.time);
+    }
+    options.start_modes = r.samples.back().modes;
+    options.start_x = r.samples.back().x;
+  }
+  ASSERT_GE(bounces.size(), 10u);
+  // Each of the 150 restarts of the integrator adds its error (the whole run keeps 1e-9).
+  for (size_t k = 0; k < 10; ++k) {
+    EXPECT_LE(std::abs(bounces[k] - impacts[k].time), 1e-8 * scale) << "bounce " << k + 1;
+  }
+  // A start that does not fit the model is misuse.
+  options.start_x = Eigen::VectorXd::Zero(5);
+  EXPECT_THROW(m.Run(options), std::invalid_argument);
+  options.start_x = Eigen::VectorXd::Constant(2, kNaN);
+  EXPECT_THROW(m.Run(options), std::invalid_argument);
+  options.start_modes = {7};
+  options.start_x = Eigen::VectorXd::Zero(2);
+  EXPECT_THROW(m.Run(options), std::invalid_argument);
+}
+
 TEST(SimulatorTest, BallThatComesToRestIsNotZeno) {
   // Low restitution: the ball reaches v_rest after about ten impacts, whose times still shrink
   // geometrically up to the last one (`stop`). The run must complete at rest, not stop as Zeno.
