@@ -533,12 +533,19 @@ void StartLog(const std::string& level) {
   }
 }
 
+// Where the help sends the reader: the documentation is docs/ in a source tree and
+// PREFIX/share/doc/hybrid/ in an installed copy (`cmake --install`, `pip install`); no path of
+// the build machine is compiled in.
+constexpr const char* kCliDoc =
+    "cli.md of hybrid's documentation (docs/ in the source tree, share/doc/hybrid/ under the "
+    "installation prefix)";
+
 // Each command's help lists the exit codes it can return.
 void SetExitCodeFooters(Commands& c) {
   const std::string common =
       "0 success; 1 invalid model or data (FILE:LINE:COL: message on stderr); 2 usage error (a "
       "bad option value, named); 3 cannot write output; 4 out of memory or internal error";
-  const std::string more = ". Numbers, output files and limits: docs/cli.md.";
+  const std::string more = ". Numbers, output files and limits: " + std::string(kCliDoc) + ".";
   for (CLI::App* app : {c.info, c.dot, c.import, c.diagnose, c.synthesize}) {
     app->footer("Exit codes: " + common + more);
   }
@@ -559,12 +566,14 @@ int main(int argc, char** argv) {
   // A signal that stops the program (Ctrl-C, kill) removes the temporary files of an output
   // being written.
   hybrid::cli::RemoveTemporaryFilesOnSignals();
-  CLI::App app{"hybrid: declare, inspect and draw hybrid automata (see docs/cli.md)", "hybrid"};
+  CLI::App app{"hybrid: declare, inspect and draw hybrid automata; see " + std::string(kCliDoc),
+               "hybrid"};
   app.footer(
       "Exit codes: 0 success; 1 invalid model or data (FILE:LINE:COL: message on stderr); 2 usage "
       "error (a bad option value, named); 3 cannot write output; 4 out of memory or internal "
       "error; 5 simulation stopped early; 6 check: a property violated; 7 check: a verdict "
-      "unknown. Numbers, output files and limits: docs/cli.md.");
+      "unknown. Numbers, output files and limits: " +
+      std::string(kCliDoc) + ".");
   app.require_subcommand(1);
   app.set_version_flag("--version", "hybrid " HYBRID_VERSION);
   Commands commands;

@@ -10,6 +10,8 @@
 #include <stdexcept>
 
 #include "commands/command_error.h"
+#include "commands/initial_values.h"
+#include "commands/model_file.h"
 #include "commands/output.h"
 #include "commands/progress.h"
 #include "commands/reach_plot.h"
@@ -20,7 +22,6 @@
 #include "hybrid/reachability/polyhedral_reachability.h"
 #include "hybrid/reachability/reach_checker.h"
 #include "hybrid/simulation/simulator.h"
-#include "hybrid/spaceex/spaceex_import.h"
 #include "hybrid/verification/property_prover.h"
 #include "hybrid/verification/property_sampler.h"
 #include "hybrid/verification/prove_checker.h"
@@ -562,7 +563,9 @@ json CheckReport(const CheckArgs& args, const System& system, ExitCode* exit_cod
 
 ExitCode RunCheck(const CheckArgs& args) {
   CheckOptions(args);
-  const System system = spaceex::ReadModelFile(args.model);
+  const std::vector<InitialValueSetting> init = ParseInitialValues(args.init);
+  System system = ReadModelArgument(args.model, args.config);
+  SetInitialValues(init, system);
   const Findings found = FindingsOf(args, system);
   const Simulator sim(system);
   const ExitCode code = ExitCodeOf(found.results);

@@ -16,7 +16,13 @@ namespace hybrid::cli {
 struct CheckArgs {
   std::string model;
   std::vector<std::string> properties;  ///< names to check; empty: every declared property
-  std::string method = "auto";          ///< auto, reach, prove or sample
+  /// NAME=VALUE: the initial value of continuous variable NAME, for every property checked: the
+  /// model's initial set with that variable at that point (commands/initial_values.h).
+  std::vector<std::string> init;
+  /// A SpaceEx configuration read in place of the `.cfg` next to a SpaceEx `model` (empty: that
+  /// one; commands/model_file.h).
+  std::string config;
+  std::string method = "auto";  ///< auto, reach, prove or sample
   bool json = false;
   bool modes = false;      ///< also report which modes (discrete states) are reachable
   int depth = 10;          ///< prove: longest counterexample searched, in steps
@@ -40,11 +46,13 @@ struct CheckArgs {
 /// OptionError (commands/command_error.h) for bad arguments (an unknown property name, an
 /// unknown method, a depth outside [0, 1000], an induction bound outside [1, 100], runs < 1, a
 /// budget outside (0, 1e6], an order outside [1, 12], a negative step, a plot without two axes
-/// that are variables), and OutputError when standard output or the plot cannot be written.
+/// that are variables, a bad `init` as SetInitialValues says, a `config` with a model that is not
+/// a SpaceEx model), and OutputError when standard output or the plot cannot be written.
 ExitCode RunCheck(const CheckArgs& args);
 
 /// The report `hybrid check --json` writes (docs/cli.md) for `system` checked with `args`
-/// (`args.model` is only the name the report gives; `args.json` is ignored), and in `exit_code`
+/// (`args.model` is only the name the report gives; `args.json`, `args.init` and `args.config`
+/// are ignored: `system` is the model as the caller read and set it up), and in `exit_code`
 /// (if not null) the exit code RunCheck would return. Throws as RunCheck for bad arguments.
 nlohmann::ordered_json CheckReport(const CheckArgs& args, const System& system,
                                    ExitCode* exit_code);

@@ -4,16 +4,17 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "commands/command_error.h"
 #include "commands/diagnosis_plot.h"
+#include "commands/model_file.h"
 #include "commands/output.h"
 #include "hybrid/automaton/printer.h"
 #include "hybrid/model_diagnosis/automaton_diagnosis.h"
 #include "hybrid/plotting/svg_plot.h"
-#include "hybrid/spaceex/spaceex_import.h"
 
 namespace hybrid::cli {
 namespace {
@@ -184,7 +185,7 @@ AutomatonDiagnosis Diagnosed(const DiagnoseModelArgs& args, double& seconds) {
   const auto start = std::chrono::steady_clock::now();
   AutomatonDiagnosisOptions options;
   options.noise = NoiseOption(args);
-  const System model = spaceex::ReadModelFile(args.model);
+  const System model = ReadModelArgument(args.model, args.config);
   const TraceData data = ReadTraceFile(args.data, model);
   options.engine.significance = args.significance;
   options.engine.threads = args.threads;
@@ -268,7 +269,11 @@ ExitCode RunDiagnoseModel(const DiagnoseModelArgs& args) {
   CheckDiagnosisOptions(args.threads, args.significance);
   NoiseOption(args);
   std::vector<NamedFile> inputs = {{"data", args.data}};
-  for (NamedFile& f : ModelInputs("model", args.model)) inputs.push_back(std::move(f));
+  for (NamedFile& f :
+       ModelInputs("model", args.model,
+                   args.config.empty() ? std::nullopt : std::optional<std::string>(args.config))) {
+    inputs.push_back(std::move(f));
+  }
   std::vector<NamedFile> outputs = {{"out_model", args.out_model}};
   if (!args.report.empty()) outputs.push_back({"report", args.report + "/diagnosis.json"});
   CheckDistinctFiles(inputs, outputs);

@@ -23,6 +23,9 @@ struct DiagnoseModelArgs {
   /// NAME=SD: the noise standard deviation of observed variable NAME, in place of the estimate.
   std::vector<std::string> noise;
   ProgressMode progress = ProgressMode::kOff;
+  /// A SpaceEx configuration read in place of the `.cfg` next to a SpaceEx `model` (empty: that
+  /// one; commands/model_file.h).
+  std::string config;
 };
 
 /// Checks the options both `hybrid diagnose` forms share (the finger's too): OptionError (exit 2)
@@ -36,7 +39,8 @@ void CheckDiagnosisOptions(int threads, double significance);
 nlohmann::ordered_json DiagnoseModelReport(const DiagnoseModelArgs& args, bool curves = false);
 
 /// Runs `hybrid diagnose MODEL DATA.csv`; returns kOk. Before any work: OptionError (exit 2) for
-/// bad option values and for outputs naming an input or each other; OutputError when an output's
+/// bad option values and for outputs naming an input or each other (a `config` with a model that
+/// is not a SpaceEx model: when the model is read); OutputError when an output's
 /// directory does not exist. Then ParseError for a bad model, hybrid::DataError (FILE:LINE:COL)
 /// for a bad trace, InputError for a model the diagnosis does not take (several components) or
 /// cannot simulate as it is (exit 1), OutputError when an output cannot be written. Outputs are

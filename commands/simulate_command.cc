@@ -11,11 +11,12 @@
 
 #include "automaton/number_syntax.h"
 #include "commands/command_error.h"
+#include "commands/initial_values.h"
+#include "commands/model_file.h"
 #include "commands/output.h"
 #include "commands/trajectory_plot.h"
 #include "hybrid/automaton/parser.h"
 #include "hybrid/simulation/simulator.h"
-#include "hybrid/spaceex/spaceex_import.h"
 
 namespace hybrid::cli {
 namespace {
@@ -284,7 +285,9 @@ namespace {
 // The checks of the options made before the model is read. Throws OptionError (and OutputError
 // for an output's missing directory).
 void CheckSimulateArgs(const SimulateArgs& args) {
-  std::vector<NamedFile> inputs = ModelInputs("model", args.model);
+  std::vector<NamedFile> inputs =
+      ModelInputs("model", args.model,
+                  args.config.empty() ? std::nullopt : std::optional<std::string>(args.config));
   inputs.push_back({"input_csv", args.input_csv});
   CheckDistinctFiles(inputs, {{"out", args.out}, {"events", args.events}, {"plot", args.plot}});
   if (args.input_csv.empty() ? false : args.csv_shape != "step" && args.csv_shape != "linear") {
@@ -294,6 +297,7 @@ void CheckSimulateArgs(const SimulateArgs& args) {
   if (args.until && !(*args.until > 0.0)) {
     throw OptionError("until", Arg("until") + ": the horizon must be positive and finite");
   }
+  (void)ParseInitialValues(args.init);
   CheckOutputPlaces({{"out", args.out}, {"events", args.events}, {"plot", args.plot}});
 }
 
@@ -328,8 +332,9 @@ double CheckedHorizon(const SimulationOptions& options, const System& system) {
 
 ExitCode RunSimulate(const SimulateArgs& args) {
   CheckSimulateArgs(args);
-  System system = spaceex::ReadModelFile(args.model);
+  System system = ReadModelArgument(args.model, args.config);
   SetParameters(args.parameters, system);
+  SetInitialValues(ParseInitialValues(args.init), system);
   const SymbolTable& symbols = system.symbols();
   std::vector<InputSignal> signals;
   if (!args.input_csv.empty()) {

@@ -16,19 +16,28 @@ struct SimulateArgs {
   std::string model;
   std::vector<std::string> inputs;      ///< NAME=SIGNAL, SIGNAL as in a scenario
   std::vector<std::string> parameters;  ///< NAME=VALUE: parameter overrides (System::SetParameter)
-  std::string input_csv;                ///< time column plus one column per input
-  std::string csv_shape = "step";       ///< how CSV rows are joined: step or linear
-  std::optional<double> until;          ///< nullopt: the scenario's horizon
-  double sample = 0.0;                  ///< 0: start, end and events only
-  std::string out;                      ///< trajectory CSV
-  std::string events;                   ///< event log CSV
-  std::string plot;                     ///< SVG of the run (variables, inputs, jumps, modes)
-  bool json = false;                    ///< JSON summary (with every event) on standard output
+  /// NAME=VALUE: the initial value of continuous variable NAME for this run, after `parameters`
+  /// (commands/initial_values.h).
+  std::vector<std::string> init;
+  /// A SpaceEx configuration read in place of the `.cfg` next to a SpaceEx `model` (empty: that
+  /// one; commands/model_file.h).
+  std::string config;
+  std::string input_csv;           ///< time column plus one column per input
+  std::string csv_shape = "step";  ///< how CSV rows are joined: step or linear
+  /// nullopt: the scenario's horizon (for a SpaceEx model, its configuration's time-horizon).
+  std::optional<double> until;
+  double sample = 0.0;  ///< 0: start, end and events only
+  std::string out;      ///< trajectory CSV
+  std::string events;   ///< event log CSV
+  std::string plot;     ///< SVG of the run (variables, inputs, jumps, modes)
+  bool json = false;    ///< JSON summary (with every event) on standard output
 };
 
 /// Runs `hybrid simulate`; returns ExitCode::kOk when the run completed, kSimulationFailed when
 /// it stopped early. Throws, before simulating: OptionError (commands/command_error.h) for bad
-/// argument values (a malformed or unknown parameter in `parameters` or input in `inputs`,
+/// argument values (a malformed or unknown parameter in `parameters` or input in `inputs`, a
+/// malformed, unknown, non-finite or out-of-domain initial value in `init`, a `config` with a
+/// model that is not a SpaceEx model,
 /// `csv_shape`, a negative `sample`, an `until` that is not positive, more recorded states than
 /// the simulator allows, `out` and `events` naming one file or an output naming the model or the
 /// input CSV); OutputError when an output's directory does not exist; hybrid::ParseError for a

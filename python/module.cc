@@ -55,6 +55,8 @@
 #include "commands/command_error.h"
 #include "commands/diagnose_model_command.h"
 #include "commands/info_command.h"
+#include "commands/initial_values.h"
+#include "commands/model_file.h"
 #include "commands/output.h"
 #include "commands/simulate_command.h"
 #include "gripper/commands/diagnose_command.h"
@@ -480,8 +482,9 @@ std::string RunStoppable(const std::function<std::string()>& job) {
 // A model read from a file (.ha or SpaceEx .xml), with the operations of the command line.
 class Model {
  public:
-  explicit Model(std::string path)
-      : path_(std::move(path)), system_(spaceex::ReadModelFile(path_)) {}
+  // `config`: a SpaceEx configuration in place of the model's .cfg (commands/model_file.h).
+  Model(std::string path, const std::optional<std::string>& config)
+      : path_(std::move(path)), system_(cli::ReadModelArgument(path_, config.value_or(""))) {}
 
   const std::string& path() const { return path_; }
   const std::string& name() const { return system_.name(); }
@@ -591,8 +594,8 @@ class Model {
   }
 
   py::dict Simulate(std::optional<double> until, const std::map<std::string, SignalValue>& inputs,
-                    std::optional<double> sample,
-                    const std::map<std::string, double>& parameters) const;
+                    std::optional<double> sample, const std::map<std::string, double>& parameters,
+                    const std::map<std::string, double>& init) const;
 
  private:
   std::vector<InputSignal> Signals(const std::map<std::string, SignalValue>& inputs) const;
@@ -684,14 +687,18 @@ py::dict RunDict(std::string_view encoded) {
 py::dict Model::Simulate(std::optional<double> until,
                          const std::map<std::string, SignalValue>& inputs,
                          std::optional<double> sample,
-                         const std::map<std::string, double>& parameters) const {
+                         const std::map<std::string, double>& parameters,
+                         const std::map<std::string, double>& init) const {
+  // The run's initial values, in a copy of the model (commands/initial_values.h).
+  System system = system_;
+  cli::SetInitialValues({init.begin(), init.end()}, system);
   SimulationOptions options;
   options.until = until;
   if (sample) options.sample_step = *sample;
   for (const auto& [name, value] : parameters) options.parameters.emplace_back(name, value);
   const std::vector<InputSignal> signals = Signals(inputs);
   const double horizon = until ? *until : system_.scenario() ? system_.scenario()->until : 0.0;
-  return RunDict(RunStoppable([&] { return EncodedRun(system_, options, signals, horizon); }));
+  return RunDict(RunStoppable([&] { return EncodedRun(system, options, signals, horizon); }));
 }
 
 // `hybrid hand --json` (without --simulate): the report as JSON text.
@@ -892,7 +899,8 @@ PYBIND11_MODULE(_hybrid, m) {
         py::arg("significance"), py::arg("threads"), py::arg("noise"));
   m.def("is_trace_file", &hybrid::IsTraceFile, py::arg("path"));
   py::class_<Model>(m, "Model")
-      .def(py::init<std::string>(), py::arg("path"))
+      .def(py::init<std::string, std::optional<std::string>>(), py::arg("path"),
+           py::arg("config") = py::none())
       .def_property_readonly("path", &Model::path)
       .def_property_readonly("name", &Model::name)
       .def("info_json", &Model::InfoJsonText)
@@ -903,5 +911,6 @@ PYBIND11_MODULE(_hybrid, m) {
            py::arg("order"), py::arg("step"))
       .def("simulate", &Model::Simulate, py::arg("until") = py::none(),
            py::arg("inputs") = std::map<std::string, SignalValue>{}, py::arg("sample") = py::none(),
-           py::arg("parameters") = std::map<std::string, double>{});
+           py::arg("parameters") = std::map<std::string, double>{},
+           py::arg("init") = std::map<std::string, double>{});
 }

@@ -236,7 +236,7 @@ def main():
 # the motor position in counts. Input u in [-1, 1]: motor counts per second. Discrete state
 # (c1, c2, c3, l1, l2, l3): c_i = 1 when link i is blocked by an object, l_i = 1 when it is at its
 # upper joint limit, l3 = -1 when link 3 is at its lower limit. Modes are named c<c1c2c3>_l<l1l2l3>
-# with n for -1. Joint ranges: ../shared/robotiq/kinematics.md (Klamp't limits). See
+# with n for -1. Joint ranges: docs/gripper_facts.md (Klamp't limits). See
 # docs/finger_model.md for the phases, the transitions and every interpretation made.
 
 automaton finger {""")

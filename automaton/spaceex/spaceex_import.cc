@@ -6,8 +6,10 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
+#include "automaton/number_syntax.h"
 #include "automaton/quoted_text.h"
 #include "automaton/spaceex/spaceex_config.h"
 #include "automaton/spaceex/spaceex_document.h"
@@ -170,6 +172,7 @@ class Translator {
   void BuildInstances(const SxComponent& system);
   Target MapParam(const Instance& inst, const SxParam& p, const SxMap* map) const;
   void ReadForbidden();
+  void ReadHorizon();
   void AssignFlows();
   void ReadInitially();
   std::string InitialBoundSide(const Located& f, const SxFormula& side) const;
@@ -185,6 +188,7 @@ class Translator {
   std::string ParamLine(const Instance& inst, const SxParam& p) const;
   const Bound& InitialBound(const Instance& inst, const std::string& param) const;
   std::string Forbidden(const Located& f, const SxFormula& node) const;
+  void PropertyAndScenarioLines(Lines& out) const;
   std::string ForbiddenName(const Located& f, const SxFormula& n) const;
   Lines SystemLines(const SxComponent& system, const std::vector<std::string>& automaton_of) const;
   Translation Emit(const SxComponent& system);
@@ -200,8 +204,10 @@ class Translator {
   std::map<std::string, Bound> initial_;                 // SpaceEx system name -> bound
   std::map<std::string, std::string> initial_location_;  // instance `as` -> location name
   std::optional<Origin> initially_at_;
-  std::optional<Located> forbidden_;  // the option `forbidden`, if given
-  std::set<std::string> declared_;    // SpaceEx system names some instance declares
+  std::optional<Located> forbidden_;    // the option `forbidden`, if given
+  std::optional<std::string> horizon_;  // a positive `time-horizon`, in the model language
+  Origin horizon_at_;
+  std::set<std::string> declared_;  // SpaceEx system names some instance declares
   std::vector<std::string> notes_;
 };
 
@@ -474,6 +480,34 @@ Target Translator::MapParam(const Instance& inst, const SxParam& p, const SxMap*
                                               "' are of different kinds");
   }
   return {target->name, *network_.Find(target->name), ""};
+}
+
+// Reads the option `time-horizon`, SpaceEx's bound on the time its analysis explores. A positive
+// number becomes the horizon of the default run (the scenario's `until`) and of the property
+// `forbidden` (`within`), so that the simulator and every checking engine read the same bound; a
+// negative one (SpaceEx writes -1) means no bound. Anything else is an error at the value.
+void Translator::ReadHorizon() {
+  const std::optional<SpaceExConfig::Value> value = cfg_->Find("time-horizon");
+  if (!value) return;
+  const std::string quoted = EscapedForMessage(value->text);
+  const NumberRead<double> r = ReadDecimal(value->text);
+  if (!r.ok() || r.value == 0.0) {
+    Fail(CfgAt(value->offset),
+         "time-horizon: " +
+             (r.ok() ? "'" + quoted + "' is zero" : NumberErrorMessage(quoted, r.error)) +
+             ": give the time the analysis covers as a positive number (negative: no bound)");
+  }
+  if (r.value < 0.0) {
+    notes_.push_back("time-horizon = " + quoted +
+                     " (negative) sets no bound: properties hold over unbounded time, and a "
+                     "simulation needs a horizon of its own.");
+    return;
+  }
+  horizon_ = FormatNumber(r.value);
+  horizon_at_ = CfgAt(value->offset);
+  notes_.push_back("time-horizon = " + quoted + " is the horizon of the default run (until " +
+                   *horizon_ + ")" +
+                   (forbidden_ ? " and of 'forbidden' (within " + *horizon_ + ")" : "") + ".");
 }
 
 // Reads the option `forbidden`. The names it reads count as used by every instance whose
@@ -832,7 +866,19 @@ std::string Join(const std::vector<std::string>& lines) {
   return out;
 }
 
-// The `system` block of a network: one instance per bind, then the property.
+// The property `forbidden` (within the horizon, if there is one) and the default run to the
+// horizon: the lines that end the translated system.
+void Translator::PropertyAndScenarioLines(Lines& out) const {
+  const std::string within = horizon_ ? " within " + *horizon_ : "";
+  if (forbidden_) {
+    out.Add(
+        "  property forbidden: never " + Forbidden(*forbidden_, forbidden_->formula) + within + ";",
+        forbidden_->where(0));
+  }
+  if (horizon_) out.Add("  scenario { until " + *horizon_ + "; }", horizon_at_);
+}
+
+// The `system` block of a network: one instance per bind, then the property and the scenario.
 Lines Translator::SystemLines(const SxComponent& system,
                               const std::vector<std::string>& automaton_of) const {
   Lines out;
@@ -855,10 +901,7 @@ Lines Translator::SystemLines(const SxComponent& system,
                 (binds.empty() ? ";" : " {" + binds + " }"),
             inst.at);
   }
-  if (forbidden_) {
-    out.Add("  property forbidden: never " + Forbidden(*forbidden_, forbidden_->formula) + ";",
-            forbidden_->where(0));
-  }
+  PropertyAndScenarioLines(out);
   out.Add("}", At(system.offset));
   return out;
 }
@@ -898,10 +941,7 @@ Translation Translator::Emit(const SxComponent& system) {
     out.Add("", top);
     out.Add("automaton " + name + " {", At(inst.tmpl->sx->offset));
     out.Append(body);
-    if (!system.IsNetwork() && forbidden_) {
-      out.Add("  property forbidden: never " + Forbidden(*forbidden_, forbidden_->formula) + ";",
-              forbidden_->where(0));
-    }
+    if (!system.IsNetwork()) PropertyAndScenarioLines(out);
     out.Add("}", At(inst.tmpl->sx->offset));
   }
   if (system.IsNetwork()) out.Append(SystemLines(system, automaton_of));
@@ -919,10 +959,7 @@ Translation Translator::Run() {
   } else {
     if (!initially_at_)
       notes_.push_back("The configuration has no 'initially': the model has no initial states.");
-    if (const auto horizon = cfg_->Find("time-horizon")) {
-      notes_.push_back("time-horizon = " + EscapedForMessage(horizon->text) +
-                       " is not imported: properties hold over unbounded time here.");
-    }
+    ReadHorizon();
   }
   for (const Instance& inst : instances_) {
     if (!inst.dropped_flows.empty()) {
@@ -987,9 +1024,16 @@ bool IsSpaceExFile(const std::filesystem::path& path) {
   return ext == ".xml";
 }
 
-System ReadModelFile(const std::filesystem::path& path) {
-  if (!IsSpaceExFile(path)) return ParseModelFile(path);
-  return ImportSpaceExFile(path).Parse(path.string());
+System ReadModelFile(const std::filesystem::path& path,
+                     const std::optional<std::filesystem::path>& config) {
+  if (!IsSpaceExFile(path)) {
+    if (config) {
+      throw std::invalid_argument("a configuration is read with a SpaceEx model (.xml) only, and " +
+                                  path.string() + " is not one");
+    }
+    return ParseModelFile(path);
+  }
+  return ImportSpaceExFile(path, config).Parse(path.string());
 }
 
 }  // namespace hybrid::spaceex

@@ -625,10 +625,14 @@ TEST(HybridCli, ImportWritesAModelThatChecksLikeTheSpaceExFile) {
   const Result import =
       RunHybrid("import " + Quote(kFischerXml.string()) + " -o " + Quote(out.string()));
   ASSERT_EQ(import.exit_code, 0) << import.err;
-  // The configuration next to the model was read; its time horizon is named as not imported.
-  EXPECT_NE(import.err.find("note: time-horizon = 100 is not imported"), std::string::npos);
-  EXPECT_NE(ReadAll(out).find("property forbidden: never in P1.cs and in P2.cs;"),
+  // The configuration next to the model was read; its time horizon bounds the property and the
+  // default run.
+  EXPECT_NE(import.err.find("note: time-horizon = 100 is the horizon of the default run"),
+            std::string::npos)
+      << import.err;
+  EXPECT_NE(ReadAll(out).find("property forbidden: never in P1.cs and in P2.cs within 100;"),
             std::string::npos);
+  EXPECT_NE(ReadAll(out).find("scenario { until 100; }"), std::string::npos);
   // Both the written model and the SpaceEx file itself are checked, with the same verdict:
   // Fischer's protocol with Delta = 2 > delta = 1 is safe.
   for (const fs::path& model : {out, kFischerXml}) {

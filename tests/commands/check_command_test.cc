@@ -859,5 +859,103 @@ TEST(CheckCommand, PlotReachDrawsTheFlowpipe) {
   EXPECT_NE(error_of([](cli::CheckArgs& a) { a.step = -1; }).find("step: "), std::string::npos);
 }
 
+// ---------------------------------------------------------------------------------------------
+// SpaceEx habits: the configuration's time-horizon bounds `forbidden`; --config; --init.
+
+const fs::path kFischerXml = kSourceDir / "spec" / "spaceex" / "fischer_2.xml";
+const fs::path kFischerCfg = kSourceDir / "spec" / "spaceex" / "fischer_2.cfg";
+
+// The value of `option = VALUE` in the configuration text `cfg`, read here apart from the import.
+std::string CfgValue(const std::string& cfg, const std::string& option) {
+  std::istringstream in(cfg);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(option, 0) == 0) return line.substr(line.find('=') + 2);
+  }
+  ADD_FAILURE() << "no " << option << " in:\n" << cfg;
+  return "";
+}
+
+TEST(CheckCommand, SpaceExForbiddenIsCheckedWithinTheTimeHorizon) {
+  const std::string cfg = ReadAll(kFischerCfg);
+  const double horizon = std::stod(CfgValue(cfg, "time-horizon"));
+  const json bundled = JsonHere(ArgsOf<cli::CheckArgs>(kFischerXml.string()), 0);
+  ASSERT_EQ(bundled.at("properties").size(), 1u);
+  EXPECT_EQ(bundled.at("properties")[0].at("name"), "forbidden");
+  EXPECT_EQ(bundled.at("properties")[0].at("within").get<double>(), horizon);
+  EXPECT_EQ(bundled.at("properties")[0].at("verdict"), "proved");  // Delta = 2 > delta = 1
+  // Another configuration: its horizon, or none for SpaceEx's -1.
+  TempDir dir;
+  const std::string line = "time-horizon = " + CfgValue(cfg, "time-horizon");
+  std::string other = cfg;
+  other.replace(other.find(line), line.size(), "time-horizon = 7.25");
+  const std::string short_cfg = dir.Write("short.cfg", other).string();
+  const json shorter =
+      JsonHere(ArgsOf<cli::CheckArgs>(kFischerXml.string(),
+                                      [&](cli::CheckArgs& a) { a.config = short_cfg; }),
+               0);
+  EXPECT_EQ(shorter.at("properties")[0].at("within").get<double>(), 7.25);
+  std::string none = cfg;
+  none.replace(none.find(line), line.size(), "time-horizon = -1");
+  const std::string none_cfg = dir.Write("none.cfg", none).string();
+  const json unbounded = JsonHere(
+      ArgsOf<cli::CheckArgs>(kFischerXml.string(), [&](cli::CheckArgs& a) { a.config = none_cfg; }),
+      0);
+  EXPECT_FALSE(unbounded.at("properties")[0].contains("within"));
+  EXPECT_EQ(unbounded.at("properties")[0].at("verdict"), "proved");
+  const Result refused = RunHybrid("check " + Quote(kThermostat) + " --config " + Quote(short_cfg));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_EQ(refused.err,
+            "hybrid: --config names a SpaceEx configuration, read with a SpaceEx "
+            "model (.xml) only, and MODEL '" +
+                kThermostat + "' is not one\n");
+  EXPECT_EQ(refused.out, "");
+}
+
+// x' = 1 - x / 2 from x0: x(t) = 2 + (x0 - 2) e^(-t/2), increasing towards 2 from below. From
+// x0 = 0, x(3) = 2 - 2 e^(-1.5) = 1.554 >= 1.5 (first at t = 2 ln 4 = 2.77), but x < 2 < 2.5:
+// `mid` violated, `low` proved. From x0 = -0.5, x(3) = 2 - 2.5 e^(-1.5) = 1.442 < 1.5: both
+// proved. From x0 = 5, x(0) >= 2.5: `low` violated at the start.
+TEST(CheckCommand, InitChangesTheInitialSetOfEveryEngine) {
+  TempDir dir;
+  const std::string model = dir.Write("decay.ha", R"(automaton decay {
+    var x in [-10, 10];
+    mode m { x' = -0.5 * x + 1; }
+    init m { x = 0; }
+    property low: never x >= 2.5 within 3;
+    property mid: never x >= 1.5 within 3;
+  })")
+                                .string();
+  auto verdicts = [&](const std::vector<std::string>& init, int exit_code) {
+    const json j = JsonHere(
+        ArgsOf<cli::CheckArgs>(model, [&](cli::CheckArgs& a) { a.init = init; }), exit_code);
+    std::map<std::string, json> by_name;
+    for (const json& p : j.at("properties")) by_name[p.at("name")] = p;
+    return by_name;
+  };
+  auto declared = verdicts({}, 6);
+  EXPECT_EQ(declared["low"].at("verdict"), "proved");
+  EXPECT_EQ(declared["mid"].at("verdict"), "violated");
+  const double crossing = 2.0 * std::log(4.0);
+  const double at = declared["mid"].at("trace").at("state").at("time").get<double>();
+  EXPECT_GE(at, crossing - 1e-6);
+  EXPECT_LE(at, 3.0);
+  auto below = verdicts({"x=-0.5"}, 0);
+  EXPECT_EQ(below["low"].at("verdict"), "proved");
+  EXPECT_EQ(below["mid"].at("verdict"), "proved");
+  auto above = verdicts({"x=5"}, 6);
+  EXPECT_EQ(above["low"].at("verdict"), "violated");
+  EXPECT_EQ(above["low"].at("trace").at("start").at("values").at("x").get<double>(), 5.0);
+  // Errors name the option: exit 2, nothing on standard output.
+  const Result unknown = RunHybrid("check " + Quote(model) + " --init z=1");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_EQ(unknown.err,
+            "hybrid: --init: 'z' is not a continuous variable of the model; did you mean 'x'?\n");
+  EXPECT_EQ(unknown.out, "");
+  const Result outside = RunHybrid("check " + Quote(model) + " --init x=20");
+  EXPECT_EQ(outside.exit_code, 2);
+  EXPECT_EQ(outside.err,
+            "hybrid: --init x: 20 lies outside the declared domain [-10, 10] of 'x'\n");
+}
+
 }  // namespace
 }  // namespace hybrid

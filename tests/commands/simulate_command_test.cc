@@ -521,5 +521,149 @@ TEST(HybridSimulate, InvariantViolationExitsFiveAndWritesItsOutputs) {
   EXPECT_EQ(Field(z, "events").size(), 100u);
 }
 
+// ---------------------------------------------------------------------------------------------
+// SpaceEx habits: the configuration's time-horizon, --config, --init (docs/spaceex.md).
+
+const fs::path kFischerXml = kSourceDir / "spec" / "spaceex" / "fischer_2.xml";
+const fs::path kFischerCfg = kSourceDir / "spec" / "spaceex" / "fischer_2.cfg";
+
+// The number of the line `time-horizon = N` of the configuration text `cfg`, read here apart from
+// the import (-1 and a test failure if there is none).
+double TimeHorizonOf(const std::string& cfg) {
+  std::istringstream in(cfg);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("time-horizon", 0) == 0) return std::stod(line.substr(line.find('=') + 1));
+  }
+  ADD_FAILURE() << "no time-horizon in:\n" << cfg;
+  return -1.0;
+}
+
+// `cfg` with its time-horizon line replaced by `line`.
+std::string WithHorizonLine(const std::string& cfg, const std::string& line) {
+  const std::size_t start = cfg.find("time-horizon");
+  EXPECT_NE(start, std::string::npos) << cfg;
+  return cfg.substr(0, start) + line + cfg.substr(cfg.find('\n', start));
+}
+
+TEST(HybridSimulate, SpaceExHorizonIsTheConfigurationsTimeHorizon) {
+  const double horizon = TimeHorizonOf(ReadAll(kFischerCfg));
+  EXPECT_EQ(horizon, 100.0);  // spec/spaceex/fischer_2.cfg as written
+  const json j = testing::RunHybridJson("simulate " + Quote(kFischerXml) + " --json");
+  EXPECT_EQ(Field(j, "status"), "completed");
+  EXPECT_EQ(Field(j, "until").get<double>(), horizon);
+  EXPECT_EQ(Field(j, "final", "time").get<double>(), horizon);
+  // Nothing fires in Fischer's protocol before it must: both clocks run from 0 to the horizon.
+  EXPECT_EQ(Field(j, "final", "values", "P1.x").get<double>(), horizon);
+  // An explicit --until wins.
+  const json until =
+      testing::RunHybridJson("simulate " + Quote(kFischerXml) + " --until 2.5 --json");
+  EXPECT_EQ(Field(until, "until").get<double>(), 2.5);
+  EXPECT_EQ(Field(until, "final", "time").get<double>(), 2.5);
+}
+
+TEST(HybridSimulate, ConfigSelectsAnotherConfiguration) {
+  TempDir dir;
+  const std::string cfg =
+      dir.Write("short.cfg", WithHorizonLine(ReadAll(kFischerCfg), "time-horizon = 7.25")).string();
+  const std::string config = " --config " + Quote(cfg);
+  const json j = testing::RunHybridJson("simulate " + Quote(kFischerXml) + config + " --json");
+  EXPECT_EQ(Field(j, "until").get<double>(), 7.25);
+  EXPECT_EQ(Field(j, "final", "values", "P2.x").get<double>(), 7.25);
+  // info and dot read it too: info prints the scenario and the property's horizon.
+  const Result info = RunHybrid("info " + Quote(kFischerXml) + config);
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("until 7.25;"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("within 7.25;"), std::string::npos) << info.out;
+  EXPECT_EQ(RunHybrid("dot " + Quote(kFischerXml) + config).exit_code, 0);
+  // An output may not overwrite the configuration given.
+  const Result overwrite =
+      RunHybrid("simulate " + Quote(kFischerXml) + config + " -o " + Quote(cfg));
+  EXPECT_EQ(overwrite.exit_code, 2);
+  EXPECT_NE(overwrite.err.find("an output may not overwrite an input"), std::string::npos)
+      << overwrite.err;
+}
+
+TEST(HybridSimulate, RefusesBadConfigurations) {
+  TempDir dir;
+  // Line 7, column 16: the value after "time-horizon = " in fischer_2.cfg's layout.
+  const std::string original = ReadAll(kFischerCfg);
+  const std::string bad =
+      dir.Write("bad.cfg", WithHorizonLine(original, "time-horizon = soon")).string();
+  int line = 1;
+  for (std::size_t i = 0; i < original.find("time-horizon"); ++i) line += original[i] == '\n';
+  ExpectRefused(Quote(kFischerXml) + " --config " + Quote(bad),
+                bad + ":" + std::to_string(line) +
+                    ":16: time-horizon: 'soon' is not a decimal number: give the time the "
+                    "analysis covers as a positive number (negative: no bound)");
+  ExpectRefused(Quote(kFischerXml) + " --config " + Quote(dir.File("none.cfg")),
+                dir.File("none.cfg") + ":0:0: cannot read file");
+  // A configuration belongs to a SpaceEx model only: exit 2, naming the option.
+  ExpectRefused(Quote(Spec("thermostat")) + " --config " + Quote(kFischerCfg),
+                "hybrid: --config names a SpaceEx configuration, read with a SpaceEx model (.xml) "
+                "only, and MODEL '" +
+                    Spec("thermostat") + "' is not one",
+                2);
+  // A negative time-horizon (SpaceEx's -1) sets no bound: a run needs --until.
+  const std::string unbounded =
+      dir.Write("unbounded.cfg", WithHorizonLine(original, "time-horizon = -1")).string();
+  ExpectRefused(Quote(kFischerXml) + " --config " + Quote(unbounded),
+                "no horizon: give one (--until) or declare a scenario in the model");
+}
+
+// x' = 1 - x / 2: x(t) = 2 + (x0 - 2) e^(-t/2), the closed form the runs are checked against.
+constexpr const char* kDecay =
+    "automaton decay {\n"
+    "  var x in [-10, 10];\n"
+    "  mode m { x' = -0.5 * x + 1; }\n"
+    "  init m { x = 0; }\n"
+    "  scenario { until 3; }\n"
+    "}\n";
+
+double Decay(double x0, double t) { return 2.0 + (x0 - 2.0) * std::exp(-t / 2.0); }
+
+TEST(HybridSimulate, InitSetsTheInitialValueOfTheRun) {
+  TempDir dir;
+  const std::string model = Quote(dir.Write("decay.ha", kDecay));
+  const json declared = testing::RunHybridJson("simulate " + model + " --json");
+  EXPECT_NEAR(Field(declared, "final", "values", "x").get<double>(), Decay(0.0, 3.0), 1e-7);
+  const json five = testing::RunHybridJson("simulate " + model + " --init x=5 --json");
+  EXPECT_NEAR(Field(five, "final", "values", "x").get<double>(), Decay(5.0, 3.0), 1e-7);
+  // The later value of a variable wins; the domain's ends are allowed.
+  const json last = testing::RunHybridJson("simulate " + model + " --init x=5 --init x=-10 --json");
+  EXPECT_NEAR(Field(last, "final", "values", "x").get<double>(), Decay(-10.0, 3.0), 1e-6);
+  // In a composed system the names are qualified: A starts at 5, B as declared.
+  const std::string system = Quote(dir.Write(
+      "two.ha", std::string(kDecay) + "system two {\n  instance A = decay;\n  instance B = decay;\n"
+                                      "  scenario { until 3; }\n}\n"));
+  const json two = testing::RunHybridJson("simulate " + system + " --init A.x=5 --json");
+  EXPECT_NEAR(Field(two, "final", "values", "A.x").get<double>(), Decay(5.0, 3.0), 1e-7);
+  EXPECT_NEAR(Field(two, "final", "values", "B.x").get<double>(), Decay(0.0, 3.0), 1e-7);
+  ExpectRefused(system + " --init x=1",
+                "hybrid: --init: 'x' is not a continuous variable of the model; did you mean "
+                "'A.x' or 'B.x'? (a composed system's names are qualified by the instance)",
+                2);
+}
+
+TEST(HybridSimulate, RefusesBadInitialValues) {
+  TempDir dir;
+  const std::string model = Quote(dir.Write("decay.ha", kDecay));
+  ExpectRefused(model + " --init y=1",
+                "hybrid: --init: 'y' is not a continuous variable of the model; did you mean "
+                "'x'?",
+                2);
+  ExpectRefused(model + " --init x=11",
+                "hybrid: --init x: 11 lies outside the declared domain [-10, 10] of 'x'", 2);
+  ExpectRefused(model + " --init x=-10.5",
+                "hybrid: --init x: -10.5 lies outside the declared domain [-10, 10] of 'x'", 2);
+  ExpectRefused(model + " --init x=nan", "hybrid: --init x: 'nan' is not a decimal number", 2);
+  ExpectRefused(model + " --init x=1e999", "hybrid: --init x: '1e999' is out of range", 2);
+  ExpectRefused(model + " --init x", "hybrid: --init 'x': expected NAME=VALUE", 2);
+  const std::string thermostat = Quote(Spec("thermostat"));
+  ExpectRefused(thermostat + " --init u=1",
+                "hybrid: --init: 'u' is an input, not a continuous variable (drive it with "
+                "--input)",
+                2);
+}
+
 }  // namespace
 }  // namespace hybrid

@@ -20,7 +20,7 @@ Automaton BundledFinger() {
 }
 
 TEST(FingerParametersOf, TheBundledFingerHasTheReportsConstants) {
-  // The joint ranges of ../shared/robotiq/kinematics.md (Klamp't limits).
+  // The joint ranges of docs/gripper_facts.md (Klamp't limits).
   const FingerParameters p = FingerParametersOf(BundledFinger());
   EXPECT_EQ(p.theta_min, Eigen::Vector3d(0, 0, -55));
   EXPECT_EQ(p.theta_max, Eigen::Vector3d(70, 90, 43));

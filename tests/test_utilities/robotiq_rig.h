@@ -14,7 +14,7 @@
 // configuration at q, as the report's tables give it for a finger closing from 0 (the tables
 // are retraced on opening: the finger has no hysteresis of its own).
 //
-// The controller (report section 2; the manual, ../shared/robotiq/kinematics.md): the motor
+// The controller (report section 2; the manual, docs/gripper_facts.md): the motor
 // moves towards the request and stops when the finger can move no further (the free finger
 // against the palm at q = 240; link 3 at its upper limit; link 2 at its limit with link 3 at its
 // lower one); it stays there until a more open position is requested. Samples are taken once the
@@ -29,7 +29,7 @@
 
 namespace hybrid::testing {
 
-/// The finger's constants: the joint ranges of kinematics.md, m1 = theta1_max / 140 and
+/// The finger's constants: the joint ranges of docs/gripper_facts.md, m1 = theta1_max / 140 and
 /// m2 = theta2_max / 100 (deg per count) as in the report, and the phase-3 law of link 3.
 struct RigFinger {
   double theta1_max = 70.0;  ///< deg; link 1 reaches it at q = 140

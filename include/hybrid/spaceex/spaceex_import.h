@@ -35,10 +35,14 @@ struct Translation {
 /// the configuration text `cfg`: the component named by the option `system` (default: the last
 /// one) becomes an automaton (a base component) or a system of instances (a network: one
 /// automaton per base component, or per instance where instances differ in constants or initial
-/// states); `initially` gives initial states, `forbidden` the property `never` of that set.
+/// states); `initially` gives initial states, `forbidden` the property `never` of that set, and a
+/// positive `time-horizon` T the horizon of both the default run (`scenario { until T; }`) and
+/// that property (`within T`), so that simulation and every checking engine read one bound (a
+/// negative `time-horizon`, SpaceEx's -1, sets none).
 /// Throws ParseError naming the file, line and column of malformed XML or configuration, of a
 /// construct the translation does not support (nested networks, disjunctive initial sets, flows
-/// that leave a variable unconstrained, ...), of an attribute the import does not know or a
+/// that leave a variable unconstrained, ...), of a `time-horizon` that is not a non-zero number,
+/// of an attribute the import does not know or a
 /// boolean attribute that is not true, false, 1 or 0 (in any case), or of a name that is not
 /// declared. Names that `forbidden` reads are declared by the components they belong to, also
 /// when nothing else reads them. Messages and notes escape the control characters they quote
@@ -61,8 +65,11 @@ std::optional<std::filesystem::path> DefaultConfigFile(const std::filesystem::pa
 /// True if `path` names a SpaceEx model (its extension is `.xml`, in any case).
 bool IsSpaceExFile(const std::filesystem::path& path);
 
-/// Reads a model of either language: a SpaceEx model (IsSpaceExFile) through ImportSpaceExFile,
-/// anything else with ParseModelFile.
-System ReadModelFile(const std::filesystem::path& path);
+/// Reads a model of either language: a SpaceEx model (IsSpaceExFile) through ImportSpaceExFile
+/// with the configuration `config` (default: the `.cfg` next to it), anything else with
+/// ParseModelFile. Throws std::invalid_argument when `config` is given for a file that is not a
+/// SpaceEx model (only SpaceEx models have a configuration).
+System ReadModelFile(const std::filesystem::path& path,
+                     const std::optional<std::filesystem::path>& config = std::nullopt);
 
 }  // namespace hybrid::spaceex

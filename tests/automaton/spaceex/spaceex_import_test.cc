@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -312,17 +313,53 @@ TEST(SpaceExImportTest, ControlCharactersInNamesAndOptionsAreEscaped) {
   EXPECT_EQ(Error(Base(Var("x&#27;[2J"), ""), ""),
             "m.xml:4:1: parameter 'x\\x1b[2J' is not a name of the model language (letters, "
             "digits and '_', not starting with a digit)");
-  const Translation t =
-      Translate(SpecFile("water_tank.xml"),
-                "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"\n"
-                "time-horizon = \"1\x1b[2J\nautomaton injected { }\"\n");
-  ASSERT_FALSE(t.notes.empty());
-  EXPECT_EQ(t.notes[0],
-            "time-horizon = 1\\x1b[2J\\nautomaton injected { } is not imported: properties hold "
-            "over unbounded time here.");
-  EXPECT_EQ(t.text.find('\x1b'), std::string::npos);
-  EXPECT_EQ(t.text.find("\nautomaton injected"), std::string::npos);
-  EXPECT_NO_THROW((void)t.Parse("m.xml"));
+  const std::string tank = SpecFile("water_tank.xml");
+  const std::string init =
+      "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"\n";
+  EXPECT_EQ(Error(tank, init + "time-horizon = \"1\x1b[2J\nautomaton injected { }\"\n"),
+            "m.cfg:2:17: time-horizon: '1\\x1b[2J\\nautomaton injected { }' is not a decimal "
+            "number: give the time the analysis covers as a positive number (negative: no bound)");
+}
+
+// The configuration's time-horizon bounds both the default run and the property, as SpaceEx's
+// analysis stops there. The oracle is the water tank's arithmetic: from y = 1 the level rises at
+// 1 cm/s until y = high = 10, so y(t) = 1 + t for t <= 9: y reaches 7 at t = 6 and never within
+// 5 (y(5) = 6), while over unbounded time it reaches 12.
+TEST(SpaceExImportTest, TimeHorizonBoundsTheDefaultRunAndForbidden) {
+  const std::string tank = SpecFile("water_tank.xml");
+  const std::string cfg =
+      "initially = \"loc()==on & y==1 & x==0 & delay==2 & high==10 & low==5\"\n"
+      "forbidden = \"y >= 7\"\n";
+  const Translation bounded = Translate(tank, cfg + "time-horizon = 5\n");
+  const System system = bounded.Parse("m.xml");
+  ASSERT_TRUE(system.scenario().has_value());
+  EXPECT_EQ(system.scenario()->until, 5.0);
+  ASSERT_EQ(system.properties().size(), 1u);
+  EXPECT_EQ(system.properties()[0].horizon, std::optional<double>(5.0));
+  EXPECT_EQ(bounded.notes.at(0),
+            "time-horizon = 5 is the horizon of the default run (until 5) and of 'forbidden' "
+            "(within 5).");
+  EXPECT_EQ(ForbiddenVerdict(tank, cfg + "time-horizon = 5\n"), Verdict::kProved);
+  EXPECT_EQ(ForbiddenVerdict(tank, cfg + "time-horizon = 6.5\n"), Verdict::kViolated);
+  // No time-horizon, or a negative one (SpaceEx's -1): no bound, no default run.
+  for (const std::string& none : {std::string(), std::string("time-horizon = -1\n")}) {
+    const System unbounded = Translate(tank, cfg + none).Parse("m.xml");
+    EXPECT_FALSE(unbounded.scenario().has_value()) << none;
+    EXPECT_EQ(unbounded.properties()[0].horizon, std::nullopt) << none;
+    EXPECT_EQ(ForbiddenVerdict(tank, cfg + none), Verdict::kViolated) << none;
+  }
+  // In a network, the scenario is the system's.
+  const System fischer =
+      Translate(SpecFile("fischer_2.xml"), SpecFile("fischer_2.cfg")).Parse("m.xml");
+  ASSERT_TRUE(fischer.scenario().has_value());
+  EXPECT_EQ(fischer.properties()[0].horizon, std::optional<double>(fischer.scenario()->until));
+  EXPECT_EQ(Error(tank, cfg + "time-horizon = 0\n"),
+            "m.cfg:3:16: time-horizon: '0' is zero: give the time the analysis covers as a "
+            "positive number (negative: no bound)");
+  EXPECT_EQ(Error(tank, cfg + "time-horizon = 1e999\n"),
+            "m.cfg:3:16: time-horizon: '1e999' is out of range (beyond the largest double, about "
+            "1.8e308): give the time the analysis covers as a positive number (negative: no "
+            "bound)");
 }
 
 // In SpaceEx a label is in the alphabet of every component that declares it: a component that
@@ -358,6 +395,19 @@ TEST(SpaceExImportTest, ReadModelFileReadsBothLanguages) {
   const System imported =
       ReadModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/fischer_2.xml");
   EXPECT_EQ(imported.properties().size(), 1u);
+  // Another configuration in place of the one beside the model; none for a model-language file.
+  const std::string tank = std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/water_tank.xml";
+  const std::string fischer_cfg = std::string(HYBRID_SOURCE_DIR) + "/spec/spaceex/fischer_2.cfg";
+  try {  // fischer_2.cfg chooses `system = "fischer"`, which water_tank.xml has not
+    (void)ReadModelFile(tank, fischer_cfg);
+    ADD_FAILURE() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), fischer_cfg);
+    EXPECT_EQ(e.message(), "no component 'fischer' in " + tank);
+  }
+  EXPECT_THROW(
+      (void)ReadModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/thermostat.ha", fischer_cfg),
+      std::invalid_argument);
   EXPECT_TRUE(IsSpaceExFile("a/b.XML"));
   EXPECT_FALSE(IsSpaceExFile("a/b.ha"));
   try {
