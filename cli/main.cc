@@ -32,6 +32,7 @@
 #include "commands/exit_code.h"
 #include "commands/info_command.h"
 #include "commands/mode_groups.h"
+#include "commands/model_file.h"
 #include "commands/output.h"
 #include "commands/simulate_command.h"
 #include "gripper/commands/diagnose_command.h"
@@ -54,6 +55,9 @@ using hybrid::cli::WriteOutput;
 using json = nlohmann::ordered_json;
 
 constexpr const char* kModelHelp = "Model file (.ha, or a SpaceEx .xml read with its .cfg)";
+constexpr const char* kConfigHelp =
+    "SpaceEx configuration of a SpaceEx MODEL (.xml), read in place of the .cfg of the same "
+    "name: initial states, forbidden set, time-horizon";
 
 // The options of every command, filled by CLI11, and the subcommands that parse them.
 struct Commands {
@@ -69,7 +73,7 @@ struct Commands {
   std::string model;  // info, dot and import
   bool as_json = false;
   std::string output;
-  std::string config;  // import
+  std::string config;  // --config: import, info, dot, diagnose
   bool product = false;
   bool compact = false;  // dot
   std::string group_by;  // dot
@@ -92,12 +96,14 @@ void AddModelCommands(CLI::App& app, Commands& c) {
                               "warnings as comments; --json for the JSON report");
   c.info->add_option("MODEL", c.model, kModelHelp)->required();
   c.info->add_flag("--json", c.as_json, "Machine-readable output");
+  c.info->add_option("--config", c.config, kConfigHelp);
 
   c.dot = app.add_subcommand("dot",
                              "Write the mode graph in Graphviz DOT (render with "
                              "`dot -Tsvg`)");
   c.dot->add_option("MODEL", c.model, kModelHelp)->required();
   c.dot->add_option("-o,--output", c.output, "Output file (default: standard output)");
+  c.dot->add_option("--config", c.config, kConfigHelp);
   c.dot->add_flag("--product", c.product,
                   "Draw a composed model as its product automaton instead of one cluster per "
                   "component");
@@ -130,6 +136,10 @@ void AddSimulate(CLI::App& app, Commands& c) {
   simulate->add_option("--set", a.parameters,
                        "NAME=VALUE: give parameter NAME the value VALUE (e.g. gob1=80 for the "
                        "finger; A.gob1 in a system); repeatable");
+  simulate->add_option("--init", a.init,
+                       "NAME=VALUE: start continuous variable NAME at VALUE in this run (A.x in "
+                       "a system); repeatable");
+  simulate->add_option("--config", a.config, kConfigHelp);
   simulate->add_option("--input-csv", a.input_csv,
                        "CSV with a 'time' column and one column per input");
   simulate->add_option("--csv-shape", a.csv_shape,
@@ -178,6 +188,10 @@ void AddCheck(CLI::App& app, Commands& c) {
   check->add_option("--property", a.properties,
                     "Check only this property (repeatable; default: every declared property, "
                     "components' ones named INSTANCE.NAME)");
+  check->add_option("--init", a.init,
+                    "NAME=VALUE: check from the initial states with continuous variable NAME at "
+                    "VALUE (A.x in a system); repeatable");
+  check->add_option("--config", a.config, kConfigHelp);
   check
       ->add_option("--method", a.method,
                    "auto (reach for linear hybrid automata, then flowpipe, prove, and sample for "
@@ -301,6 +315,7 @@ void AddDiagnosis(CLI::App& app, Commands& c) {
   diagnose->add_option("DATA", c.diagnose_data, "The trace of the model FILE");
   diagnose->add_option("--model", d.model,
                        "The model (default for the finger's data: the bundled finger.ha)");
+  diagnose->add_option("--config", c.config, kConfigHelp);
   diagnose
       ->add_option("--noise", c.diagnose_noise,
                    "NAME=SD: noise standard deviation of a traced variable, in place of the "
@@ -372,10 +387,14 @@ ExitCode RunDiagnosis(Commands& c) {
                                      "`hybrid diagnose MODEL " +
                                      d.data + "`");
     }
-    const hybrid::cli::DiagnoseModelArgs m{d.model,     d.data,           d.json,
-                                           d.out_model, d.report,         d.significance,
-                                           d.threads,   c.diagnose_noise, d.progress};
+    const hybrid::cli::DiagnoseModelArgs m{d.model,    d.data,         d.json,    d.out_model,
+                                           d.report,   d.significance, d.threads, c.diagnose_noise,
+                                           d.progress, c.config};
     return hybrid::cli::RunDiagnoseModel(m);
+  }
+  if (!c.config.empty()) {
+    throw OptionError(
+        "config", Arg("config") + " applies to a SpaceEx model (.xml), not to the finger's data");
   }
   if (!c.diagnose_noise.empty()) {
     throw OptionError("noise", Arg("noise") +
@@ -411,11 +430,13 @@ ExitCode RunImport(const Commands& c) {
 ExitCode RunModelCommand(const Commands& c) {
   if (c.import->parsed()) return RunImport(c);
   if (c.dot->parsed()) {
-    hybrid::cli::CheckDistinctFiles(hybrid::cli::ModelInputs("model", c.model),
-                                    {{"output", c.output}});
+    hybrid::cli::CheckDistinctFiles(
+        hybrid::cli::ModelInputs("model", c.model,
+                                 c.config.empty() ? std::nullopt : std::optional(c.config)),
+        {{"output", c.output}});
     hybrid::cli::CheckOutputPlaces({{"output", c.output}});
   }
-  const System system = hybrid::spaceex::ReadModelFile(c.model);
+  const System system = hybrid::cli::ReadModelArgument(c.model, c.config);
   if (c.info->parsed()) {
     const json report = hybrid::cli::InfoJson(system, c.model);
     for (const auto& w : report["warnings"]) {

@@ -79,8 +79,8 @@ def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):
 class Model:
     """A hybrid automaton (or a system of them) read from a file; see :func:`load`."""
 
-    def __init__(self, path):
-        self._model = _hybrid.Model(str(path))
+    def __init__(self, path, config=None):
+        self._model = _hybrid.Model(str(path), None if config is None else str(config))
 
     @property
     def path(self):
@@ -100,16 +100,20 @@ class Model:
         """The mode graph in Graphviz DOT (``hybrid dot``); ``product=True`` draws the product."""
         return self._model.dot(product)
 
-    def simulate(self, until=None, inputs=None, sample=None, parameters=None):
+    def simulate(self, until=None, inputs=None, sample=None, parameters=None, init=None):
         """Simulates from the initial state with exact event location (``hybrid simulate``).
 
         Args:
-            until: the horizon in model time units; None: the model's scenario's.
+            until: the horizon in model time units; None: the model's scenario's (for a SpaceEx
+                model, its configuration's ``time-horizon``).
             inputs: {input name: signal}, a signal being a number (constant), a list of
                 (time, value) steps, or a signal in the language's syntax, e.g.
                 ``"ramp(0: 0, 2: 1)"``; inputs left out follow the scenario (or stay at 0).
             sample: > 0 also records the state every ``sample`` time units.
             parameters: {parameter name: value} overrides.
+            init: {continuous variable name: value}, the run's initial values (``A.x`` in a
+                composed system); ValueError for a name that is no continuous variable, a value
+                that is not finite or lies outside the variable's declared domain.
 
         Returns:
             A dict: ``hybrid simulate --json``'s members (``status``, ``message``, ``until``,
@@ -120,7 +124,8 @@ class Model:
             ``states`` ({variable name: numpy array}, aligned with ``time``) and ``modes`` (the
             mode at each instant, ``A.m|B.n`` for several components).
         """
-        result = self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}))
+        result = self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}),
+                                      dict(init or {}))
         result.update(_json.loads(result.pop("report_json")))
         return result
 
@@ -181,11 +186,12 @@ class Model:
         return "hybrid.Model(%r)" % self.path
 
 
-def load(path):
+def load(path, config=None):
     """Reads the model at ``path`` (a ``.ha`` file, or SpaceEx ``.xml`` with the ``.cfg`` of
-    the same name next to it). Raises ModelError (file:line:col: message) if it does not parse,
-    OSError-like ValueError if it cannot be read."""
-    return Model(path)
+    the same name next to it, or the configuration ``config`` when given). Raises ModelError
+    (file:line:col: message) if it does not parse, OSError-like ValueError if it cannot be read,
+    ValueError if ``config`` is given with a model that is not SpaceEx's."""
+    return Model(path, config)
 
 
 def hand(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c=None):
