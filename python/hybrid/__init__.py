@@ -26,7 +26,6 @@ import json as _json
 
 from . import _hybrid
 from ._version import __version__
-from ._version import __version__
 
 ModelError = _hybrid.ModelError
 DataError = _hybrid.DataError

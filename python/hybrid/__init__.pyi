@@ -8,8 +8,6 @@ Signal = Union[float, Sequence[tuple[float, float]], str]
 
 __version__: str
 
-__version__: str
-
 class ModelError(ValueError): ...
 class DataError(ValueError): ...
 
