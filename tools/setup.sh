@@ -26,6 +26,8 @@ packages=(
   pybind11-dev python3-dev     # the Python module (python/, docs/python.md)
   python3-pytest               # its test suite (tests/python/)
   python3-jsonschema           # the JSON Schemas of the --json outputs (tests/python/test_json_schemas.py)
+  python3-venv python3-pip python3-setuptools python3-wheel  # `pip install .` (pyproject.toml,
+                               # docs/python.md "Installing") and its test (tests/python/test_pip_install.py)
 )
 
 sudo_cmd=()

@@ -106,7 +106,21 @@ TEST(HybridCli, EachCommandsHelpListsItsExitCodes) {
 TEST(HybridCli, VersionExitsZero) {
   const Result r = RunHybrid("--version");
   EXPECT_EQ(r.exit_code, 0);
-  EXPECT_EQ(r.out, "hybrid 0.1.0\n");
+  EXPECT_EQ(r.out, "hybrid " HYBRID_PROJECT_VERSION "\n");  // CMake's project(VERSION)
+}
+
+// The help that sends the reader to cli.md says where it is both in a source tree and installed
+// (`cmake --install` and `pip install` put docs/ in PREFIX/share/doc/hybrid/).
+TEST(HybridCli, HelpSaysWhereTheDocumentationIs) {
+  for (const char* command : {"", "info", "simulate", "check", "finger", "diagnose"}) {
+    const Result r = RunHybrid(std::string(command) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << command;
+    EXPECT_NE(r.out.find("cli.md of hybrid's documentation (docs/ in the source tree, "
+                         "share/doc/hybrid/ under the installation prefix)"),
+              std::string::npos)
+        << command << ": " << r.out;
+    EXPECT_EQ(r.out.find("docs/cli.md"), std::string::npos) << command;
+  }
 }
 
 TEST(HybridCli, UsageErrorsExitTwo) {

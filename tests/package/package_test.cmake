@@ -130,6 +130,14 @@ if(NOT output MATCHES "modes \\(2\\): off, on" OR NOT output MATCHES "property c
   message(FATAL_ERROR "package test: `hybrid info` on the installed thermostat printed no modes "
                       "off, on and property comfortable")
 endif()
+# The documentation every --help names (cli.md) and the licences, in share/doc/hybrid/.
+foreach(file cli.md python.md schemas/check.schema.json README.md CHANGELOG.md LICENSE
+             LICENSE.GPL-3.0)
+  if(NOT EXISTS ${prefix}/share/doc/hybrid/${file})
+    message(FATAL_ERROR "package test: share/doc/hybrid/${file} is not installed")
+  endif()
+endforeach()
+message(STATUS "package test: the documentation is installed in share/doc/hybrid/")
 # 6. The build tree's package, without installing: the first program of the outside project.
 set(configure_build_tree ${configure})
 list(FILTER configure_build_tree EXCLUDE REGEX "^-DCMAKE_PREFIX_PATH=|^-B|^-DHYBRID_ALL_HEADERS=")
