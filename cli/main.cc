@@ -287,6 +287,9 @@ void AddHand(CLI::App& app, Commands& c) {
   AddNumberOption(hand, "--g-b", &a.g_b, "Motor command of finger B");
   AddNumberOption(hand, "--g-c", &a.g_c, "Motor command of finger C");
   hand->add_flag("--json", a.json, "Machine-readable output");
+  hand->add_flag("--joint-state", a.joint_state,
+                 "Also give the joints of the ROS description (names, radians; "
+                 "docs/robot_frames.md)");
   hand->add_option("--draw", a.draw, "Write an SVG drawing of the hand (see --at)");
   AddNumberListOption(hand, "--at", &a.draw_at,
                       "Motor positions drawn by --draw (default 0,30,70,110,150,180,210,255)");

@@ -61,6 +61,7 @@
 #include "commands/simulate_command.h"
 #include "gripper/commands/diagnose_command.h"
 #include "gripper/commands/grasp_sweep.h"
+#include "hybrid/gripper/gripper_emulator.h"
 #include "gripper/commands/gripper_command.h"
 #include "hybrid/automaton/dot_writer.h"
 #include "hybrid/automaton/log.h"
@@ -595,7 +596,8 @@ class Model {
 
   py::dict Simulate(std::optional<double> until, const std::map<std::string, SignalValue>& inputs,
                     std::optional<double> sample, const std::map<std::string, double>& parameters,
-                    const std::map<std::string, double>& init) const;
+                    const std::map<std::string, double>& init,
+                    std::optional<double> tolerance) const;
 
  private:
   std::vector<InputSignal> Signals(const std::map<std::string, SignalValue>& inputs) const;
@@ -688,13 +690,18 @@ py::dict Model::Simulate(std::optional<double> until,
                          const std::map<std::string, SignalValue>& inputs,
                          std::optional<double> sample,
                          const std::map<std::string, double>& parameters,
-                         const std::map<std::string, double>& init) const {
+                         const std::map<std::string, double>& init,
+                         std::optional<double> tolerance) const {
   // The run's initial values, in a copy of the model (commands/initial_values.h).
   System system = system_;
   cli::SetInitialValues({init.begin(), init.end()}, system);
   SimulationOptions options;
   options.until = until;
   if (sample) options.sample_step = *sample;
+  if (tolerance) {
+    options.relative_tolerance = *tolerance;
+    options.absolute_tolerance = *tolerance * 1e-2;
+  }
   for (const auto& [name, value] : parameters) options.parameters.emplace_back(name, value);
   const std::vector<InputSignal> signals = Signals(inputs);
   const double horizon = until ? *until : system_.scenario() ? system_.scenario()->until : 0.0;
@@ -704,8 +711,9 @@ py::dict Model::Simulate(std::optional<double> until,
 // `hybrid hand --json` (without --simulate): the report as JSON text.
 std::string HandJsonText(const std::vector<std::string>& objects, const std::string& mode,
                          std::optional<double> spread, double g, std::optional<double> g_a,
-                         std::optional<double> g_b, std::optional<double> g_c) {
+                         std::optional<double> g_b, std::optional<double> g_c, bool joint_state) {
   cli::HandArgs args;
+  args.joint_state = joint_state;
   args.objects = objects;
   args.mode = mode;
   args.spread = spread;
@@ -800,6 +808,90 @@ std::string FingerJsonText(double g, std::optional<double> gob1, std::optional<d
   return cli::FingerReportJson(args).dump();
 }
 
+// hybrid.Gripper: the stateful emulator (include/hybrid/gripper/gripper_emulator.h) with registers
+// as a dict of names and the state as a dict.
+class Gripper {
+ public:
+  Gripper(const std::optional<std::string>& model, const std::vector<std::string>& objects)
+      : emulator_(spaceex::ReadModelFile(model ? *model
+                                               : cli::BundledFile("spec/gripper.ha").string()),
+                  cli::ParseObjectList(objects)) {}
+
+  // Writes the registers named in `values` (the others keep their values).
+  void Command(const std::map<std::string, int>& values) {
+    gripper::GripperRegisters r = emulator_.registers();
+    const std::map<std::string, int*> flags = {{"rACT", &r.rACT}, {"rMOD", &r.rMOD},
+                                               {"rGTO", &r.rGTO}, {"rATR", &r.rATR},
+                                               {"rGLV", &r.rGLV}, {"rICF", &r.rICF},
+                                               {"rICS", &r.rICS}};
+    for (const auto& [name, value] : values) {
+      if (const auto it = flags.find(name); it != flags.end()) {
+        *it->second = value;
+        continue;
+      }
+      const std::string axes = "ABCS";
+      const size_t axis = name.size() == 4 ? axes.find(name[3]) : std::string::npos;
+      const std::string kind = name.substr(0, 3);
+      if (axis == std::string::npos || (kind != "rPR" && kind != "rSP" && kind != "rFR")) {
+        throw cli::OptionError("registers", cli::Arg("registers") + ": no register named '" +
+                                                name + "' (rACT, rMOD, rGTO, rATR, rGLV, rICF, "
+                                                "rICS, rPRA..rPRS, rSPA..rSPS, rFRA..rFRS)");
+      }
+      (kind == "rPR" ? r.rPR : kind == "rSP" ? r.rSP : r.rFR)[axis] = value;
+    }
+    emulator_.Command(r);
+  }
+
+  py::dict Step(double dt) {
+    {
+      py::gil_scoped_release release;
+      emulator_.Step(dt);
+    }
+    return State();
+  }
+
+  py::dict State() const {
+    const gripper::GripperState& st = emulator_.state();
+    const gripper::GripperStatus& g = st.status;
+    py::dict status;
+    for (const auto& [name, value] : {std::pair{"gACT", g.gACT}, {"gMOD", g.gMOD},
+                                      {"gGTO", g.gGTO}, {"gIMC", g.gIMC}, {"gSTA", g.gSTA},
+                                      {"gFLT", g.gFLT}}) {
+      status[name] = value;
+    }
+    const std::string axes = "ABCS";
+    for (int k = 0; k < 4; ++k) {
+      status[("gDT" + std::string(1, axes[k])).c_str()] = g.gDT[k];
+      status[("gPR" + std::string(1, axes[k])).c_str()] = g.gPR[k];
+      status[("gPO" + std::string(1, axes[k])).c_str()] = g.gPO[k];
+      status[("gCU" + std::string(1, axes[k])).c_str()] = g.gCU[k];
+    }
+    py::array_t<double> theta({3, 3});
+    for (int f = 0; f < 3; ++f) {
+      for (int i = 0; i < 3; ++i) theta.mutable_at(f, i) = st.theta[f][i];
+    }
+    py::dict joints;
+    joints["name"] = st.joints.name;
+    joints["position"] = st.joints.position;
+    joints["model_position"] = st.joints.model_position;
+    joints["clamped"] = st.joints.clamped;
+    py::dict out;
+    out["time"] = st.time;
+    out["status"] = status;
+    out["theta"] = theta;
+    out["motor"] = std::vector<double>(st.motor.begin(), st.motor.end());
+    out["scissor"] = st.scissor;
+    out["spread_angle"] = st.spread_angle;
+    out["joint_state"] = joints;
+    out["simulation"] = st.simulation;
+    out["message"] = st.message;
+    return out;
+  }
+
+ private:
+  gripper::GripperEmulator emulator_;
+};
+
 // `hybrid diagnose DATA --json`: the report as JSON text (the bundled finger without a model).
 std::string DiagnoseJsonText(const std::string& data, const std::optional<std::string>& model,
                              double significance, int threads) {
@@ -892,12 +984,19 @@ PYBIND11_MODULE(_hybrid, m) {
   m.def("finger_json", &FingerJsonText, py::arg("g"), py::arg("gob1"), py::arg("gob2"),
         py::arg("gob3"), py::arg("objects"));
   m.def("hand_json", &HandJsonText, py::arg("objects"), py::arg("mode"), py::arg("spread"),
-        py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"));
+        py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"),
+        py::arg("joint_state") = false);
   m.def("diagnose_json", &DiagnoseJsonText, py::arg("data"), py::arg("model"),
         py::arg("significance"), py::arg("threads"));
   m.def("diagnose_model_json", &DiagnoseModelJsonText, py::arg("model"), py::arg("data"),
         py::arg("significance"), py::arg("threads"), py::arg("noise"));
   m.def("is_trace_file", &hybrid::IsTraceFile, py::arg("path"));
+  py::class_<Gripper>(m, "Gripper")
+      .def(py::init<std::optional<std::string>, std::vector<std::string>>(), py::arg("model"),
+           py::arg("objects"))
+      .def("command", &Gripper::Command, py::arg("registers"))
+      .def("step", &Gripper::Step, py::arg("dt"))
+      .def("state", &Gripper::State);
   py::class_<Model>(m, "Model")
       .def(py::init<std::string, std::optional<std::string>>(), py::arg("path"),
            py::arg("config") = py::none())
@@ -912,5 +1011,6 @@ PYBIND11_MODULE(_hybrid, m) {
       .def("simulate", &Model::Simulate, py::arg("until") = py::none(),
            py::arg("inputs") = std::map<std::string, SignalValue>{}, py::arg("sample") = py::none(),
            py::arg("parameters") = std::map<std::string, double>{},
-           py::arg("init") = std::map<std::string, double>{});
+           py::arg("init") = std::map<std::string, double>{},
+           py::arg("tolerance") = py::none());
 }

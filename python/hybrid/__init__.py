@@ -30,8 +30,8 @@ from ._version import __version__
 ModelError = _hybrid.ModelError
 DataError = _hybrid.DataError
 
-__all__ = ["DataError", "ModelError", "Model", "diagnose", "finger", "finger_angles",
-           "finger_sweep", "hand", "hand_sweep", "load", "set_log_level"]
+__all__ = ["DataError", "Gripper", "ModelError", "Model", "diagnose", "finger", "finger_angles",
+           "finger_sweep", "hand", "hand_sweep", "joint_state", "load", "set_log_level"]
 
 
 def set_log_level(level):
@@ -99,7 +99,8 @@ class Model:
         """The mode graph in Graphviz DOT (``hybrid dot``); ``product=True`` draws the product."""
         return self._model.dot(product)
 
-    def simulate(self, until=None, inputs=None, sample=None, parameters=None, init=None):
+    def simulate(self, until=None, inputs=None, sample=None, parameters=None, init=None,
+                 tolerance=None):
         """Simulates from the initial state with exact event location (``hybrid simulate``).
 
         Args:
@@ -113,6 +114,8 @@ class Model:
             init: {continuous variable name: value}, the run's initial values (``A.x`` in a
                 composed system); ValueError for a name that is no continuous variable, a value
                 that is not finite or lies outside the variable's declared domain.
+            tolerance: the integrator's relative tolerance (its absolute one is a hundredth of
+                it); None: the defaults, 1e-10 and 1e-12 (docs/simulation.md).
 
         Returns:
             A dict: ``hybrid simulate --json``'s members (``status``, ``message``, ``until``,
@@ -124,7 +127,7 @@ class Model:
             mode at each instant, ``A.m|B.n`` for several components).
         """
         result = self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}),
-                                      dict(init or {}))
+                                      dict(init or {}), tolerance)
         result.update(_json.loads(result.pop("report_json")))
         return result
 
@@ -218,6 +221,67 @@ def hand(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c
     """
     report = _hybrid.hand_json(list(objects), mode, spread, float(g), g_a, g_b, g_c)
     return _json.loads(report)
+
+
+def joint_state(objects=(), mode="basic", spread=None, g=255.0, g_a=None, g_b=None, g_c=None):
+    """The hand of :func:`hand` (same arguments) at the end of its closing, as the joints of the
+    ROS description (ros-industrial/robotiq's robotiq_3f_gripper_visualization; the mapping and
+    its sources: docs/robot_frames.md), like a sensor_msgs/JointState.
+
+    Returns:
+        A dict: ``name`` (the 11 joints, in the ROS joint-state publisher's order), ``position``
+        (radians, within the description's limits), ``model_position`` (the model's values in
+        the same frame before clamping into the limits) and ``clamped`` (the joints where the two
+        differ). Raises as :func:`hand`.
+    """
+    report = _hybrid.hand_json(list(objects), mode, spread, float(g), g_a, g_b, g_c, True)
+    return _json.loads(report)["joint_state"]
+
+
+class Gripper:
+    """A stateful emulator of the gripper for a physics simulator's loop (docs/gripper_emulator.md):
+    write its registers (:meth:`command`), advance time (:meth:`step`), read joint states and
+    status registers back. It steps the composed automata of spec/gripper.ha (three fingers, the
+    scissor axis and their position controllers), compiled once; each step continues the run
+    from where the last one stopped.
+
+    Args:
+        model: a system like spec/gripper.ha; None: the bundled one.
+        objects: object descriptions in the palm's x-y plane (metres), as :func:`hand` takes
+            them; the fingers' contacts with them are those of :func:`hand`.
+
+    Starts reset (``gACT`` 0) and open, with the scissor axis at 0 (fingers B and C apart).
+    """
+
+    def __init__(self, model=None, objects=()):
+        self._gripper = _hybrid.Gripper(None if model is None else str(model), list(objects))
+
+    def command(self, registers=None, **more):
+        """Writes output registers by their manual names, e.g. ``command(rACT=1, rGTO=1,
+        rPRA=255)`` (or a dict); registers not named keep their values. They take effect from
+        the next step. Flags rACT, rGTO, rATR, rGLV, rICF, rICS are 0 or 1; rMOD is 0 basic,
+        1 pinch, 2 wide, 3 scissor; rPRx, rSPx, rFRx (x = A, B, C, S) are 0..255.
+
+        Raises:
+            ValueError: an unknown register or a value out of its range.
+        """
+        values = dict(registers or {})
+        values.update(more)
+        self._gripper.command({k: int(v) for k, v in values.items()})
+
+    def step(self, dt):
+        """Advances ``dt`` seconds (0 < dt <= 10) and returns the state reached: a dict with
+        ``time``, ``status`` (the input registers: gACT, gMOD, gGTO, gIMC, gSTA, gFLT and per
+        axis A, B, C, S: gDTx, gPRx, gPOx, gCUx), ``theta`` (3 x 3, the report's angles of fingers
+        A, B, C in degrees), ``motor`` (A, B, C), ``scissor``, ``spread_angle`` (degrees),
+        ``joint_state`` (the ROS description's joints, as :func:`joint_state`), ``simulation``
+        ("completed", or how the step's run ended) and ``message``."""
+        return self._gripper.step(float(dt))
+
+    @property
+    def state(self):
+        """The state after the last step (or at the start), as :meth:`step` returns it."""
+        return self._gripper.state()
 
 
 def finger(g=255.0, objects=(), gob1=None, gob2=None, gob3=None):

@@ -65,6 +65,15 @@ def hand(
     g_b: float | None = ...,
     g_c: float | None = ...,
 ) -> dict[str, Any]: ...
+def joint_state(
+    objects: Sequence[str] = ...,
+    mode: str = ...,
+    spread: float | None = ...,
+    g: float = ...,
+    g_a: float | None = ...,
+    g_b: float | None = ...,
+    g_c: float | None = ...,
+) -> dict[str, Any]: ...
 def finger(
     g: float = ...,
     objects: Sequence[str] = ...,
