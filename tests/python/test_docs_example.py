@@ -29,3 +29,15 @@ def test_worked_example_runs(tmp_path, monkeypatch, capsys):
         assert (tmp_path / "python_example.png").stat().st_size > 0
     except ImportError:
         pass
+
+
+def test_gripper_example_runs(capsys):
+    with open(os.path.join(SOURCE, "docs", "python.md")) as f:
+        text = f.read()
+    section = text[text.index("## The gripper where a robot program uses it"):]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    exec(compile(code, "docs/python.md", "exec"), {"__name__": "example"})
+    out = capsys.readouterr().out
+    assert "clamped: ['finger_1_joint_3', 'finger_2_joint_3', 'finger_middle_joint_3']" in out
+    assert "gSTA 2 finger A at [21.4039  0.     43.    ]" in out
+    assert "held:" in out
