@@ -13,7 +13,7 @@ struct Segment2 {
   Eigen::Vector2d b = Eigen::Vector2d::Zero();
 };
 
-/// Link lengths of the planar finger (metres), from `../shared/robotiq/kinematics.md`: proximal
+/// Link lengths of the planar finger (metres), from docs/gripper_facts.md: proximal
 /// (joint 1 to joint 2), medial (joint 2 to joint 3) and distal (joint 3 to the fingertip).
 struct FingerLengths {
   double proximal = 0.05715;

@@ -8,7 +8,7 @@ namespace hybrid::gripper {
 
 /// The constants of one Robotiq finger shared by the closed form, the geometry and the generated
 /// automaton (`spec/finger.ha`): joint ranges in degrees (Klamp't limits, see
-/// `../shared/robotiq/kinematics.md`), the motor range in counts, and the report's transmission
+/// docs/gripper_facts.md), the motor range in counts, and the report's transmission
 /// rates m1 = theta1_max / 140 and m2 = theta2_max / 100 (degrees per count).
 struct FingerParameters {
   Eigen::Vector3d theta_min{0.0, 0.0, -55.0};

@@ -22,6 +22,10 @@ namespace hybrid::gripper {
 /// The search samples the path every kResolution counts (in phase 3, whose theta3 rate grows
 /// without bound towards g = 255, every 0.025 degrees of theta3), so no point of the finger
 /// moves more than 0.105 mm between samples, and it bisects each sign change to 1e-10 counts.
+/// Samples that a motion bound proves clear are skipped (no link can have moved as far as its
+/// clearance at the last sample evaluated: FingerClosedForm::VariationBound and
+/// FingerGeometry::LinkMotionBounds), so the search finds the same first sign change as on every
+/// sample, in a few dozen evaluations where the finger is far from everything.
 /// Objects are at least 0.2 mm across (Obstacle::kMinimumRadius), so a link cannot cross one
 /// between samples; a contact is missed only if a link dips into an object by less than its
 /// motion between two samples and leaves again (a graze). Contacts with the palm at or after

@@ -23,13 +23,13 @@ SpreadMode SpreadModeByName(const std::string& name);
 /// (-half_span, 0, 0) and closes towards +x; B and C at (half_span, 0, +-lateral) close towards
 /// -x, their planes turned by the spread angle phi about the y axis towards the centre plane
 /// (phi > 0) or away from it. phi = phi_min + (phi_max - phi_min) s / 255, with the spread
-/// presets of spec/hand.ha. The palm dimensions are not in ../shared/robotiq/kinematics.md:
+/// presets of spec/hand.ha. The palm dimensions are not in docs/gripper_facts.md:
 /// they are assumptions of this model (decision H1 of docs/finger_model.md).
 struct HandLayout {
   double half_span = 0.045;
   double lateral = 0.036;
   /// Links are `link_width` wide across their plane: two fingers touch when their link centre
-  /// lines come within link_width of each other (kinematics.md: about 0.03).
+  /// lines come within link_width of each other (docs/gripper_facts.md: about 0.03).
   double link_width = 0.03;
   double phi_min = -17.0;
   double phi_max = 17.0;
@@ -51,7 +51,8 @@ struct HandLayout {
 /// their distance reaches HandLayout::link_width. The motor positions are swept together (all
 /// fingers at g while g is below their command); at the first touch both links are blocked
 /// (GeometricFinger `imposed` contacts) and the sweep continues. Touches are found by sampling
-/// every GeometricFinger::kResolution counts and bisection, like object contacts.
+/// every GeometricFinger::kResolution counts and bisection, like object contacts (skipping the
+/// samples a motion bound proves apart, per pair of links, as GeometricFinger does).
 class Hand {
  public:
   struct FingerTouch {
