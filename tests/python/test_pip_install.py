@@ -9,8 +9,8 @@ Which build pip does: by default setup.py builds the module in this build tree
 (HYBRID_CMAKE_BUILD_DIR = HYBRID_BUILD_DIR, which ctest sets): after the suite's build the module
 is up to date there, so the install takes seconds and checks everything but the configuration of
 a tree of its own. With HYBRID_TEST_PIP_FRESH=1, pip configures and builds a tree of its own from
-nothing, as a user's `pip install .` does (tens of minutes on two cores: ctest's timeout of this
-test is an hour).
+nothing, as a user's `pip install .` does (about 5 minutes on two cores: ctest's timeout of this
+test is half an hour).
 
 Run by ctest as `pip_install`, apart from the rest of tests/python (tests/CMakeLists.txt).
 """
