@@ -1,9 +1,12 @@
 #include "hybrid/automaton/dot_writer.h"
 
+#include <algorithm>
 #include <map>
+#include <set>
 #include <span>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hybrid/automaton/printer.h"
@@ -23,6 +26,46 @@ std::string Escape(const std::string& text) {
     out.push_back(c);
   }
   return out;
+}
+
+// `line` broken at spaces into pieces of at most `width` characters, the continuations indented
+// by four spaces and joined by newlines; a word longer than the room stays whole.
+std::string WrapLine(std::string_view line, size_t width) {
+  constexpr std::string_view kIndent = "    ";
+  std::string out;
+  for (size_t room = width;; room = width > kIndent.size() ? width - kIndent.size() : 1) {
+    if (line.size() <= room) return out + std::string(line);
+    size_t cut = line.rfind(' ', room);
+    if (cut == std::string_view::npos || cut == 0) cut = line.find(' ', room);
+    if (cut == std::string_view::npos) return out + std::string(line);
+    out += std::string(line.substr(0, cut)) + "\n" + std::string(kIndent);
+    line.remove_prefix(cut + 1);
+  }
+}
+
+// `text` (lines ended by newlines) with every line but the first (a name, kept whole) longer
+// than `width` characters wrapped (WrapLine); unchanged for a width of 0 or less.
+std::string Wrapped(const std::string& text, int width) {
+  if (width <= 0) return text;
+  size_t start = text.find('\n');
+  if (start == std::string::npos) return text;
+  std::string out = text.substr(0, ++start);
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    out += WrapLine(std::string_view(text).substr(start, end - start), static_cast<size_t>(width));
+    if (end < text.size()) out += "\n";
+    start = end + 1;
+  }
+  return out;
+}
+
+// The DOT attributes of a node or edge whose full label is `full` and whose drawn label is
+// `compact` in compact drawings: the label, and in compact drawings the full one as tooltip.
+std::string LabelAttributes(const std::string& full, const std::string& compact,
+                            const DotOptions& options) {
+  if (!options.compact) return "label=\"" + Escape(Wrapped(full, options.wrap_width)) + "\"";
+  return "label=\"" + Escape(compact) + "\", tooltip=\"" + Escape(full) + "\"";
 }
 
 // The mode's name (`name`) with its discrete values: "name (c1=0, l3=-1)".
@@ -70,13 +113,16 @@ std::string InitLabel(const Automaton& a, const InitialState& s) {
   return text;
 }
 
-// The modes of `a`, one node each, in clusters by options.group (when set).
+// The modes of `a`, one node each, in clusters by options.group (when set) applied to the modes
+// of `grouped` (`a` itself, or the renamed automaton of the first of the instances drawn from
+// `a`, their declaration: the same modes, so `--group-by A.c1` still finds A's variable).
 // `names`: the modes' names to show, by id (empty: their own names).
-void WriteModes(const Automaton& a, std::span<const std::string> names, const std::string& prefix,
-                const std::string& indent, const DotOptions& options, std::ostream& out) {
+void WriteModes(const Automaton& a, const Automaton& grouped, std::span<const std::string> names,
+                const std::string& prefix, const std::string& indent, const DotOptions& options,
+                std::ostream& out) {
   std::map<std::string, std::vector<int>> groups;  // by name: one cluster each, sorted
   for (int m = 0; m < a.num_modes(); ++m) {
-    groups[options.group ? options.group(a, a.modes()[m]) : ""].push_back(m);
+    groups[options.group ? options.group(grouped, grouped.modes()[m]) : ""].push_back(m);
   }
   int cluster = 0;
   for (const auto& [name, modes] : groups) {
@@ -89,9 +135,8 @@ void WriteModes(const Automaton& a, std::span<const std::string> names, const st
     for (const int m : modes) {
       const Mode& mode = a.modes()[m];
       const std::string& shown = names.empty() ? mode.name : names[m];
-      const std::string label = options.compact ? shown : ModeLabel(a, mode, shown);
-      out << inner << prefix << "m" << m << " [shape=box, style=rounded, label=\"" << Escape(label)
-          << "\"];\n";
+      out << inner << prefix << "m" << m << " [shape=box, style=rounded, "
+          << LabelAttributes(ModeLabel(a, mode, shown), shown, options) << "];\n";
     }
     if (!name.empty()) out << indent << "}\n";
   }
@@ -106,53 +151,140 @@ std::string QualifiedModeName(const System& system, std::span<const int> tuple) 
   return out;
 }
 
-void WriteAutomaton(const Automaton& a, std::span<const std::string> names,
-                    const std::string& prefix, const std::string& indent, const DotOptions& options,
-                    std::ostream& out) {
-  WriteModes(a, names, prefix, indent, options, out);
+// `a`'s modes (grouped as those of `grouped`: WriteModes), initial states and transitions.
+void WriteAutomaton(const Automaton& a, const Automaton& grouped,
+                    std::span<const std::string> names, const std::string& prefix,
+                    const std::string& indent, const DotOptions& options, std::ostream& out) {
+  WriteModes(a, grouped, names, prefix, indent, options, out);
   for (size_t i = 0; i < a.initial_states().size(); ++i) {
     const InitialState& s = a.initial_states()[i];
     out << indent << prefix << "init" << i << " [shape=point, width=0.12];\n";
-    out << indent << prefix << "init" << i << " -> " << prefix << "m" << s.mode.value()
-        << " [label=\"" << (options.compact ? "" : Escape(InitLabel(a, s))) << "\"];\n";
+    out << indent << prefix << "init" << i << " -> " << prefix << "m" << s.mode.value() << " ["
+        << LabelAttributes(InitLabel(a, s), "", options) << "];\n";
   }
   for (const Transition& t : a.transitions()) {
-    const std::string label = options.compact ? t.label : TransitionLabel(a, t);
     out << indent << prefix << "m" << t.source.value() << " -> " << prefix << "m"
-        << t.target.value() << " [label=\"" << Escape(label) << "\"";
+        << t.target.value() << " [" << LabelAttributes(TransitionLabel(a, t), t.label, options);
     if (t.urgency == Urgency::kLazy) out << ", style=dashed";
     out << "];\n";
   }
+}
+
+// The components drawn in one cluster each: with `merge`, the instances of one automaton
+// declared alike (equal Component::source, non-empty instance names) together, in the order of
+// their first member; otherwise each alone.
+std::vector<std::vector<int>> ClusterMembers(std::span<const Component> components, bool merge) {
+  std::vector<std::vector<int>> clusters;
+  for (int c = 0; c < static_cast<int>(components.size()); ++c) {
+    const Component& comp = components[static_cast<size_t>(c)];
+    const auto alike = [&](const std::vector<int>& cluster) {
+      const Component& first = components[static_cast<size_t>(cluster.front())];
+      return !first.instance.empty() && first.source == comp.source;
+    };
+    const auto it = merge && !comp.instance.empty()
+                        ? std::find_if(clusters.begin(), clusters.end(), alike)
+                        : clusters.end();
+    if (it == clusters.end()) {
+      clusters.push_back({c});
+    } else {
+      it->push_back(c);
+    }
+  }
+  return clusters;
+}
+
+// The names of `comp`'s automaton as declared (symbols and transition labels) that do not stand
+// for INSTANCE.NAME in the system: shared and bound ones, with the System names they stand for.
+std::map<std::string, std::string> NamesNotQualified(const Component& comp) {
+  std::map<std::string, std::string> out;
+  const auto note = [&](const std::string& declared, const std::string& in_system) {
+    if (!declared.empty() && in_system != comp.instance + "." + declared) {
+      out[declared] = in_system;
+    }
+  };
+  // Renaming keeps slots and transitions in order (System::AddComponent).
+  for (int s = 0; s < comp.source.symbols().size(); ++s) {
+    note(comp.source.symbols()[s].name, comp.automaton.symbols()[s].name);
+  }
+  for (size_t t = 0; t < comp.source.transitions().size(); ++t) {
+    note(comp.source.transitions()[t].label, comp.automaton.transitions()[t].label);
+  }
+  return out;
+}
+
+// The label of the one cluster of the instances `members` (two or more) of one automaton: the
+// instances and the automaton, how its names are read in each instance, the names every
+// instance shares and, per instance, those bound to other names.
+std::string MergedClusterLabel(std::span<const Component> components,
+                               const std::vector<int>& members) {
+  std::string instances, qualified;
+  std::vector<std::map<std::string, std::string>> others;
+  for (const int m : members) {
+    const Component& comp = components[static_cast<size_t>(m)];
+    instances += (instances.empty() ? "" : ", ") + comp.instance;
+    qualified += (qualified.empty() ? "" : ", ") + comp.instance + ".x";
+    others.push_back(NamesNotQualified(comp));
+  }
+  const Component& first = components[static_cast<size_t>(members.front())];
+  std::string text =
+      instances + ": " + first.source.name() + "\n" + "x stands for " + qualified + "\n";
+  std::string shared;
+  std::set<std::string> shared_names;
+  for (const auto& [name, in_system] : others.front()) {
+    const auto kept = [&](const auto& o) { return o.count(name) > 0 && o.at(name) == name; };
+    if (in_system == name && std::all_of(others.begin(), others.end(), kept)) {
+      shared += (shared.empty() ? "" : ", ") + name;
+      shared_names.insert(name);
+    }
+  }
+  if (!shared.empty()) text += "shared: " + shared + "\n";
+  for (size_t k = 0; k < members.size(); ++k) {
+    std::string bound;
+    for (const auto& [name, in_system] : others[k]) {
+      if (shared_names.count(name) == 0) {
+        bound += (bound.empty() ? "" : ", ") + name + " = " + in_system;
+      }
+    }
+    if (!bound.empty()) {
+      text += components[static_cast<size_t>(members[k])].instance + ": " + bound + "\n";
+    }
+  }
+  return text;
 }
 
 }  // namespace
 
 std::string WriteDot(const System& system, const DotOptions& options) {
   std::ostringstream out;
+  const auto components = system.components();
+  // The newer ranking keeps a large graph's ranks compact, and clusters inside clusters
+  // (components, then groups) need it; it spreads the groups of one automaton, though.
+  const bool newrank = !options.group || (!options.product && components.size() > 1);
   out << "digraph \"" << Escape(system.name()) << "\" {\n"
       << "  rankdir=LR;\n"
-      // Clusters inside clusters (components, then groups) need the newer ranking.
-      << (options.group && !options.product && system.components().size() > 1 ? "  newrank=true;\n"
-                                                                              : "")
-      << "  node [fontname=\"Helvetica\", fontsize=10];\n"
+      << (newrank ? "  newrank=true;\n" : "") << "  node [fontname=\"Helvetica\", fontsize=10];\n"
       << "  edge [fontname=\"Helvetica\", fontsize=9];\n";
-  const auto components = system.components();
   if (options.product) {
     // Product modes shown as the simulator and the verifier name them: "P1.idle|P2.req".
     std::vector<std::vector<int>> tuples;
     const Automaton a = system.Product(options.max_product_modes, &tuples);
     std::vector<std::string> names;
     for (const std::vector<int>& tuple : tuples) names.push_back(QualifiedModeName(system, tuple));
-    WriteAutomaton(a, names, "", "  ", options, out);
+    WriteAutomaton(a, a, names, "", "  ", options, out);
   } else if (components.size() == 1) {
-    WriteAutomaton(components[0].automaton, {}, "", "  ", options, out);
+    WriteAutomaton(components[0].automaton, components[0].automaton, {}, "", "  ", options, out);
   } else {
-    for (size_t c = 0; c < components.size(); ++c) {
-      const Component& comp = components[c];
-      out << "  subgraph cluster_" << c << " {\n    label=\""
-          << Escape((comp.instance.empty() ? "" : comp.instance + ": ") + comp.automaton.name())
-          << "\";\n";
-      WriteAutomaton(comp.automaton, {}, "c" + std::to_string(c) + "_", "    ", options, out);
+    for (const std::vector<int>& members : ClusterMembers(components, options.merge_instances)) {
+      const int c = members.front();
+      const Component& comp = components[static_cast<size_t>(c)];
+      const bool merged = members.size() > 1;
+      const std::string label =
+          merged
+              ? Escape(Wrapped(MergedClusterLabel(components, members), options.wrap_width))
+              : Escape((comp.instance.empty() ? "" : comp.instance + ": ") + comp.automaton.name());
+      out << "  subgraph cluster_" << c << " {\n    label=\"" << label << "\";\n";
+      WriteAutomaton(merged ? comp.source : comp.automaton, comp.automaton, {},
+                     "c" + std::to_string(c) + "_", "    ", options, out);
       out << "  }\n";
     }
   }

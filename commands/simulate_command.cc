@@ -364,7 +364,13 @@ ExitCode RunSimulate(const SimulateArgs& args) {
         }
       }
     }
-    files.emplace_back(args.plot, TrajectoryPlotSvg(sim, result, drawn, system.name()));
+    // Without samples between events the plot draws a run of its own that records some, so that
+    // its curves follow the model; the other outputs keep the run they describe.
+    const SimulationOptions plotted = PlotOptions(options, until);
+    const SimulationResult dense =
+        plotted.sample_step == options.sample_step ? SimulationResult{} : sim.Run(plotted, signals);
+    files.emplace_back(args.plot, TrajectoryPlotSvg(sim, dense.samples.empty() ? result : dense,
+                                                    drawn, system.name()));
   }
   WriteOutputs(files);
   WriteOutput("-", args.json ? SimulationReport(sim, result, until).dump(2) + "\n"

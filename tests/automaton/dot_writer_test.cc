@@ -1,5 +1,7 @@
 // Tests of WriteDot: labels, escaping, styles, clusters and product drawings, and that Graphviz
-// accepts the output (`dot -Tsvg`).
+// accepts the output (`dot -Tsvg`); long label lines wrapped, compact labels with the full ones
+// as tooltips, the instances of one automaton drawn once (the hand: 35 modes drawn instead of
+// 97), the product drawn over its reachable modes only (counted here by hand).
 
 #include "hybrid/automaton/dot_writer.h"
 
@@ -11,6 +13,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "hybrid/automaton/parser.h"
 
@@ -25,6 +28,33 @@ size_t Count(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1)) ++n;
   return n;
+}
+
+// The values of every attribute `name` of `dot`, in order (escapes kept).
+std::vector<std::string> Values(const std::string& dot, const std::string& name) {
+  const std::string key = name + "=\"";
+  std::vector<std::string> out;
+  for (size_t at = dot.find(key); at != std::string::npos; at = dot.find(key, at + 1)) {
+    if (at == 0 || (dot[at - 1] != ' ' && dot[at - 1] != '[')) continue;
+    size_t end = at + key.size();
+    while (end < dot.size() && !(dot[end] == '"' && dot[end - 1] != '\\')) ++end;
+    out.push_back(dot.substr(at + key.size(), end - at - key.size()));
+  }
+  return out;
+}
+
+std::vector<std::string> Labels(const std::string& dot) { return Values(dot, "label"); }
+
+// Splits a DOT label into its "\l"-ended lines.
+std::vector<std::string> Lines(const std::string& label) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  for (size_t at = label.find("\\l"); at != std::string::npos; at = label.find("\\l", start)) {
+    out.push_back(label.substr(start, at - start));
+    start = at + 2;
+  }
+  if (start < label.size()) out.push_back(label.substr(start));
+  return out;
 }
 
 // Renders `dot_text` with Graphviz to SVG; returns the SVG, or "" (and a failure) if `dot` fails.
@@ -241,12 +271,149 @@ TEST(DotWriter, CompactLabelsAndGroupsClusterTheModes) {
   EXPECT_EQ(Count(dot, "subgraph cluster_"), 4u) << dot;  // two components, two groups
   EXPECT_NE(dot.find("label=\"lit\"; style=rounded"), std::string::npos) << dot;
   EXPECT_NE(dot.find("newrank=true;"), std::string::npos);
-  EXPECT_EQ(dot.find("guard"), std::string::npos) << "no guards in compact labels";
-  EXPECT_EQ(dot.find("L.b'"), std::string::npos) << "no flows in compact labels";
-  EXPECT_NE(dot.find("c0_m0 -> c0_m1 [label=\"push\"];"), std::string::npos) << dot;
+  for (const std::string& label : Labels(dot)) {
+    EXPECT_EQ(label.find("guard"), std::string::npos) << "no guards in compact labels";
+    EXPECT_EQ(label.find("L.b'"), std::string::npos) << "no flows in compact labels";
+  }
+  // The full labels stay as tooltips.
+  EXPECT_NE(dot.find("c0_m0 -> c0_m1 [label=\"push\", tooltip=\"closed_to_open [push]\\l"
+                     "guard D.t >= 2\\lD.t := 0\\l\"];"),
+            std::string::npos)
+      << dot;
+  EXPECT_NE(dot.find("c1_m0 [shape=box, style=rounded, label=\"dark\", tooltip=\"dark (L.on=0)\\l"
+                     "L.b' = 0\\l\"];"),
+            std::string::npos)
+      << dot;
   const std::string svg = RenderSvg(dot);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   EXPECT_NE(svg.find(">lit<"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+TEST(DotWriter, LongLinesWrapAtSpacesAndReadBackWhole) {
+  const System finger = Finger();
+  const std::string wrapped = WriteDot(finger);
+  DotOptions whole;
+  whole.wrap_width = 0;
+  const std::string unwrapped = WriteDot(finger, whole);
+  const std::vector<std::string> a = Labels(wrapped), b = Labels(unwrapped);
+  ASSERT_EQ(a.size(), b.size());
+  size_t broken = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    const std::vector<std::string> lines = Lines(a[k]);
+    ASSERT_FALSE(lines.empty());
+    EXPECT_EQ(lines.front(), Lines(b[k]).front()) << "the name line stays whole";
+    std::string joined = lines.front();
+    for (size_t i = 1; i < lines.size(); ++i) {
+      const std::string& line = lines[i];
+      // At most 40 characters, unless one word (after a continuation's indent) is longer.
+      const std::string words = line.starts_with("    ") ? line.substr(4) : line;
+      if (line.size() > 40) EXPECT_EQ(words.find(' '), std::string::npos) << line;
+      if (line.starts_with("    ")) {
+        joined += " " + words;
+        ++broken;
+      } else {
+        joined += "\\l" + line;
+      }
+    }
+    EXPECT_EQ(joined + (a[k].ends_with("\\l") ? "\\l" : ""), b[k]);
+  }
+  // Six modes' third-link flow (91 characters) in three lines each, at least.
+  EXPECT_GE(broken, 12u);
+  EXPECT_NE(RenderSvg(wrapped).find("</svg>"), std::string::npos);
+}
+
+TEST(DotWriter, CompactLabelsKeepTheFullOnesAsTooltips) {
+  const System finger = Finger();
+  DotOptions compact;
+  compact.compact = true;
+  const std::string dot = WriteDot(finger, compact);
+  DotOptions whole;
+  whole.wrap_width = 0;
+  const std::vector<std::string> full = Labels(WriteDot(finger, whole));
+  const std::vector<std::string> tooltips = Values(dot, "tooltip");
+  EXPECT_EQ(tooltips, full);
+  EXPECT_EQ(tooltips.size(), 31u + 1u + 106u);  // modes, the initial edge, transitions
+  const std::string svg = RenderSvg(dot);
+  EXPECT_NE(svg.find("xlink:title=\"c000_l000 (c1=0"), std::string::npos);
+}
+
+System Hand() { return ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/hand.ha"); }
+
+// The hand: three instances A, B, C of the finger declared alike (31 modes each, counted on the
+// finger's own file) and the spread (4 modes, counted on its component).
+TEST(DotWriter, InstancesDeclaredAlikeAreDrawnOnce) {
+  const System hand = Hand();
+  const int finger_modes = Finger().components()[0].automaton.num_modes();
+  ASSERT_EQ(hand.components().size(), 4u);
+  const int spread_modes = hand.components()[3].automaton.num_modes();
+  EXPECT_EQ(finger_modes, 31);
+  EXPECT_EQ(spread_modes, 4);
+  const std::string merged = WriteDot(hand);
+  EXPECT_EQ(Count(merged, "[shape=box"), static_cast<size_t>(finger_modes + spread_modes));
+  EXPECT_EQ(Count(merged, "subgraph cluster_"), 2u);
+  EXPECT_NE(merged.find("label=\"A, B, C: finger\\lx stands for A.x, B.x, C.x\\lshared: u\\l\""),
+            std::string::npos)
+      << merged.substr(0, 400);
+  // Drawn as declared: the finger's own names, not A's.
+  EXPECT_NE(merged.find("theta1' = m1 * u"), std::string::npos);
+  EXPECT_EQ(merged.find("A.theta1"), std::string::npos);
+  EXPECT_NE(merged.find("label=\"S: spread\""), std::string::npos);
+  DotOptions every;
+  every.merge_instances = false;
+  const std::string separate = WriteDot(hand, every);
+  EXPECT_EQ(Count(separate, "[shape=box"), static_cast<size_t>(3 * finger_modes + spread_modes));
+  EXPECT_EQ(Count(separate, "subgraph cluster_"), 4u);
+  // An instance declared otherwise (another initial value) keeps a cluster of its own.
+  System changed = Hand();
+  changed.SetInitialValue("A.theta1", 5);
+  const std::string two = WriteDot(changed);
+  EXPECT_EQ(Count(two, "[shape=box"), static_cast<size_t>(2 * finger_modes + spread_modes));
+  EXPECT_NE(two.find("label=\"A: finger\""), std::string::npos);
+  EXPECT_NE(two.find("label=\"B, C: finger\\lx stands for B.x, C.x\\lshared: u\\l\""),
+            std::string::npos);
+  EXPECT_NE(RenderSvg(merged).find("</svg>"), std::string::npos);
+  // A grouping by one instance's variable still applies to the one drawing of all three.
+  DotOptions by_a;
+  by_a.group = [](const Automaton& a, const Mode& m) -> std::string {
+    for (const auto& [slot, value] : m.discrete_values) {
+      if (a.symbols()[slot].name == "A.c1") return "A.c1=" + std::to_string(value);
+    }
+    return "";
+  };
+  const std::string grouped = WriteDot(hand, by_a);
+  EXPECT_EQ(Count(grouped, "label=\"A.c1=0\"; style=rounded"), 1u) << grouped.substr(0, 600);
+  EXPECT_EQ(Count(grouped, "label=\"A.c1=1\"; style=rounded"), 1u);
+}
+
+TEST(DotWriter, MergedInstancesListTheirBoundNames) {
+  const System hand = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/controlled_hand.ha");
+  const std::string dot = WriteDot(hand);
+  EXPECT_NE(dot.find("label=\"ctlA, ctlB, ctlC: controller\\lx stands for ctlA.x, ctlB.x, "
+                     "ctlC.x\\lshared: request\\lctlA: g = A.g, stall = A.stall, u = A.u\\l"
+                     "ctlB: g = B.g, stall = B.stall, u = B.u\\lctlC: g = C.g, stall = C.stall, "
+                     "u = C.u\\l\""),
+            std::string::npos)
+      << dot.substr(0, 2000);
+  EXPECT_EQ(Count(dot, "subgraph cluster_"), 3u);  // fingers, controllers, spread
+}
+
+// The house's product: 2 x 2 mode pairs, of which (closed, dark) reaches (open, lit) by `push`
+// together, then (closed, lit) by the door's unlabelled transition; (open, dark) is never
+// reached, since the door opens only by `push`, which the light takes with it from dark to lit.
+TEST(DotWriter, ProductDrawsItsReachableModesOnly) {
+  const System s = ParseModel(kTwoComponents, "house.ha");
+  const std::string dot = WriteDot(s, {.product = true});
+  EXPECT_EQ(Count(dot, "[shape=box"), 3u);
+  EXPECT_NE(dot.find("label=\"D.closed|L.dark (L.on=0)"), std::string::npos);
+  EXPECT_NE(dot.find("label=\"D.open|L.lit (L.on=1)"), std::string::npos);
+  EXPECT_NE(dot.find("label=\"D.closed|L.lit (L.on=1)"), std::string::npos);
+  EXPECT_EQ(dot.find("D.open|L.dark"), std::string::npos);
 }
 
 }  // namespace

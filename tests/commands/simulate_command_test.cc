@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "commands/trajectory_plot.h"
 #include "tests/test_utilities/command_line.h"
 #include "tests/test_utilities/in_process.h"
 #include "tests/test_utilities/models.h"
@@ -183,6 +184,37 @@ TEST(HybridSimulate, TraceCsvHasEveryEventAndSample) {
   EXPECT_EQ(log[1][5], "on");
   EXPECT_NEAR(std::stod(log[1][6]), 18.0, 1e-9);
   EXPECT_EQ(std::stod(log[1][0]), Field(j, "events", 0, "time").get<double>());
+}
+
+// --plot without --sample draws the ball from states between its bounces (the plot's own run),
+// while the trace, the event log and the JSON summary stay those of the run without samples:
+// byte for byte what the same command writes without --plot, and no "sample" rows.
+TEST(HybridSimulate, PlotWithoutSampleIsDenseAndLeavesTheOtherOutputs) {
+  TempDir dir;
+  cli::SimulateArgs plain;
+  plain.model = Spec("bouncing_ball");
+  plain.out = dir.File("plain.csv");
+  plain.events = dir.File("plain_events.csv");
+  plain.json = true;
+  cli::SimulateArgs plotted = plain;
+  plotted.out = dir.File("plotted.csv");
+  plotted.events = dir.File("plotted_events.csv");
+  plotted.plot = dir.File("ball.svg");
+  const InProcess a = SimulateHere(plain), b = SimulateHere(plotted);
+  ASSERT_EQ(a.exit_code, 0);
+  ASSERT_EQ(b.exit_code, 0);
+  EXPECT_EQ(a.out, b.out);
+  EXPECT_EQ(ReadAll(plain.out), ReadAll(plotted.out));
+  EXPECT_EQ(ReadAll(plain.events), ReadAll(plotted.events));
+  EXPECT_EQ(ReadAll(plotted.out).find(",sample,"), std::string::npos);
+  // 34 bounces: the trace has the start, both sides of each and the end; the plot's height curve
+  // more than kPlotSamples points.
+  EXPECT_EQ(ReadCsv(plotted.out).size(), 1u + 2u + 2u * 34u);
+  const std::string svg = ReadAll(plotted.plot);
+  const auto points = svg.find("points=\"");
+  ASSERT_NE(points, std::string::npos);
+  const std::string first = svg.substr(points, svg.find('"', points + 8) - points);
+  EXPECT_GT(std::count(first.begin(), first.end(), ','), cli::kPlotSamples);
 }
 
 // --set overrides a parameter: an object blocking link 1 at g = 80 (the finger's gob1) gives the
