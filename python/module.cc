@@ -36,6 +36,8 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <span>
@@ -61,7 +63,6 @@
 #include "commands/simulate_command.h"
 #include "gripper/commands/diagnose_command.h"
 #include "gripper/commands/grasp_sweep.h"
-#include "hybrid/gripper/gripper_emulator.h"
 #include "gripper/commands/gripper_command.h"
 #include "hybrid/automaton/dot_writer.h"
 #include "hybrid/automaton/log.h"
@@ -69,6 +70,7 @@
 #include "hybrid/flowpipe/flowpipe_reachability.h"
 #include "hybrid/gripper/finger_closed_form.h"
 #include "hybrid/gripper/finger_parameters.h"
+#include "hybrid/gripper/gripper_emulator.h"
 #include "hybrid/gripper/measured_data.h"
 #include "hybrid/model_diagnosis/trace_data.h"
 #include "hybrid/simulation/simulator.h"
@@ -602,9 +604,20 @@ class Model {
  private:
   std::vector<InputSignal> Signals(const std::map<std::string, SignalValue>& inputs) const;
 
+  // The simulator of system_, compiled on the first run and kept (Simulator::Run is const and
+  // reentrant: each run has its own state).
+  const Simulator& CachedSimulator() const;
+
   std::string path_;
   System system_;
+  mutable std::once_flag simulator_once_;
+  mutable std::unique_ptr<Simulator> simulator_;
 };
+
+const Simulator& Model::CachedSimulator() const {
+  std::call_once(simulator_once_, [&] { simulator_ = std::make_unique<Simulator>(system_); });
+  return *simulator_;
+}
 
 std::vector<InputSignal> Model::Signals(const std::map<std::string, SignalValue>& inputs) const {
   std::vector<InputSignal> signals;
@@ -624,10 +637,7 @@ std::vector<InputSignal> Model::Signals(const std::map<std::string, SignalValue>
 // samples n, their times, the number of variables and each one's name and n values, the mode
 // labels (a table of the distinct ones, then one index per sample), the status, the message and
 // the command's JSON report (for `horizon`).
-std::string EncodedRun(const System& system, const SimulationOptions& options,
-                       const std::vector<InputSignal>& signals, double horizon) {
-  const Simulator sim(system);
-  const SimulationResult r = sim.Run(options, signals);
+std::string EncodedRun(const Simulator& sim, const SimulationResult& r, double horizon) {
   const std::size_t n = r.samples.size();
   Encoder e;
   e.Number(n);
@@ -681,7 +691,8 @@ py::dict RunDict(std::string_view encoded) {
   out["time"] = time;
   out["states"] = states;
   out["modes"] = modes;
-  // final, events, steps, until (and zeno): the command's JSON, parsed by the package.
+  // final, events, steps, until (and zeno): the command's JSON, parsed by the package (Python's
+  // json module is faster at it than building the objects one by one from C++).
   out["report_json"] = d.Text();
   return out;
 }
@@ -692,9 +703,6 @@ py::dict Model::Simulate(std::optional<double> until,
                          const std::map<std::string, double>& parameters,
                          const std::map<std::string, double>& init,
                          std::optional<double> tolerance) const {
-  // The run's initial values, in a copy of the model (commands/initial_values.h).
-  System system = system_;
-  cli::SetInitialValues({init.begin(), init.end()}, system);
   SimulationOptions options;
   options.until = until;
   if (sample) options.sample_step = *sample;
@@ -705,7 +713,32 @@ py::dict Model::Simulate(std::optional<double> until,
   for (const auto& [name, value] : parameters) options.parameters.emplace_back(name, value);
   const std::vector<InputSignal> signals = Signals(inputs);
   const double horizon = until ? *until : system_.scenario() ? system_.scenario()->until : 0.0;
-  return RunDict(RunStoppable([&] { return EncodedRun(system, options, signals, horizon); }));
+  // The kept simulator, or, with initial values, one of a copy of the model that has them
+  // (commands/initial_values.h).
+  std::optional<System> with_init;
+  std::optional<Simulator> own;
+  if (!init.empty()) {
+    with_init.emplace(system_);
+    cli::SetInitialValues({init.begin(), init.end()}, *with_init);
+    own.emplace(*with_init);
+  }
+  const Simulator& sim = own ? *own : CachedSimulator();
+  // First here, without the GIL, for at most kQuickPasses passes of the integration loop: a short
+  // run (most are) costs no process. A run that needs more is run again from the start where
+  // Ctrl-C can stop it (RunStoppable), so that no long computation ignores Ctrl-C.
+  constexpr long kQuickPasses = 20000;
+  SimulationOptions quick = options;
+  quick.max_steps = std::min(options.max_steps, kQuickPasses);
+  std::optional<SimulationResult> result;
+  {
+    py::gil_scoped_release release;
+    result = sim.Run(quick, signals);
+  }
+  if (result->status == SimulationStatus::kStepLimit && options.max_steps > kQuickPasses) {
+    return RunDict(
+        RunStoppable([&] { return EncodedRun(sim, sim.Run(options, signals), horizon); }));
+  }
+  return RunDict(EncodedRun(sim, *result, horizon));
 }
 
 // `hybrid hand --json` (without --simulate): the report as JSON text.
@@ -813,17 +846,16 @@ std::string FingerJsonText(double g, std::optional<double> gob1, std::optional<d
 class Gripper {
  public:
   Gripper(const std::optional<std::string>& model, const std::vector<std::string>& objects)
-      : emulator_(spaceex::ReadModelFile(model ? *model
-                                               : cli::BundledFile("spec/gripper.ha").string()),
-                  cli::ParseObjectList(objects)) {}
+      : emulator_(
+            spaceex::ReadModelFile(model ? *model : cli::BundledFile("spec/gripper.ha").string()),
+            cli::ParseObjectList(objects)) {}
 
   // Writes the registers named in `values` (the others keep their values).
   void Command(const std::map<std::string, int>& values) {
     gripper::GripperRegisters r = emulator_.registers();
-    const std::map<std::string, int*> flags = {{"rACT", &r.rACT}, {"rMOD", &r.rMOD},
-                                               {"rGTO", &r.rGTO}, {"rATR", &r.rATR},
-                                               {"rGLV", &r.rGLV}, {"rICF", &r.rICF},
-                                               {"rICS", &r.rICS}};
+    const std::map<std::string, int*> flags = {
+        {"rACT", &r.rACT}, {"rMOD", &r.rMOD}, {"rGTO", &r.rGTO}, {"rATR", &r.rATR},
+        {"rGLV", &r.rGLV}, {"rICF", &r.rICF}, {"rICS", &r.rICS}};
     for (const auto& [name, value] : values) {
       if (const auto it = flags.find(name); it != flags.end()) {
         *it->second = value;
@@ -833,8 +865,8 @@ class Gripper {
       const size_t axis = name.size() == 4 ? axes.find(name[3]) : std::string::npos;
       const std::string kind = name.substr(0, 3);
       if (axis == std::string::npos || (kind != "rPR" && kind != "rSP" && kind != "rFR")) {
-        throw cli::OptionError("registers", cli::Arg("registers") + ": no register named '" +
-                                                name + "' (rACT, rMOD, rGTO, rATR, rGLV, rICF, "
+        throw cli::OptionError("registers", cli::Arg("registers") + ": no register named '" + name +
+                                                "' (rACT, rMOD, rGTO, rATR, rGLV, rICF, "
                                                 "rICS, rPRA..rPRS, rSPA..rSPS, rFRA..rFRS)");
       }
       (kind == "rPR" ? r.rPR : kind == "rSP" ? r.rSP : r.rFR)[axis] = value;
@@ -854,8 +886,11 @@ class Gripper {
     const gripper::GripperState& st = emulator_.state();
     const gripper::GripperStatus& g = st.status;
     py::dict status;
-    for (const auto& [name, value] : {std::pair{"gACT", g.gACT}, {"gMOD", g.gMOD},
-                                      {"gGTO", g.gGTO}, {"gIMC", g.gIMC}, {"gSTA", g.gSTA},
+    for (const auto& [name, value] : {std::pair{"gACT", g.gACT},
+                                      {"gMOD", g.gMOD},
+                                      {"gGTO", g.gGTO},
+                                      {"gIMC", g.gIMC},
+                                      {"gSTA", g.gSTA},
                                       {"gFLT", g.gFLT}}) {
       status[name] = value;
     }
@@ -1011,6 +1046,5 @@ PYBIND11_MODULE(_hybrid, m) {
       .def("simulate", &Model::Simulate, py::arg("until") = py::none(),
            py::arg("inputs") = std::map<std::string, SignalValue>{}, py::arg("sample") = py::none(),
            py::arg("parameters") = std::map<std::string, double>{},
-           py::arg("init") = std::map<std::string, double>{},
-           py::arg("tolerance") = py::none());
+           py::arg("init") = std::map<std::string, double>{}, py::arg("tolerance") = py::none());
 }

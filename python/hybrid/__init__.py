@@ -19,7 +19,8 @@ attribute ``argument`` is that name) or ``KeyError``; a bug of the library raise
 
 Ctrl-C stops a long call (:meth:`Model.check`, :meth:`Model.simulate`, :func:`diagnose`,
 :func:`finger_angles` on large arrays) at once with ``KeyboardInterrupt``: called from the main
-thread, the first three compute in a child process that is killed (docs/python.md).
+thread, the first three compute in a child process that is killed (:meth:`Model.simulate` after
+its first 20000 integration passes, which run in the process: docs/python.md).
 """
 
 import json as _json
