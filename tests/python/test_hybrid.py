@@ -411,3 +411,23 @@ def test_reach_set_encloses_the_falling_ball():
     assert corners.shape == (len(reach["mode"]), 4, 2)
     with pytest.raises(ValueError):
         model.reach_vertices("h", "nope")
+
+
+def test_simulate_long_runs_leave_the_quick_path_with_the_same_result():
+    # 240,000 samples: more than the 20000 passes run in the process first, so the run starts
+    # again where Ctrl-C can stop it (a child process on the main thread, the process elsewhere).
+    model = hybrid.load(os.path.join(SOURCE, "spec", "thermostat.ha"))
+    main = model.simulate(sample=0.0005)
+    assert main["status"] == "completed" and len(main["time"]) > 240000
+    other = {}
+    worker = threading.Thread(target=lambda: other.update(model.simulate(sample=0.0005)))
+    worker.start()
+    worker.join()
+    np.testing.assert_array_equal(main["time"], other["time"])
+    for name, values in main["states"].items():
+        np.testing.assert_array_equal(values, other["states"][name])
+    assert main["events"] == other["events"]
+    # A short run takes the quick path and is the same run as a long one's beginning.
+    short = model.simulate(until=5.0, sample=0.0005)
+    k = len(short["time"])
+    np.testing.assert_array_equal(short["time"][:k - 1], main["time"][:k - 1])
