@@ -142,7 +142,7 @@ bool AnglesOfBlock(const FingerClosedForm& closed, std::span<const double> g,
 py::array_t<double> FingerAngles(
     const py::array_t<double, py::array::c_style | py::array::forcecast>& g,
     std::optional<double> gob1, std::optional<double> gob2, std::optional<double> gob3,
-    const std::optional<std::string>& model) {
+    const std::optional<std::string>& model, const std::optional<py::array>& out_array) {
   FingerContacts contacts;
   const std::array<std::optional<double>, 3> gob = {gob1, gob2, gob3};
   for (int i = 0; i < 3; ++i) {
@@ -151,7 +151,20 @@ py::array_t<double> FingerAngles(
   const FingerClosedForm closed(contacts, model ? ParametersOfModel(*model) : FingerParameters{});
   const size_t n = static_cast<size_t>(g.size());
   const std::span<const double> in(g.data(), n);
-  py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+  py::array_t<double> out;
+  if (out_array) {
+    // Written in place: it must be exactly what the answer would be (no conversion, no copy).
+    const py::array& a = *out_array;
+    if (!a.dtype().is(py::dtype::of<double>()) || a.ndim() != 2 ||
+        a.shape(0) != static_cast<py::ssize_t>(n) || a.shape(1) != 3 ||
+        !(a.flags() & py::array::c_style) || !a.writeable()) {
+      throw cli::OptionError("out", cli::Arg("out") + " must be a writable C-contiguous float64 " +
+                                        "array of shape (" + std::to_string(n) + ", 3)");
+    }
+    out = py::reinterpret_borrow<py::array_t<double>>(a);
+  } else {
+    out = py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+  }
   const std::span<double> theta(out.mutable_data(), 3 * n);
   constexpr size_t kBlock = size_t{1} << 22;
   for (size_t start = 0; start < n; start += kBlock) {
@@ -167,6 +180,24 @@ py::array_t<double> FingerAngles(
     }
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
+  return out;
+}
+
+// finger_angles of one motor position without a model: FingerAngles' answer without the batch
+// machinery (no array conversion, no blocks), the closed form of the last contacts kept per
+// thread.
+py::array_t<double> FingerAnglesOne(double g, std::optional<double> gob1,
+                                    std::optional<double> gob2, std::optional<double> gob3) {
+  FingerContacts contacts;
+  const std::array<std::optional<double>, 3> gob = {gob1, gob2, gob3};
+  for (int i = 0; i < 3; ++i) {
+    if (gob[i]) contacts.gob[i] = MotorPosition("gob" + std::to_string(i + 1), *gob[i]);
+  }
+  thread_local std::optional<FingerClosedForm> last;
+  if (!last || last->contacts().gob != contacts.gob) last.emplace(contacts);
+  MotorPosition("g", g);
+  py::array_t<double> out({py::ssize_t{1}, py::ssize_t{3}});
+  last->AnglesAt(std::span<const double>(&g, 1), std::span<double>(out.mutable_data(), 3));
   return out;
 }
 
@@ -1009,8 +1040,11 @@ PYBIND11_MODULE(_hybrid, m) {
     }
   });
   m.def("set_log_level", &SetLogLevel, py::arg("level"));
+  m.def("finger_angles_one", &FingerAnglesOne, py::arg("g"), py::arg("gob1"), py::arg("gob2"),
+        py::arg("gob3"));
   m.def("finger_angles", &FingerAngles, py::arg("g"), py::arg("gob1") = py::none(),
-        py::arg("gob2") = py::none(), py::arg("gob3") = py::none(), py::arg("model") = py::none());
+        py::arg("gob2") = py::none(), py::arg("gob3") = py::none(), py::arg("model") = py::none(),
+        py::arg("out") = py::none());
   m.def("hand_sweep", &HandSweepDict, py::arg("objects"), py::arg("offsets"), py::arg("mode"),
         py::arg("spread"), py::arg("g"), py::arg("g_a"), py::arg("g_b"), py::arg("g_c"),
         py::arg("threads"));

@@ -101,7 +101,22 @@ def main():
     print("speed: plain Python / hybrid.finger_angles per query = %.0f (mean over the cases)"
           % (total_python / total_ours))
     print("agreement: " + ("FAILED" if failed else "every angle within 1e-9 of both references"))
+    single_call_ratio(args.repeat)
     return 1 if failed else 0
+
+
+def single_call_ratio(repeat):
+    """One position per call, as a controller's loop asks: hybrid.finger_angles(g) (its scalar
+    path) against the plain-Python finger, best of `repeat` timings of 20000 calls each."""
+    import timeit
+    calls = 20000
+    for name, contacts in (("free", {}), ("gob1=80", {"gob1": 80.0})):
+        ours = min(timeit.repeat(lambda: hybrid.finger_angles(100.0, **contacts), number=calls,
+                                 repeat=max(repeat, 1))) / calls
+        theirs = min(timeit.repeat(lambda: report_finger.finger_angles(100.0, **contacts),
+                                   number=calls, repeat=max(repeat, 1))) / calls
+        print("single call, %-8s hybrid %.0f ns, plain Python %.0f ns: hybrid / Python = %.2f"
+              % (name, ours * 1e9, theirs * 1e9, ours / theirs))
 
 
 if __name__ == "__main__":

@@ -52,7 +52,7 @@ def set_log_level(level):
     _hybrid.set_log_level(level)
 
 
-def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):
+def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None, out=None):
     """Joint angles (theta1, theta2, theta3) in degrees of one finger closing to motor position g.
 
     The report's closed form (Franchi and Hauser's tables with the decisions of
@@ -64,6 +64,9 @@ def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):
             (``--gob1..3``); None: never.
         model: path of a finger model like spec/finger.ha whose constants (joint ranges,
             phase-3 fraction) replace the report's.
+        out: a writable C-contiguous float64 array of shape (n, 3) to write the angles into
+            (returned); None: a new array. A batch computed again into the same array pays no
+            allocation or page faults.
 
     Returns:
         A float64 array of shape (n, 3), n the number of values of g (1 for a number).
@@ -73,7 +76,9 @@ def finger_angles(g, gob1=None, gob2=None, gob3=None, model=None):
         ValueError: a motor position outside [0, 255] or NaN, or a model that is not a finger.
         ModelError: a model file that does not parse.
     """
-    return _hybrid.finger_angles(g, gob1, gob2, gob3, model)
+    if model is None and out is None and type(g) in (float, int):  # one position: no batch
+        return _hybrid.finger_angles_one(g, gob1, gob2, gob3)
+    return _hybrid.finger_angles(g, gob1, gob2, gob3, model, out)
 
 
 class Model:

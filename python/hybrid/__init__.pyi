@@ -17,6 +17,7 @@ def finger_angles(
     gob2: float | None = ...,
     gob3: float | None = ...,
     model: str | None = ...,
+    out: npt.NDArray[np.float64] | None = ...,
 ) -> npt.NDArray[np.float64]: ...
 
 class Model:

@@ -431,3 +431,33 @@ def test_simulate_long_runs_leave_the_quick_path_with_the_same_result():
     short = model.simulate(until=5.0, sample=0.0005)
     k = len(short["time"])
     np.testing.assert_array_equal(short["time"][:k - 1], main["time"][:k - 1])
+
+
+def test_finger_angles_out_and_single_positions():
+    g = np.linspace(0.0, 255.0, 1001)
+    expected = hybrid.finger_angles(g, gob1=80.0)
+    out = np.full((1001, 3), np.nan)
+    assert hybrid.finger_angles(g, gob1=80.0, out=out) is out
+    np.testing.assert_array_equal(out, expected)
+    for bad in (np.zeros((1001, 3), dtype=np.float32), np.zeros((1000, 3)), np.zeros((3, 1001)).T,
+                np.zeros((1001, 3))[::1, :].copy().view()[:, :]):
+        if bad.flags.c_contiguous and bad.dtype == np.float64 and bad.shape == (1001, 3):
+            continue
+        with pytest.raises(ValueError, match="out must be a writable C-contiguous float64"):
+            hybrid.finger_angles(g, out=bad)
+    frozen = np.zeros((1001, 3))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="out must be"):
+        hybrid.finger_angles(g, out=frozen)
+    # One position (a Python number) takes the scalar path: the batch's numbers, the same errors.
+    for contacts in ({}, {"gob1": 80.0}, {"gob2": 50.0}, {"gob1": 100.0, "gob2": 140.0}):
+        batch = hybrid.finger_angles(g, **contacts)
+        for k in (0, 137, 500, 999, 1000):
+            single = hybrid.finger_angles(float(g[k]), **contacts)
+            assert single.shape == (1, 3)
+            np.testing.assert_array_equal(single[0], batch[k])
+    assert hybrid.finger_angles(200).shape == (1, 3)
+    with pytest.raises(ValueError, match="g must be a motor position"):
+        hybrid.finger_angles(300.0)
+    with pytest.raises(ValueError, match="gob1 must be a motor position"):
+        hybrid.finger_angles(100.0, gob1=-1.0)
