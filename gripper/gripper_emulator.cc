@@ -46,6 +46,27 @@ int DiscreteValue(const System& system, int c, int mode, const std::string& name
 
 }  // namespace
 
+int* GripperRegisters::Find(std::string_view name) {
+  const std::array<std::pair<std::string_view, int*>, 7> flags = {{{"rACT", &rACT},
+                                                                   {"rMOD", &rMOD},
+                                                                   {"rGTO", &rGTO},
+                                                                   {"rATR", &rATR},
+                                                                   {"rGLV", &rGLV},
+                                                                   {"rICF", &rICF},
+                                                                   {"rICS", &rICS}}};
+  for (const auto& [flag, field] : flags) {
+    if (name == flag) return field;
+  }
+  if (name.size() != 4) return nullptr;
+  const size_t axis = std::string_view("ABCS").find(name[3]);
+  if (axis == std::string_view::npos) return nullptr;
+  const std::string_view kind = name.substr(0, 3);
+  if (kind == "rPR") return &rPR[axis];
+  if (kind == "rSP") return &rSP[axis];
+  if (kind == "rFR") return &rFR[axis];
+  return nullptr;
+}
+
 GripperEmulator::GripperEmulator(System model, std::vector<Obstacle> objects,
                                  const HandLayout& layout)
     : system_(std::make_unique<System>(std::move(model))),

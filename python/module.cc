@@ -772,12 +772,11 @@ py::dict Model::Simulate(std::optional<double> until,
   return RunDict(EncodedRun(sim, *result, horizon));
 }
 
-// `hybrid hand --json` (without --simulate): the report as JSON text.
-std::string HandJsonText(const std::vector<std::string>& objects, const std::string& mode,
+// The arguments of `hybrid hand` from hybrid.hand's keyword arguments.
+cli::HandArgs HandArgsOf(const std::vector<std::string>& objects, const std::string& mode,
                          std::optional<double> spread, double g, std::optional<double> g_a,
-                         std::optional<double> g_b, std::optional<double> g_c, bool joint_state) {
+                         std::optional<double> g_b, std::optional<double> g_c) {
   cli::HandArgs args;
-  args.joint_state = joint_state;
   args.objects = objects;
   args.mode = mode;
   args.spread = spread;
@@ -785,6 +784,15 @@ std::string HandJsonText(const std::vector<std::string>& objects, const std::str
   args.g_a = g_a;
   args.g_b = g_b;
   args.g_c = g_c;
+  return args;
+}
+
+// `hybrid hand --json` (without --simulate): the report as JSON text.
+std::string HandJsonText(const std::vector<std::string>& objects, const std::string& mode,
+                         std::optional<double> spread, double g, std::optional<double> g_a,
+                         std::optional<double> g_b, std::optional<double> g_c, bool joint_state) {
+  cli::HandArgs args = HandArgsOf(objects, mode, spread, g, g_a, g_b, g_c);
+  args.joint_state = joint_state;
   py::gil_scoped_release release;
   return cli::HandReport(args).dump();
 }
@@ -831,14 +839,7 @@ py::dict HandSweepDict(
     const py::array_t<double, py::array::c_style | py::array::forcecast>& offsets,
     const std::string& mode, std::optional<double> spread, double g, std::optional<double> g_a,
     std::optional<double> g_b, std::optional<double> g_c, int threads) {
-  cli::HandArgs args;
-  args.objects = objects;
-  args.mode = mode;
-  args.spread = spread;
-  args.g = g;
-  args.g_a = g_a;
-  args.g_b = g_b;
-  args.g_c = g_c;
+  const cli::HandArgs args = HandArgsOf(objects, mode, spread, g, g_a, g_b, g_c);
   const std::vector<std::array<double, 2>> rows = OffsetRows(offsets);
   cli::GraspSweep sweep;
   {
@@ -884,23 +885,14 @@ class Gripper {
   // Writes the registers named in `values` (the others keep their values).
   void Command(const std::map<std::string, int>& values) {
     gripper::GripperRegisters r = emulator_.registers();
-    const std::map<std::string, int*> flags = {
-        {"rACT", &r.rACT}, {"rMOD", &r.rMOD}, {"rGTO", &r.rGTO}, {"rATR", &r.rATR},
-        {"rGLV", &r.rGLV}, {"rICF", &r.rICF}, {"rICS", &r.rICS}};
     for (const auto& [name, value] : values) {
-      if (const auto it = flags.find(name); it != flags.end()) {
-        *it->second = value;
-        continue;
-      }
-      const std::string axes = "ABCS";
-      const size_t axis = name.size() == 4 ? axes.find(name[3]) : std::string::npos;
-      const std::string kind = name.substr(0, 3);
-      if (axis == std::string::npos || (kind != "rPR" && kind != "rSP" && kind != "rFR")) {
+      int* field = r.Find(name);
+      if (field == nullptr) {
         throw cli::OptionError("registers", cli::Arg("registers") + ": no register named '" + name +
                                                 "' (rACT, rMOD, rGTO, rATR, rGLV, rICF, "
                                                 "rICS, rPRA..rPRS, rSPA..rSPS, rFRA..rFRS)");
       }
-      (kind == "rPR" ? r.rPR : kind == "rSP" ? r.rSP : r.rFR)[axis] = value;
+      *field = value;
     }
     emulator_.Command(r);
   }

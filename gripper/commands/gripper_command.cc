@@ -102,15 +102,21 @@ std::string BlockerName(const std::optional<int>& by, const std::string& imposed
 
 // The contacts that take effect while closing (a given contact position beyond where a link
 // stops moving, e.g. --gob1 200 with link 1 at its limit since 140, does not).
-json ContactsJson(const FingerClosedForm& closed, const std::array<std::optional<int>, 3>& by,
-                  const std::array<std::string, 3>& imposed_names) {
+std::vector<HandFinger::Contact> EffectiveContacts(
+    const FingerClosedForm& closed, const std::array<std::optional<int>, 3>& by,
+    const std::array<std::string, 3>& imposed_names) {
   const FingerContacts& contacts = closed.contacts();
-  json out = json::array();
+  std::vector<HandFinger::Contact> out;
   for (int i = 0; i < 3; ++i) {
     if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
-    out.push_back(
-        {{"link", i + 1}, {"g", contacts.gob[i]}, {"by", BlockerName(by[i], imposed_names[i])}});
+    out.push_back({i + 1, contacts.gob[i], BlockerName(by[i], imposed_names[i])});
   }
+  return out;
+}
+
+json ContactsJson(const std::vector<HandFinger::Contact>& contacts) {
+  json out = json::array();
+  for (const auto& c : contacts) out.push_back({{"link", c.link}, {"g", c.g}, {"by", c.by}});
   return out;
 }
 
@@ -374,7 +380,7 @@ json FingerReport(const FingerArgs& args, const FingerClosedForm& closed,
   json report;
   if (args.g) report = ConfigurationJson(*args.g, closed.At(*args.g));
   if (!args.requests.empty()) report["requests"] = RequestHistoryJson(args.requests, closed);
-  report["contacts"] = ContactsJson(closed, by, {"", "", ""});
+  report["contacts"] = ContactsJson(EffectiveContacts(closed, by, {"", "", ""}));
   report["stop"] = StopJson(closed.stop());
   if (geometric) {
     const double first = FirstObjectContact(*geometric);
@@ -567,13 +573,7 @@ HandFinger HandFingerOf(const gripper::Hand& hand, int f) {
   }
   HandFinger out{command, hand.At(f, 255.0)};
   const FingerClosedForm& closed = hand.finger(f).closed_form();
-  const FingerContacts& contacts = closed.contacts();
-  for (int i = 0; i < 3; ++i) {
-    // The contacts that take effect while closing (see ContactsJson).
-    if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
-    out.contacts.push_back(
-        {i + 1, contacts.gob[i], BlockerName(hand.finger(f).blocked_by()[i], imposed[i])});
-  }
+  out.contacts = EffectiveContacts(closed, hand.finger(f).blocked_by(), imposed);
   // Where the finger stops by itself (phase 4), if before its command; else +inf.
   const double stop = closed.stop();
   out.stop = stop <= command ? stop : std::numeric_limits<double>::infinity();
@@ -609,11 +609,7 @@ json HandFingersJson(const gripper::Hand& hand) {
     json j = {{"finger", std::string(1, kFingerNames[f])}, {"command", finger.command}};
     j.update(ConfigurationJson(finger.command, finger.configuration));
     j.erase("g");
-    json contacts = json::array();
-    for (const auto& c : finger.contacts) {
-      contacts.push_back({{"link", c.link}, {"g", c.g}, {"by", c.by}});
-    }
-    j["contacts"] = std::move(contacts);
+    j["contacts"] = ContactsJson(finger.contacts);
     j["stop"] = StopJson(finger.stop);
     fingers.push_back(j);
   }
@@ -723,17 +719,35 @@ std::string HandText(const HandArgs& args, const gripper::Hand& hand, double spr
   return out.str();
 }
 
+// What `hybrid finger` works from: its checked arguments, the contact positions given, the
+// objects, the model, the finger on the objects and its closed form.
+struct FingerSetup {
+  FingerArgs args;
+  FingerContacts contacts;
+  std::vector<Obstacle> objects;
+  std::optional<Automaton> model;
+  std::optional<GeometricFinger> geometric;
+  FingerClosedForm closed;
+};
+
+FingerSetup SetUpFinger(const FingerArgs& args_in) {
+  FingerArgs args = args_in;
+  const FingerContacts contacts = CheckFingerArgs(args);
+  std::vector<Obstacle> objects = ParseObjects(args.objects);
+  std::optional<Automaton> model = FingerModel(args);
+  const FingerParameters parameters = ModelParameters(model, args.model);
+  std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
+  FingerClosedForm closed =
+      geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
+  return {std::move(args),      contacts,         std::move(objects), std::move(model),
+          std::move(geometric), std::move(closed)};
+}
+
 }  // namespace
 
 ExitCode RunFinger(const FingerArgs& args_in) {
-  FingerArgs args = args_in;
-  const FingerContacts contacts = CheckFingerArgs(args);
-  const std::vector<Obstacle> objects = ParseObjects(args.objects);
-  const std::optional<Automaton> model = FingerModel(args);
-  const FingerParameters parameters = ModelParameters(model, args.model);
-  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
-  const FingerClosedForm closed =
-      geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
+  const FingerSetup setup = SetUpFinger(args_in);
+  const auto& [args, contacts, objects, model, geometric, closed] = setup;
   if (!args.queries.empty() || !args.g_range.empty()) {
     const std::vector<double> g = args.queries.empty()
                                       ? MotorRange(args.g_range, kMaxBatchQueries)
@@ -789,16 +803,9 @@ json HandJson(const HandArgs& args, const gripper::Hand& hand, double spread) {
 
 }  // namespace
 
-nlohmann::ordered_json FingerReportJson(const FingerArgs& args_in) {
-  FingerArgs args = args_in;
-  const FingerContacts contacts = CheckFingerArgs(args);
-  const std::vector<Obstacle> objects = ParseObjects(args.objects);
-  const std::optional<Automaton> model = FingerModel(args);
-  const FingerParameters parameters = ModelParameters(model, args.model);
-  const std::optional<GeometricFinger> geometric = FingerOnObjects(objects, parameters);
-  const FingerClosedForm closed =
-      geometric ? geometric->closed_form() : FingerClosedForm(contacts, parameters);
-  return FingerReport(args, closed, geometric, objects);
+nlohmann::ordered_json FingerReportJson(const FingerArgs& args) {
+  const FingerSetup s = SetUpFinger(args);
+  return FingerReport(s.args, s.closed, s.geometric, s.objects);
 }
 
 HandSettings CheckedHandSettings(const HandArgs& args) {
@@ -819,12 +826,7 @@ std::vector<gripper::Obstacle> ParseObjectList(const std::vector<std::string>& t
 HandFinger FingerAt(const GeometricFinger& finger, double g) {
   const FingerClosedForm& closed = finger.closed_form();
   HandFinger out{g, closed.At(g)};
-  const FingerContacts& contacts = closed.contacts();
-  for (int i = 0; i < 3; ++i) {
-    // The contacts that take effect while closing (see ContactsJson).
-    if (contacts.gob[i] > 255.0 || closed.pieces().back().c[i] != 1) continue;
-    out.contacts.push_back({i + 1, contacts.gob[i], BlockerName(finger.blocked_by()[i], "")});
-  }
+  out.contacts = EffectiveContacts(closed, finger.blocked_by(), {"", "", ""});
   out.stop = closed.stop();
   return out;
 }

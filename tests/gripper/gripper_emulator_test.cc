@@ -81,3 +81,21 @@ TEST(GripperEmulatorTest, NeedsTheGrippersInstances) {
 
 }  // namespace
 }  // namespace hybrid::gripper
+
+namespace hybrid::gripper {
+namespace {
+
+TEST(GripperRegistersTest, FindNamesEveryRegisterAsTheManualDoes) {
+  GripperRegisters r;
+  EXPECT_EQ(r.Find("rACT"), &r.rACT);
+  EXPECT_EQ(r.Find("rICS"), &r.rICS);
+  EXPECT_EQ(r.Find("rPRA"), &r.rPR[0]);
+  EXPECT_EQ(r.Find("rSPS"), &r.rSP[3]);
+  EXPECT_EQ(r.Find("rFRC"), &r.rFR[2]);
+  for (const char* bad : {"", "rPR", "rPRD", "rXYA", "gACT", "rACTA"}) {
+    EXPECT_EQ(r.Find(bad), nullptr) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace hybrid::gripper

@@ -4,6 +4,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hybrid/automaton/system.h"
@@ -32,6 +33,10 @@ struct GripperRegisters {
   std::array<int, 4> rPR = {0, 0, 0, 0};          ///< position requests (rPRA, rPRB, rPRC, rPRS)
   std::array<int, 4> rSP = {255, 255, 255, 255};  ///< speeds (rSPA, ...)
   std::array<int, 4> rFR = {150, 150, 150, 150};  ///< forces (rFRA, ...; not modelled)
+
+  /// The register named `name` as the manual names it ("rACT", ..., "rPRA".."rPRS",
+  /// "rSPA".."rSPS", "rFRA".."rFRS"); nullptr for a name that is no register.
+  int* Find(std::string_view name);
 };
 
 /// The gripper's input registers (status), as the manual names them. Arrays are indexed A, B,

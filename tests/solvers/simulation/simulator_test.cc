@@ -17,6 +17,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,7 @@
 
 #include "hybrid/automaton/parser.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/random_hybrid_automata.h"
 #include "tests/test_utilities/random_models.h"
 
 namespace hybrid {
@@ -2350,6 +2352,68 @@ TEST(SimulatorScheduleTest, RefusesTimesOutOfOrderOrBeyondTheHorizon) {
   EXPECT_THROW(sim.Run(options), std::invalid_argument);
   options.lazy_schedule = {{13.0, "halt", {{0, 0}}}};
   EXPECT_THROW(sim.Run(options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hybrid
+
+namespace hybrid {
+namespace {
+
+// Differential: a run of a random automaton (tests/test_utilities/random_hybrid_automata.h, affine
+// dynamics, urgent and lazy transitions, resets) continued from the state it reached at an
+// arbitrary time (SimulationOptions::start_modes, start_x) ends where the whole run ends: the same
+// modes, the same values within the integrator's tolerance.
+RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
+  using namespace testing;  // NOLINT(build/namespaces): the random automata's generator
+  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint64_t>());
+  RandomAutomatonOptions kinds;
+  kinds.dynamics = *rc::gen::element(RandomDynamics::kMixed, RandomDynamics::kAffine);
+  PrintOptions print;
+  print.explicit_rates = true;
+  const std::string text = GenerateRandomAutomaton(rng, kinds).Text(print);
+  const System system = ParseModel(text, "random.ha");
+  std::optional<Simulator> sim;
+  try {
+    sim.emplace(system);
+  } catch (const std::invalid_argument&) {
+    RC_DISCARD("no initial state");
+  }
+  constexpr double kHorizon = 3.0;
+  const double split = *GenReal(0.3, 2.7) + 0.000123;
+  SimulationOptions whole_options;
+  whole_options.until = kHorizon;
+  SimulationResult whole;
+  try {
+    whole = sim->Run(whole_options);
+  } catch (const std::invalid_argument&) {
+    RC_DISCARD("the start violates an invariant");
+  }
+  RC_PRE(whole.status == SimulationStatus::kCompleted);
+  SimulationOptions first_options;
+  first_options.until = split;
+  const SimulationResult first = sim->Run(first_options);
+  RC_ASSERT(first.status == SimulationStatus::kCompleted);
+  SimulationOptions second_options;
+  second_options.until = kHorizon - split;
+  second_options.start_modes = first.samples.back().modes;
+  second_options.start_x = first.samples.back().x;
+  const SimulationResult second = sim->Run(second_options);
+  RC_ASSERT(second.status == SimulationStatus::kCompleted);
+  RC_ASSERT(second.samples.back().modes == whole.samples.back().modes);
+  const Eigen::VectorXd& a = whole.samples.back().x;
+  const Eigen::VectorXd& b = second.samples.back().x;
+  for (int i = 0; i < a.size(); ++i) {
+    RC_ASSERT(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])));
+  }
+  // The events: the whole run's after the split, the second part's shifted by it.
+  size_t k = 0;
+  while (k < whole.events.size() && whole.events[k].time <= split) ++k;
+  RC_ASSERT(whole.events.size() - k == second.events.size());
+  for (size_t j = 0; j < second.events.size(); ++j, ++k) {
+    RC_ASSERT(whole.events[k].transitions == second.events[j].transitions);
+    RC_ASSERT(std::abs(whole.events[k].time - (split + second.events[j].time)) <= 1e-6);
+  }
 }
 
 }  // namespace
