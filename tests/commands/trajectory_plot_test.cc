@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "hybrid/automaton/parser.h"
+#include "tests/test_utilities/svg_scan.h"
 #include "tests/test_utilities/text_count.h"
 
 namespace hybrid::cli {
@@ -73,14 +74,13 @@ TEST(TrajectoryPlot, DrawsPanelsJumpsAndModes) {
   EXPECT_NE(strip.find("<title>a: t = 2 to 2.5</title>"), std::string::npos) << strip;
   EXPECT_EQ(svg.find("class=\"mode-legend\""), std::string::npos) << "every name fits";
   // x = t on [0, 1]: the first points of the first polyline are on one straight line.
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(svg, m, std::regex("points=\"([^\"]*)\"")));
+  const std::vector<std::string> polylines = testing::AttributeValues(svg, "points");
+  ASSERT_FALSE(polylines.empty());
   std::vector<double> xs, ys;
-  std::istringstream in(m[1].str());
-  std::string pair;
-  while (in >> pair && xs.size() < 3) {
-    xs.push_back(std::stod(pair.substr(0, pair.find(','))));
-    ys.push_back(std::stod(pair.substr(pair.find(',') + 1)));
+  for (const auto& [x, y] : testing::PointPairs(polylines.front())) {
+    if (xs.size() == 3) break;
+    xs.push_back(x);
+    ys.push_back(y);
   }
   ASSERT_EQ(xs.size(), 3u);
   EXPECT_NEAR((ys[1] - ys[0]) * (xs[2] - xs[0]), (ys[2] - ys[0]) * (xs[1] - xs[0]), 0.5);
@@ -112,18 +112,9 @@ using testing::Count;
 
 // The points of the `index`-th polyline of `svg`, in pixels.
 std::vector<std::array<double, 2>> PolylinePoints(const std::string& svg, int index) {
-  const std::regex points("points=\"([^\"]*)\"");
-  auto it = std::sregex_iterator(svg.begin(), svg.end(), points);
-  for (int k = 0; k < index && it != std::sregex_iterator(); ++k) ++it;
-  std::vector<std::array<double, 2>> out;
-  if (it == std::sregex_iterator()) return out;
-  std::istringstream in((*it)[1].str());
-  std::string pair;
-  while (in >> pair) {
-    out.push_back(
-        {std::stod(pair.substr(0, pair.find(','))), std::stod(pair.substr(pair.find(',') + 1))});
-  }
-  return out;
+  const std::vector<std::string> polylines = testing::AttributeValues(svg, "points");
+  if (index >= static_cast<int>(polylines.size())) return {};
+  return testing::PointPairs(polylines[index]);
 }
 
 System BouncingBall() {

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_utilities/svg_scan.h"
 #include "tests/test_utilities/text_count.h"
 
 namespace hybrid::gripper {
@@ -66,24 +67,14 @@ std::vector<PixelLine> Lines(const std::string& svg, const std::string& prefix) 
   return lines;
 }
 
-// The points of the <polyline class="NAME" ...> element. A plain scan: std::regex matches
-// `[^"]*` by one recursive call per character, which overflows the stack on a long points list
-// under AddressSanitizer's larger frames.
+// The points of the <polyline class="NAME" ...> element.
 std::vector<std::array<double, 2>> Polyline(const std::string& svg, const std::string& name) {
   const std::size_t start = svg.find("<polyline class=\"" + name + "\"");
   if (start == std::string::npos) return {};
   const std::size_t end = svg.find("/>", start);
-  const std::size_t attribute = svg.find(" points=\"", start);
-  if (end == std::string::npos || attribute == std::string::npos || attribute > end) return {};
-  const std::size_t from = attribute + std::string(" points=\"").size();
-  const std::size_t to = svg.find('"', from);
-  if (to == std::string::npos || to > end) return {};
-  std::vector<std::array<double, 2>> points;
-  std::istringstream text(svg.substr(from, to - from));
-  double x = 0, y = 0;
-  char comma = 0;
-  while (text >> x >> comma >> y && comma == ',') points.push_back({x, y});
-  return points;
+  if (end == std::string::npos) return {};
+  const auto points = testing::AttributeValues(svg.substr(start, end - start), "points");
+  return points.empty() ? std::vector<std::array<double, 2>>{} : testing::PointPairs(points[0]);
 }
 
 // The pixel row of the horizontal gridline at `theta` degrees, the column of the one at `g`.
