@@ -101,20 +101,6 @@ std::vector<InputSignal> ReadInputCsv(const std::string& path, InputSignal::Shap
   return signals;
 }
 
-std::string CauseName(EventRecord::Cause cause) {
-  switch (cause) {
-    case EventRecord::Cause::kCrossing:
-      return "crossing";
-    case EventRecord::Cause::kInvariant:
-      return "invariant";
-    case EventRecord::Cause::kEnabled:
-      return "enabled";
-    case EventRecord::Cause::kScheduled:
-      return "scheduled";
-  }
-  return "?";
-}
-
 std::string KindName(StateSample::Kind kind) {
   switch (kind) {
     case StateSample::Kind::kStart:
@@ -159,8 +145,8 @@ std::string EventsCsv(const Simulator& sim, const SimulationResult& r) {
   for (const auto& v : sim.variable_names()) out << "," << v << "_after";
   out << "\n";
   for (const EventRecord& e : r.events) {
-    out << e.time << "," << CauseName(e.cause) << "," << Join(e.transitions, "+") << "," << e.label
-        << "," << sim.ModeLabel(e.modes_before) << "," << sim.ModeLabel(e.modes_after);
+    out << e.time << "," << EventCauseName(e.cause) << "," << Join(e.transitions, "+") << ","
+        << e.label << "," << sim.ModeLabel(e.modes_before) << "," << sim.ModeLabel(e.modes_after);
     for (int i = 0; i < e.before.size(); ++i) out << "," << e.before[i];
     for (int i = 0; i < e.after.size(); ++i) out << "," << e.after[i];
     out << "\n";
@@ -252,12 +238,26 @@ void OverrideInputs(const std::vector<std::string>& specs, const SymbolTable& sy
 
 }  // namespace
 
+std::string EventCauseName(EventRecord::Cause cause) {
+  switch (cause) {
+    case EventRecord::Cause::kCrossing:
+      return "crossing";
+    case EventRecord::Cause::kInvariant:
+      return "invariant";
+    case EventRecord::Cause::kEnabled:
+      return "enabled";
+    case EventRecord::Cause::kScheduled:
+      return "scheduled";
+  }
+  return "?";
+}
+
 nlohmann::ordered_json SimulationReport(const Simulator& sim, const SimulationResult& r,
                                         double until) {
   json events = json::array();
   for (const EventRecord& e : r.events) {
     events.push_back({{"time", e.time},
-                      {"cause", CauseName(e.cause)},
+                      {"cause", EventCauseName(e.cause)},
                       {"transitions", e.transitions},
                       {"label", e.label},
                       {"mode_before", sim.ModeLabel(e.modes_before)},

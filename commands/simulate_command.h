@@ -47,6 +47,9 @@ struct SimulateArgs {
 /// (OutputError when a file cannot be written).
 ExitCode RunSimulate(const SimulateArgs& args);
 
+/// The name of an event's cause in the reports: crossing, invariant, enabled or scheduled.
+std::string EventCauseName(EventRecord::Cause cause);
+
 /// The JSON document of `hybrid simulate --json` for run `r` of `sim` to horizon `until`:
 /// status, message, until, final (a state: time, mode, values), steps, events (time, cause,
 /// transitions, label, mode_before, mode_after, before and after as values), zeno if detected.

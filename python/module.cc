@@ -664,9 +664,9 @@ std::vector<InputSignal> Model::Signals(const std::map<std::string, SignalValue>
   return signals;
 }
 
-// Simulates `system` and encodes what Model.simulate returns (decoded by RunDict): the number of
+// Encodes what Model.simulate returns of run `r` (decoded by RunDict in the parent): the number of
 // samples n, their times, the number of variables and each one's name and n values, the mode
-// labels (a table of the distinct ones, then one index per sample), the status, the message and
+// labels (a table of the distinct ones, then one index per sample) and
 // the command's JSON report (for `horizon`).
 std::string EncodedRun(const Simulator& sim, const SimulationResult& r, double horizon) {
   const std::size_t n = r.samples.size();
@@ -693,13 +693,98 @@ std::string EncodedRun(const Simulator& sim, const SimulationResult& r, double h
   e.Number(labels.size());
   for (const std::string& label : labels) e.Text(label);
   for (const std::uint64_t m : mode_of) e.Number(m);
-  e.Text(StatusName(r.status));
-  e.Text(r.message);
   e.Text(cli::SimulationReport(sim, r, horizon).dump());
   return e.Take();
 }
 
-// The dict Model.simulate returns, from EncodedRun's bytes.
+// A number as the JSON report gives it to Python: a float, or None where JSON has null (a value
+// that is not finite).
+py::object ReportNumber(double v) {
+  return std::isfinite(v) ? py::object(py::float_(v)) : py::object(py::none());
+}
+
+// {variable name: value} of state `x`; `names` are the simulator's variable names as Python
+// strings.
+py::dict StateDict(const std::vector<py::str>& names, const Eigen::VectorXd& x) {
+  py::dict out;
+  for (std::size_t i = 0; i < names.size(); ++i) out[names[i]] = ReportNumber(x[i]);
+  return out;
+}
+
+// The members of `hybrid simulate --json` (cli::SimulationReport: status, message, until, final,
+// steps, events, zeno) as Python objects, put in `out`: the same members and values as the JSON
+// text read by Python's json module (tests/python/test_hybrid.py compares them with the program's
+// output), built without the text.
+void AddReport(const Simulator& sim, const SimulationResult& r, double until, py::dict& out) {
+  std::vector<py::str> names;
+  for (const std::string& name : sim.variable_names()) names.emplace_back(name);
+  out["status"] = py::str(std::string(StatusName(r.status)));
+  out["message"] = py::str(r.message);
+  out["until"] = ReportNumber(until);
+  const StateSample& last = r.samples.back();
+  py::dict final_state;
+  final_state["time"] = ReportNumber(last.time);
+  final_state["mode"] = py::str(sim.ModeLabel(last.modes));
+  final_state["values"] = StateDict(names, last.x);
+  out["final"] = final_state;
+  out["steps"] = py::int_(r.steps);
+  py::list events(r.events.size());
+  for (std::size_t i = 0; i < r.events.size(); ++i) {
+    const EventRecord& e = r.events[i];
+    py::dict event;
+    event["time"] = ReportNumber(e.time);
+    event["cause"] = py::str(cli::EventCauseName(e.cause));
+    event["transitions"] = py::cast(e.transitions);
+    event["label"] = py::str(e.label);
+    event["mode_before"] = py::str(sim.ModeLabel(e.modes_before));
+    event["mode_after"] = py::str(sim.ModeLabel(e.modes_after));
+    event["before"] = StateDict(names, e.before);
+    event["after"] = StateDict(names, e.after);
+    events[i] = event;
+  }
+  out["events"] = events;
+  if (r.zeno) {
+    py::dict zeno;
+    zeno["accumulation_time"] = ReportNumber(r.zeno->accumulation_time);
+    zeno["cycle"] = py::cast(r.zeno->cycle);
+    out["zeno"] = zeno;
+  }
+}
+
+// The dict Model.simulate returns, built from run `r` in this process: AddReport's members, and
+// the trajectory as `time` (numpy), `states` ({name: numpy array}) and `modes` (one label per
+// instant, the distinct labels made once).
+py::dict RunDictOf(const Simulator& sim, const SimulationResult& r, double horizon) {
+  const auto n = static_cast<py::ssize_t>(r.samples.size());
+  py::dict out;
+  AddReport(sim, r, horizon, out);
+  py::array_t<double> time(n);
+  double* t = time.mutable_data();
+  for (py::ssize_t k = 0; k < n; ++k) t[k] = r.samples[k].time;
+  out["time"] = time;
+  py::dict states;
+  for (std::size_t v = 0; v < sim.variable_names().size(); ++v) {
+    py::array_t<double> column(n);
+    double* c = column.mutable_data();
+    for (py::ssize_t k = 0; k < n; ++k) c[k] = r.samples[k].x[v];
+    states[py::str(sim.variable_names()[v])] = column;
+  }
+  out["states"] = states;
+  py::list modes(n);
+  const std::vector<int>* previous = nullptr;
+  py::str label;
+  for (py::ssize_t k = 0; k < n; ++k) {
+    if (previous == nullptr || *previous != r.samples[k].modes) {
+      label = py::str(sim.ModeLabel(r.samples[k].modes));
+      previous = &r.samples[k].modes;
+    }
+    modes[k] = label;
+  }
+  out["modes"] = modes;
+  return out;
+}
+
+// The dict Model.simulate returns, from EncodedRun's bytes (a run in the child process).
 py::dict RunDict(std::string_view encoded) {
   Decoder d(encoded);
   const auto n = static_cast<py::ssize_t>(d.Number());
@@ -716,15 +801,11 @@ py::dict RunDict(std::string_view encoded) {
   for (std::uint64_t m = d.Number(); m > 0; --m) labels.emplace_back(d.Text());
   py::list modes(n);
   for (py::ssize_t k = 0; k < n; ++k) modes[k] = labels.at(d.Number());
-  py::dict out;
-  out["status"] = d.Text();
-  out["message"] = d.Text();
+  // The report's members from its JSON text (as the quick path's AddReport builds them).
+  py::dict out = py::module_::import("json").attr("loads")(py::str(d.Text()));
   out["time"] = time;
   out["states"] = states;
   out["modes"] = modes;
-  // final, events, steps, until (and zeno): the command's JSON, parsed by the package (Python's
-  // json module is faster at it than building the objects one by one from C++).
-  out["report_json"] = d.Text();
   return out;
 }
 
@@ -769,7 +850,7 @@ py::dict Model::Simulate(std::optional<double> until,
     return RunDict(
         RunStoppable([&] { return EncodedRun(sim, sim.Run(options, signals), horizon); }));
   }
-  return RunDict(EncodedRun(sim, *result, horizon));
+  return RunDictOf(sim, *result, horizon);
 }
 
 // The arguments of `hybrid hand` from hybrid.hand's keyword arguments.

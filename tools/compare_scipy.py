@@ -20,8 +20,14 @@ u < 0, m1 u > 0, ...) is false on a segment gets no event function there, and mo
 not monitored: both only make scipy's side cheaper, so the ratio is conservative. Timed with
 time.perf_counter over repeated runs in this process (median).
 
-Exit status 1 if either side misses the analytic event times by more than 1e-9 or visits other
-modes, or if ours is less than 100 times faster (the target of docs/benchmarks.md).
+From Python (as a roboticist calls it): hybrid.load("spec/finger.ha") once (the module of
+BUILD_DIR/python), then Model.simulate() of the same cycle per call, timed like scipy's side in this
+process (median), its event times checked against the analytic ones; the ratio printed beside the
+C++ one. Skipped with a note if the module is not built.
+
+Exit status 1 if any side misses the analytic event times by more than 1e-9 or visits other
+modes, or if ours (from C++, and from Python when built) is less than 100 times faster (the
+target of docs/benchmarks.md).
 """
 import json
 import os
@@ -188,6 +194,36 @@ def simulate_scipy():
     return events
 
 
+def median_seconds(call, seconds=3.0, least=5, most=50):
+    """The median wall time of `call()` over at least `least` calls, up to `most` within about
+    `seconds`."""
+    samples = []
+    deadline = time.perf_counter() + seconds
+    while len(samples) < least or (time.perf_counter() < deadline and len(samples) < most):
+        start = time.perf_counter()
+        call()
+        samples.append(time.perf_counter() - start)
+    return statistics.median(samples), len(samples)
+
+
+def from_python(build):
+    """(median seconds of Model.simulate() of the finger's cycle, its max event-time error), or
+    None if BUILD_DIR/python has no module."""
+    module_dir = os.path.join(build, "python")
+    if not os.path.isdir(os.path.join(module_dir, "hybrid")):
+        return None
+    sys.path.insert(0, os.path.abspath(module_dir))
+    import hybrid  # noqa: E402 (the build's module)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    model = hybrid.load(os.path.join(root, "spec", "finger.ha"))
+    run = model.simulate()
+    times = [e["time"] for e in run["events"]]
+    error = (max(abs(a - b) for a, b in zip(times, ANALYTIC))
+             if run["status"] == "completed" and len(times) == len(ANALYTIC) else float("inf"))
+    seconds, _ = median_seconds(model.simulate, least=200, most=5000)
+    return seconds, error
+
+
 def main():
     build = sys.argv[1] if len(sys.argv) > 1 else "build"
     exe = os.path.join(build, "benchmarks", "simulation_benchmark")
@@ -221,22 +257,30 @@ def main():
         scipy_error = float("inf")
     else:
         scipy_error = max(abs(a - b) for a, b in zip(times, ANALYTIC))
-    samples = []
-    deadline = time.perf_counter() + 3.0
-    while len(samples) < 5 or (time.perf_counter() < deadline and len(samples) < 50):
-        start = time.perf_counter()
-        simulate_scipy()
-        samples.append(time.perf_counter() - start)
-    theirs = statistics.median(samples)
+    theirs, count = median_seconds(simulate_scipy)
+    python = from_python(build)
 
     ratio = theirs / ours
     print(f"finger close-then-open cycle (spec/finger.ha default scenario, 6 events)")
     print(f"  ours : {ours * 1e6:10.2f} us per cycle (median of {len(runs)} repetitions), "
           f"max event-time error {ours_error:.3g}")
-    print(f"  scipy: {theirs * 1e6:10.2f} us per cycle (median of {len(samples)} runs, "
+    print(f"  scipy: {theirs * 1e6:10.2f} us per cycle (median of {count} runs, "
           f"scipy {scipy.__version__} solve_ivp RK45), max event-time error {scipy_error:.3g}")
     print(f"  ratio: ours is {ratio:.1f}x faster (target >= {TARGET_RATIO:g}x)")
-    for name, err in (("ours", ours_error), ("scipy", scipy_error)):
+    errors = [("ours", ours_error), ("scipy", scipy_error)]
+    if python is None:
+        print(f"  from Python: skipped ({build}/python has no module; build the target _hybrid)")
+    else:
+        python_ratio = theirs / python[0]
+        print(f"  from Python: Model.simulate {python[0] * 1e6:10.2f} us per cycle (median), "
+              f"max event-time error {python[1]:.3g}")
+        print(f"  ratio from Python: ours is {python_ratio:.1f}x faster than scipy "
+              f"(target >= {TARGET_RATIO:g}x)")
+        errors.append(("ours from Python", python[1]))
+        if python_ratio < TARGET_RATIO:
+            print(f"FAIL: ratio from Python {python_ratio:.1f} below the target {TARGET_RATIO:g}")
+            ok = False
+    for name, err in errors:
         if not err <= TOL:
             print(f"FAIL: {name} event times miss the analytic ones by {err:.3g} > {TOL:g}")
             ok = False

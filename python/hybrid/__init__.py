@@ -132,10 +132,8 @@ class Model:
             ``states`` ({variable name: numpy array}, aligned with ``time``) and ``modes`` (the
             mode at each instant, ``A.m|B.n`` for several components).
         """
-        result = self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}),
-                                      dict(init or {}), tolerance)
-        result.update(_json.loads(result.pop("report_json")))
-        return result
+        return self._model.simulate(until, dict(inputs or {}), sample, dict(parameters or {}),
+                                    dict(init or {}), tolerance)
 
     def check(self, properties=None, method="auto", budget=60.0, depth=10):
         """Checks the model's properties (``hybrid check --json``).

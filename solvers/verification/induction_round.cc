@@ -117,7 +117,10 @@ z3::check_result InductionRound::StepQuery(int m, const std::vector<std::size_t>
   }
   AddWithDefinitions(s, enc_, z3::mk_or(bad));
   const z3::check_result r =
-      meter_.Check(s, limit, ceiling_, m < 0 ? "induction" : "induction, one mode");
+      meter_.Check(s, limit, ceiling_,
+                   m < 0 ? std::string("induction")
+                         : "induction from " + enc_.automaton().modes()[m].name +
+                               (goals.size() == 1 ? ", one candidate" : ""));
   if (r == z3::sat) {
     const z3::model model = s.get_model();
     for (std::size_t g = 0; g < goals.size(); ++g) {

@@ -106,18 +106,18 @@ void QueryMeter::DumpQuery(z3::solver& s, std::uint64_t allowed) {
 }
 
 z3::check_result QueryMeter::Check(z3::solver& s, unsigned cap, std::uint64_t ceiling,
-                                   const char* what) {
+                                   const std::string& what) {
   HYBRID_ASSERT(cap > 0, "a query may use some resource units");
   if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
     ++starved_;
     if (LogEnabled(LogLevel::kDebug)) {
-      Log(LogLevel::kDebug, "prove", std::string("query (") + what + ") not run: budget spent");
+      Log(LogLevel::kDebug, "prove", "query (" + what + ") not run: budget spent");
     }
     return z3::unknown;
   }
   if (Stopped(s)) return z3::unknown;
   if (LogEnabled(LogLevel::kDebug)) {
-    Log(LogLevel::kDebug, "prove", std::string("query start (") + what + ")");
+    Log(LogLevel::kDebug, "prove", "query start (" + what + ")");
   }
   // The CPU-time limit of the query comes from the units it may use (10 s per budget second, at
   // least 10 s): work Z3's count misses (a search query of the finger's modes spent 100 s on 1.8

@@ -94,7 +94,8 @@ class QueryMeter {
   /// once the ceiling is reached or the safety deadline passed (counted in starved(), as a query
   /// that the budget, not `cap`, cut short), or when the safety net stopped an earlier query of
   /// `s`. A query that comes back unknown with less than `cap` units counts in starved() too.
-  z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling, const char* what);
+  z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling,
+                         const std::string& what);
 
   /// How many queries the budget refused or cut short so far.
   int starved() const { return starved_; }

@@ -124,13 +124,28 @@ def test_thermostat_relaxes_exponentially():
     assert r["final"]["time"] == 3.0 and r["final"]["values"]["x"] == r["states"]["x"][-1]
 
 
-def test_simulate_has_the_command_lines_members():
-    model = hybrid.load(os.path.join(SOURCE, "spec", "thermostat.ha"))
-    r = model.simulate(until=30.0, inputs={"u": 10.0})
-    cli = json.loads(run("simulate", os.path.join(SOURCE, "spec", "thermostat.ha"), "--until",
-                         "30", "--input", "u=10", "--json").stdout)
+@pytest.mark.parametrize("model, kwargs, args", [
+    ("thermostat.ha", {"until": 30.0, "inputs": {"u": 10.0}}, ["--until", "30", "--input", "u=10"]),
+    ("finger.ha", {}, []),                                          # six events, phase 1 and 2
+    ("hand.ha", {}, []),                                            # composed: A.m|B.n labels
+    ("bouncing_ball.ha", {"parameters": {"v_rest": 0.0}}, ["--set", "v_rest=0"]),  # Zeno
+    ("controlled_finger.ha", {"sample": 7.0}, ["--sample", "7"]),   # samples between events
+])
+def test_simulate_has_the_command_lines_members(model, kwargs, args):
+    # The members built in this process (the quick path) equal the program's JSON, read by the
+    # json module: the same values, key for key, Zeno's member included.
+    path = os.path.join(SOURCE, "spec", model)
+    r = hybrid.load(path).simulate(**kwargs)
+    proc = subprocess.run([BINARY, "simulate", path, *args, "--json"], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode in (0, 5), proc.stderr
+    cli = json.loads(proc.stdout)
     assert len(cli["events"]) >= 2
+    assert ("zeno" in cli) == (model == "bouncing_ball.ha")
     assert {k: v for k, v in r.items() if k not in ("time", "states", "modes")} == cli
+    # The trajectory's last instant is the report's final state.
+    assert r["modes"][-1] == cli["final"]["mode"] and r["time"][-1] == cli["final"]["time"]
+    assert {name: column[-1] for name, column in r["states"].items()} == cli["final"]["values"]
 
 
 def test_tank_inputs_and_parameters(tmp_path):
