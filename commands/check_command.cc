@@ -502,6 +502,50 @@ void WriteReachPlot(const CheckArgs& args, const Simulator& sim, const Findings&
   WriteOutput(args.plot_reach, svg);
 }
 
+// --modes: `reach in MODE` for every mode of every component (PropertyProver::ModeQueries), with
+// the model's declared invariants beside them as lemmas for the prover's induction (their verdicts
+// are not reported again). Sampled runs first: most modes are reached by some run, whose replayed
+// trace decides them at a fraction of a proof's cost. Then --method on what they leave open (auto:
+// reach, flowpipe, prove), its
+// prover searching witnesses one step deep only (the samples searched the longer paths): what is
+// left is mostly unreachable, which induction with the invariants proves or not.
+std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodContext& context,
+                                                                   const System& system) {
+  std::vector<Property> queries;
+  for (const Property& p : DeclaredProperties(system)) {
+    if (p.kind != Property::Kind::kReach) queries.push_back(p);
+  }
+  const std::size_t lemmas = queries.size();
+  for (std::size_t c = 0; c < system.components().size(); ++c) {
+    const std::vector<Property> modes = PropertyProver::ModeQueries(system, static_cast<int>(c));
+    queries.insert(queries.end(), modes.begin(), modes.end());
+  }
+  MethodContext shallow = context;
+  shallow.prove.max_depth = 1;
+  shallow.reach_set = nullptr;
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(MakeSample(shallow));
+  if (context.args.method == "auto") {  // auto's engines, its sampling already done
+    checkers.push_back(MakeReach(shallow));
+    checkers.push_back(MakeFlowpipe(shallow));
+    checkers.push_back(MakeProve(shallow));
+  } else if (context.args.method != "sample") {
+    checkers.push_back(Methods(shallow).Make(context.args.method));
+  }
+  const std::vector<CheckResult> results =
+      FallbackChecker("modes", std::move(checkers)).Check(system, queries);
+  std::vector<std::vector<PropertyProver::ModeReachability>> out;
+  std::size_t next = lemmas;
+  for (std::size_t c = 0; c < system.components().size(); ++c) {
+    const std::size_t count =
+        static_cast<std::size_t>(system.components()[c].automaton.num_modes());
+    out.push_back(PropertyProver::ModeResults(system, static_cast<int>(c),
+                                              std::span(results).subspan(next, count)));
+    next += count;
+  }
+  return out;
+}
+
 // Checks the chosen properties of `system` (and with --modes its discrete states).
 Findings FindingsOf(const CheckArgs& args, const System& system) {
   CheckOptions(args);
@@ -543,10 +587,7 @@ Findings FindingsOf(const CheckArgs& args, const System& system) {
   }
   if (args.modes) {
     stage = "modes";
-    for (std::size_t c = 0; c < system.components().size(); ++c) {
-      found.modes.push_back(
-          PropertyProver(prove).ReachableModes(system, static_cast<int>(c), budget));
-    }
+    found.modes = ModesOf(context, system);
   }
   found.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return found;

@@ -7,6 +7,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "automaton/internal_assert.h"
 #include "hybrid/automaton/log.h"
 #include "solvers/verification/proof_plan.h"
 #include "solvers/verification/proof_run.h"
@@ -66,13 +67,24 @@ std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(con
 
 std::vector<PropertyProver::ModeReachability> PropertyProver::ReachableModes(
     const System& system, int component, SolverBudget& budget) const {
+  return ModeResults(system, component, Check(system, ModeQueries(system, component), budget));
+}
+
+std::vector<Property> PropertyProver::ModeQueries(const System& system, int component) {
   const Component& comp = system.components()[component];
   std::vector<Property> queries;
   for (int m = 0; m < comp.automaton.num_modes(); ++m) {
     const std::string name = system.QualifiedModeName(component, ModeId(m));
     queries.push_back({"reach " + name, Property::Kind::kReach, Predicate::InMode(name), {}});
   }
-  const std::vector<CheckResult> results = Check(system, queries, budget);
+  return queries;
+}
+
+std::vector<PropertyProver::ModeReachability> PropertyProver::ModeResults(
+    const System& system, int component, std::span<const CheckResult> results) {
+  const Component& comp = system.components()[component];
+  HYBRID_ASSERT(results.size() == static_cast<std::size_t>(comp.automaton.num_modes()),
+                "one verdict per mode");
   std::vector<ModeReachability> out;
   for (int m = 0; m < comp.automaton.num_modes(); ++m) {
     const Mode& mode = comp.automaton.mode(ModeId(m));

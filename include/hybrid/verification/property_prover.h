@@ -119,6 +119,13 @@ class PropertyProver {
   /// The same, drawing from `budget`.
   std::vector<ModeReachability> ReachableModes(const System& system, int component,
                                                SolverBudget& budget) const;
+  /// The queries of ReachableModes: `reach in MODE` for each mode of component `component`, in
+  /// mode order, named "reach MODE" (the qualified mode name).
+  static std::vector<Property> ModeQueries(const System& system, int component);
+  /// ReachableModes' answer from `results`, the verdicts of ModeQueries(system, component) in
+  /// order (by any checker).
+  static std::vector<ModeReachability> ModeResults(const System& system, int component,
+                                                   std::span<const CheckResult> results);
 
   const Options& options() const { return options_; }
 
