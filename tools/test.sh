@@ -22,7 +22,11 @@ run_release() {
 
 run_sanitized() {
   "$root/tools/setup.sh"
+  # -g1: line tables only. The sanitizers' reports keep file:line:column in every frame, and the
+  # build takes a third less time than with full debug information (-g: the parser alone, 113 s
+  # of one core against 61 s).
   cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHYBRID_SANITIZE=ON \
+    -DCMAKE_CXX_FLAGS_DEBUG=-g1 \
     -DHYBRID_BUILD_BENCHMARKS=OFF \
     -DHYBRID_RC_PARAMS="seed=20261121 max_success=60" \
     -DHYBRID_RC_PARAMS_SLOW="seed=20261121 max_success=20" -DHYBRID_TEST_TIMEOUT=1200
