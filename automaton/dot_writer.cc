@@ -230,7 +230,8 @@ std::string MergedClusterLabel(std::span<const Component> components,
       instances + ": " + first.source.name() + "\n" + "x stands for " + qualified + "\n";
   std::string shared;
   std::set<std::string> shared_names;
-  for (const auto& [name, in_system] : others.front()) {
+  for (const auto& [key, in_system] : others.front()) {
+    const std::string& name = key;  // Clang 14 cannot capture a structured binding.
     const auto kept = [&](const auto& o) { return o.count(name) > 0 && o.at(name) == name; };
     if (in_system == name && std::all_of(others.begin(), others.end(), kept)) {
       shared += (shared.empty() ? "" : ", ") + name;
