@@ -4,9 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <ranges>
 #include <stdexcept>
 #include <string>
+
+#include "gripper/partition_index.h"
 
 namespace hybrid::gripper {
 
@@ -164,12 +165,12 @@ std::optional<Hit> FirstGeometricContact(const FingerClosedForm& cf, const Obsta
     const PieceGrid grid(piece, cf.parameters(), lo, hi);
     for (long k = 1; k < grid.size(); ++k) {
       // The first grid point from k on not proved clear (the bound grows with the point).
-      k = *std::ranges::partition_point(std::views::iota(k, grid.size()), [&](long j) {
+      k = PartitionIndex(k, grid.size(), [&](long j) {
         return ProvedClear(cf, obstacles.geometry, g_eval, grid[j], slack);
       });
       if (k >= grid.size()) break;
       const std::array<double, 3> at_k = Slack(cf, obstacles, grid[k], contacts);
-      if (std::ranges::min(at_k) <= 0.0) {
+      if (*std::min_element(at_k.begin(), at_k.end()) <= 0.0) {
         for (int i = 0; i < 3; ++i) {
           if (contacts.gob[i] != FingerContacts::kNone) continue;
           for (int o = kPalm; o < num_objects; ++o) {

@@ -5,8 +5,9 @@
 #include <limits>
 #include <numbers>
 #include <optional>
-#include <ranges>
 #include <stdexcept>
+
+#include "gripper/partition_index.h"
 
 namespace hybrid::gripper {
 namespace {
@@ -208,7 +209,7 @@ std::optional<Hand::FingerTouch> FirstTouch(const Hand& hand, double g0) {
   double g_eval = g0;
   ClosestLinks separation = Separations(previous, width);
   for (long k = 1; k <= count && !first; ++k) {
-    const long next = *std::ranges::partition_point(std::views::iota(k, count + 1), [&](long j) {
+    const long next = PartitionIndex(k, count + 1, [&](long j) {
       return ProvedApart(hand, g_eval, at(j), separation);
     });
     if (next > count) break;
