@@ -25,8 +25,10 @@ Exit status: 0; 1 if some status is MISMATCH (with --require-all: also if some i
 --peer-command TEMPLATE runs a peer tool once per model for comparison, e.g.
   --peer-command 'peer_checker --model {model}'   ({model}: the model's path, shell-quoted;
   {name}: the model's file name without .ha)
-through the shell, with the same --timeout, and prints its wall time and the ratio of our wall
-time (the whole `hybrid check` process) to the peer's. The peer's verdicts are not read.
+through the shell, with the same --timeout, and prints its wall and CPU times (user + system, of
+the command and what it waited for) and the ratios of ours (the whole `hybrid check` process) to
+the peer's. The peer's verdicts are not read. --repeat N runs each model N times, ours and the
+peer's in turns, and reports the medians.
 
 --per-property runs `hybrid check --property P` once per expected property, and the peer command
 (which may then name {property}) once per property too, for tools that check one property per
@@ -40,6 +42,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import shlex
 import signal
 import subprocess
@@ -119,6 +122,20 @@ def terminated(signum, frame):
 def run(command, timeout, shell=False):
     """(exit code or None on timeout, stdout, stderr, wall seconds); the whole process group is
     killed after `timeout` seconds."""
+    return run_timed(command, timeout, shell)[:4]
+
+
+def run_timed(command, timeout, shell=False):
+    """run()'s tuple and the CPU seconds (user + system) of the command and of every process it
+    waited for: the change of RUSAGE_CHILDREN across the run, the runs being one at a time."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    code, out, err, wall = run_process(command, timeout, shell)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return code, out, err, wall, cpu
+
+
+def run_process(command, timeout, shell):
     start = time.monotonic()
     process = subprocess.Popen(command, shell=shell, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
@@ -160,7 +177,7 @@ def check_model(hybrid, path, key, properties, args, only=None):
         command += ["--budget", str(args.budget)]
     if args.method:
         command += ["--method", args.method]
-    code, out, err, wall = run(command, args.timeout)
+    code, out, err, wall, cpu = run_timed(command, args.timeout)
     reported = {}
     failure = None
     if code is None:
@@ -196,7 +213,42 @@ def check_model(hybrid, path, key, properties, args, only=None):
             status = "MISMATCH"
         rows.append({"file": key, "property": name, "expected": want, "got": got,
                      "method": method, "seconds": seconds, "status": status, "reason": reason})
-    return rows, wall
+    return rows, wall, cpu
+
+
+def median(values):
+    ordered = sorted(values)
+    middle = len(ordered) // 2
+    return ordered[middle] if len(ordered) % 2 else (ordered[middle - 1] + ordered[middle]) / 2
+
+
+def compare_model(path, key, properties, args):
+    """The rows of one model (its first run) and its entry of "models": our wall and CPU seconds
+    and, with --peer-command, the peer's, each the median of --repeat runs made in turns (ours,
+    the peer's, ours, ...), so that a change of the machine's load falls on both."""
+    rows, walls, cpus, peer_walls, peer_cpus, peer_codes = None, [], [], [], [], []
+    for _ in range(args.repeat):
+        model_rows, wall, cpu = check_model(args.hybrid, path, key, properties, args)
+        rows = rows if rows is not None else model_rows
+        walls.append(wall)
+        cpus.append(cpu)
+        if args.peer_command:
+            command = peer_template(args.peer_command, path)
+            code, _, _, peer_wall, peer_cpu = run_timed(command, args.timeout, shell=True)
+            peer_walls.append(peer_wall)
+            peer_cpus.append(peer_cpu)
+            peer_codes.append(code)
+    entry = {"file": key, "seconds": median(walls), "cpu_seconds": median(cpus),
+             "runs": args.repeat}
+    if args.peer_command:
+        peer, peer_cpu = median(peer_walls), median(peer_cpus)
+        # A timeout in any run counts (None); else the last run's exit code.
+        code = None if None in peer_codes else peer_codes[-1]
+        entry.update({"peer_seconds": peer, "peer_cpu_seconds": peer_cpu,
+                      "peer_exit_code": code,
+                      "ratio": entry["seconds"] / peer if peer > 0 else None,
+                      "cpu_ratio": entry["cpu_seconds"] / peer_cpu if peer_cpu > 0 else None})
+    return rows, entry
 
 
 def format_row(row, widths):
@@ -233,6 +285,9 @@ def main():
     parser.add_argument("--peer-command", metavar="TEMPLATE",
                         help="shell command of a peer tool, {model} replaced by the model's "
                              "path; its wall time and the ratio ours/peer are printed")
+    parser.add_argument("--repeat", type=int, default=1, metavar="N",
+                        help="run each model N times (in turns with the peer's) and report the "
+                             "medians of the wall and CPU times (default 1)")
     parser.add_argument("--per-property", action="store_true",
                         help="one run per property, ours (--property) and the peer's "
                              "({property} in its template)")
@@ -240,6 +295,10 @@ def main():
                         help="the table of expected verdicts (default: spec/benchmarks/"
                              "expected.tsv)")
     args = parser.parse_args()
+    if args.repeat < 1:
+        parser.error("--repeat must be at least 1")
+    if args.repeat > 1 and args.per_property:
+        parser.error("--repeat applies to whole models, not to --per-property runs")
     signal.signal(signal.SIGTERM, terminated)
 
     expected = read_expected(args.expected)
@@ -272,8 +331,8 @@ def main():
     for path, key in models:
         if args.per_property:
             for prop, _ in expected.get(key, []):
-                model_rows, ours = check_model(args.hybrid, path, key, expected.get(key, []),
-                                               args, only=prop)
+                model_rows, ours, _ = check_model(args.hybrid, path, key,
+                                                  expected.get(key, []), args, only=prop)
                 rows += model_rows
                 entry = {"file": key, "property": prop, "seconds": ours}
                 if args.peer_command:
@@ -300,14 +359,9 @@ def main():
                                  ours, ratio))
                     sys.stdout.flush()
             continue
-        model_rows, ours = check_model(args.hybrid, path, key, expected.get(key, []), args)
+        model_rows, entry = compare_model(path, key, expected.get(key, []), args)
         rows += model_rows
-        entry = {"file": key, "seconds": ours}
-        if args.peer_command:
-            command = peer_template(args.peer_command, path)
-            code, _, err, peer = run(command, args.timeout, shell=True)
-            entry.update({"peer_seconds": peer, "peer_exit_code": code,
-                          "ratio": ours / peer if peer > 0 else None})
+        ours = entry["seconds"]
         per_model.append(entry)
         if not args.json:
             for row in model_rows:
@@ -317,8 +371,12 @@ def main():
                 status = ("timeout" if entry["peer_exit_code"] is None
                           else "exit %d" % entry["peer_exit_code"])
                 ratio = "-" if entry["ratio"] is None else "%.3g" % entry["ratio"]
-                print("  %s: ours %.3f s, peer %.3f s (%s), ours/peer %s"
-                      % (key, ours, entry["peer_seconds"], status, ratio))
+                cpu_ratio = "-" if entry["cpu_ratio"] is None else "%.3g" % entry["cpu_ratio"]
+                print("  %s: ours %.3f s, peer %.3f s (%s), ours/peer %s; CPU ours %.3f s, "
+                      "peer %.3f s, ours/peer %s%s"
+                      % (key, ours, entry["peer_seconds"], status, ratio, entry["cpu_seconds"],
+                         entry["peer_cpu_seconds"], cpu_ratio,
+                         "" if args.repeat == 1 else " (medians of %d)" % args.repeat))
             sys.stdout.flush()
     total = time.monotonic() - start
 
@@ -347,6 +405,12 @@ def main():
             peer = sum(m["peer_seconds"] for m in per_model)
             print("wall time: ours %.1f s, peer %.1f s, ours/peer %s"
                   % (ours, peer, "%.3g" % (ours / peer) if peer > 0 else "-"))
+            if not args.per_property:
+                ours_cpu = sum(m["cpu_seconds"] for m in per_model)
+                peer_cpu = sum(m["peer_cpu_seconds"] for m in per_model)
+                print("CPU time: ours %.1f s, peer %.1f s, ours/peer %s"
+                      % (ours_cpu, peer_cpu, "%.3g" % (ours_cpu / peer_cpu) if peer_cpu > 0
+                         else "-"))
             ratios = [m["ratio"] for m in per_model if m.get("ratio")]
             if ratios:
                 print("ratio ours/peer per run: max %.3g, median %.3g; %d of %d runs faster than "

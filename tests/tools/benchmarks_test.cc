@@ -118,5 +118,34 @@ TEST(BenchmarksTest, JsonAndPeerCommand) {
   EXPECT_TRUE(Field(report, "models", 1, "ratio").is_number());
 }
 
+// --repeat N runs each model N times, in turns with the peer's, and reports the medians of the
+// wall and CPU times; the CPU time counts the peer's process (here one that spins 0.2 s of
+// CPU time by its own clock).
+TEST(BenchmarksTest, RepeatReportsMediansOfWallAndCpuTimes) {
+  const std::string spin =
+      "python3 -c 'import time; t = time.process_time(); "
+      "[0 for _ in iter(lambda: time.process_time() - t < 0.2, False)]'";
+  const ScriptRun run =
+      RunScript("--json --repeat 3 --peer-command " + Quote(spin) + " water_tank");
+  SKIP_WITHOUT_PYTHON(run);
+  ASSERT_EQ(ExitCode(run), 0) << run.output;
+  const nlohmann::json report = nlohmann::json::parse(run.output);
+  const nlohmann::json& model = Field(report, "models", 0);
+  EXPECT_EQ(Field(model, "runs"), 3);
+  EXPECT_GE(Field(model, "peer_cpu_seconds").get<double>(), 0.2);
+  EXPECT_LT(Field(model, "peer_cpu_seconds").get<double>(), 5.0);
+  EXPECT_GT(Field(model, "cpu_seconds").get<double>(), 0.0);
+  EXPECT_TRUE(Field(model, "cpu_ratio").is_number());
+  EXPECT_EQ(Field(report, "counts", "OK"), 4);  // water_tank's 4 verdicts, of the first run
+}
+
+TEST(BenchmarksTest, RepeatMustBePositiveAndWholeModel) {
+  const ScriptRun zero = RunScript("--repeat 0 water_tank");
+  SKIP_WITHOUT_PYTHON(zero);
+  EXPECT_EQ(ExitCode(zero), 2) << zero.output;
+  EXPECT_NE(zero.output.find("--repeat must be at least 1"), std::string::npos) << zero.output;
+  EXPECT_EQ(ExitCode(RunScript("--repeat 2 --per-property water_tank")), 2);
+}
+
 }  // namespace
 }  // namespace hybrid::testing
