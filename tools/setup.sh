@@ -14,6 +14,7 @@ packages=(
   libppl-dev             # PPL: exact polyhedra in `hybrid check --method reach`
   libpugixml-dev         # pugixml: SpaceEx models (`hybrid import`, .xml models)
   libceres-dev           # Ceres: robust refinement of fitted effects in `hybrid diagnose`
+  libgoogle-perftools-dev  # tcmalloc_minimal: the hybrid program's allocator (docs/dependencies.md)
   libbenchmark-dev       # Google Benchmark
   tao-pegtl-dev          # the model-language grammar
   libcli11-dev           # the `hybrid` command line
