@@ -453,7 +453,9 @@ ExitCode RunModelCommand(const Commands& c) {
   }
   std::string text;
   try {
-    hybrid::DotOptions options{.product = c.product, .compact = c.compact};
+    hybrid::DotOptions options;
+    options.product = c.product;
+    options.compact = c.compact;
     if (!c.group_by.empty()) {
       options.group = hybrid::cli::ModeGroups(c.group_by, system, {hybrid::cli::PhaseGrouping()});
     }
