@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <set>
+#include <sstream>
 #include <string>
 
 #include "tests/test_utilities/command_line.h"
@@ -139,12 +141,47 @@ TEST(BenchmarksTest, RepeatReportsMediansOfWallAndCpuTimes) {
   EXPECT_EQ(Field(report, "counts", "OK"), 4);  // water_tank's 4 verdicts, of the first run
 }
 
-TEST(BenchmarksTest, RepeatMustBePositiveAndWholeModel) {
+// With --per-property, each property's runs are repeated (and the peer's verdict read).
+TEST(BenchmarksTest, RepeatPerPropertyAndItsBounds) {
+  const ScriptRun run = RunScript(
+      "--json --repeat 2 --per-property --peer-command 'echo {name} {property} SAFE' water_tank");
+  SKIP_WITHOUT_PYTHON(run);
+  ASSERT_EQ(ExitCode(run), 0) << run.output;
+  const nlohmann::json report = nlohmann::json::parse(run.output);
+  ASSERT_EQ(Field(report, "models").size(), 4u);
+  EXPECT_EQ(Field(report, "models", 0, "property"), "level_in_range");
+  EXPECT_EQ(Field(report, "models", 0, "runs"), 2);
+  EXPECT_EQ(Field(report, "models", 0, "peer_verdict"), "SAFE");
   const ScriptRun zero = RunScript("--repeat 0 water_tank");
-  SKIP_WITHOUT_PYTHON(zero);
   EXPECT_EQ(ExitCode(zero), 2) << zero.output;
   EXPECT_NE(zero.output.find("--repeat must be at least 1"), std::string::npos) << zero.output;
-  EXPECT_EQ(ExitCode(RunScript("--repeat 2 --per-property water_tank")), 2);
+}
+
+/// The rows (file, property, expected verdict) of a table of expected verdicts; comments and the
+/// header left out.
+std::set<std::array<std::string, 3>> ExpectedRows(const std::string& path) {
+  std::set<std::array<std::string, 3>> rows;
+  std::istringstream text(ReadAll(path));
+  std::string line;
+  while (std::getline(text, line)) {
+    if (line.empty() || line[0] == '#' || line.starts_with("file\t")) continue;
+    std::array<std::string, 3> row;
+    std::istringstream fields(line);
+    for (std::string& field : row) std::getline(fields, field, '\t');
+    rows.insert(row);
+  }
+  return rows;
+}
+
+// The ARCH-COMP instances' properties (the peer comparison's table) are rows of expected.tsv,
+// with the same verdicts.
+TEST(BenchmarksTest, ArchCompTableIsPartOfTheExpectedTable) {
+  const auto all = ExpectedRows(kSource + "/spec/benchmarks/expected.tsv");
+  const auto arch = ExpectedRows(kSource + "/spec/benchmarks/expected_arch_comp.tsv");
+  EXPECT_EQ(arch.size(), 10u);
+  for (const auto& row : arch) {
+    EXPECT_EQ(all.count(row), 1u) << row[0] << " " << row[1] << " " << row[2];
+  }
 }
 
 }  // namespace
