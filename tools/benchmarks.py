@@ -14,8 +14,10 @@ run decides share its time), status:
   OK        the verdict is the expected one
   MISMATCH  a decided verdict (proved, violated, reachable, unreachable) other than the
             expected one
-  UNKNOWN   no decided verdict: `unknown` (the tool's reason is listed below the table), or the
-            run timed out (`timeout`), failed (`error`) or did not report the property (`missing`)
+  UNKNOWN   no decided verdict: `unknown` (the tool's reason is listed below the table), a proof
+            of the runs up to a time only (`proved within T`, `unreachable within T`: not the
+            unbounded property's verdict), or the run timed out (`timeout`), failed (`error`)
+            or did not report the property (`missing`)
   -         a decided verdict for a property expected.tsv does not list (expected `-`)
 Then the unknowns with their reasons and the total time.
 
@@ -199,6 +201,10 @@ def check_model(hybrid, path, key, properties, args, only=None):
         if p is not None:
             got, method = p.get("verdict", "?"), p.get("method", "-")
             seconds, reason = p.get("seconds"), p.get("reason", "")
+            if "verdict_within" in p:
+                # A proof of the runs up to a time only ("proved within T"): not the verdict of
+                # the unbounded property, so undecided here.
+                got = "%s within %g" % (got, p["verdict_within"])
         elif failure is not None:
             (got, reason), method, seconds = failure, "-", None
         else:
@@ -222,30 +228,35 @@ def median(values):
     return ordered[middle] if len(ordered) % 2 else (ordered[middle - 1] + ordered[middle]) / 2
 
 
-def compare_model(path, key, properties, args):
-    """The rows of one model (its first run) and its entry of "models": our wall and CPU seconds
-    and, with --peer-command, the peer's, each the median of --repeat runs made in turns (ours,
-    the peer's, ours, ...), so that a change of the machine's load falls on both."""
+def compare_model(path, key, properties, args, only=None):
+    """The rows of one model (its first run; of property `only` alone if given) and its entry of
+    "models": our wall and CPU seconds and, with --peer-command, the peer's (and the verdict in
+    its last output), each the median of --repeat runs made in turns (ours, the peer's, ours,
+    ...), so that a change of the machine's load falls on both."""
     rows, walls, cpus, peer_walls, peer_cpus, peer_codes = None, [], [], [], [], []
+    peer_output = ""
     for _ in range(args.repeat):
-        model_rows, wall, cpu = check_model(args.hybrid, path, key, properties, args)
+        model_rows, wall, cpu = check_model(args.hybrid, path, key, properties, args, only=only)
         rows = rows if rows is not None else model_rows
         walls.append(wall)
         cpus.append(cpu)
         if args.peer_command:
-            command = peer_template(args.peer_command, path)
-            code, _, _, peer_wall, peer_cpu = run_timed(command, args.timeout, shell=True)
+            command = peer_template(args.peer_command, path, only)
+            code, out, err, peer_wall, peer_cpu = run_timed(command, args.timeout, shell=True)
+            peer_output = out + err
             peer_walls.append(peer_wall)
             peer_cpus.append(peer_cpu)
             peer_codes.append(code)
     entry = {"file": key, "seconds": median(walls), "cpu_seconds": median(cpus),
              "runs": args.repeat}
+    if only is not None:
+        entry["property"] = only
     if args.peer_command:
         peer, peer_cpu = median(peer_walls), median(peer_cpus)
         # A timeout in any run counts (None); else the last run's exit code.
         code = None if None in peer_codes else peer_codes[-1]
         entry.update({"peer_seconds": peer, "peer_cpu_seconds": peer_cpu,
-                      "peer_exit_code": code,
+                      "peer_exit_code": code, "peer_verdict": peer_verdict(peer_output),
                       "ratio": entry["seconds"] / peer if peer > 0 else None,
                       "cpu_ratio": entry["cpu_seconds"] / peer_cpu if peer_cpu > 0 else None})
     return rows, entry
@@ -297,8 +308,6 @@ def main():
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error("--repeat must be at least 1")
-    if args.repeat > 1 and args.per_property:
-        parser.error("--repeat applies to whole models, not to --per-property runs")
     signal.signal(signal.SIGTERM, terminated)
 
     expected = read_expected(args.expected)
@@ -331,19 +340,14 @@ def main():
     for path, key in models:
         if args.per_property:
             for prop, _ in expected.get(key, []):
-                model_rows, ours, _ = check_model(args.hybrid, path, key,
-                                                  expected.get(key, []), args, only=prop)
+                model_rows, entry = compare_model(path, key, expected.get(key, []), args,
+                                                  only=prop)
+                ours = entry["seconds"]
                 rows += model_rows
-                entry = {"file": key, "property": prop, "seconds": ours}
                 if args.peer_command:
-                    code, out, err, peer = run(peer_template(args.peer_command, path, prop),
-                                               args.timeout, shell=True)
-                    verdict = peer_verdict(out + err)
                     # A property the peer has no run for ("-") is not compared.
-                    entry.update({"peer_seconds": peer, "peer_exit_code": code,
-                                  "peer_verdict": verdict,
-                                  "ratio": ours / peer if peer > 0 and verdict != "-"
-                                  else None})
+                    if entry["peer_verdict"] == "-":
+                        entry["ratio"] = entry["cpu_ratio"] = None
                     for r in model_rows:
                         r["peer_verdict"] = entry["peer_verdict"]
                 per_model.append(entry)
@@ -353,10 +357,15 @@ def main():
                         print(format_row(row, widths))
                     if args.peer_command:
                         ratio = "-" if entry["ratio"] is None else "%.3g" % entry["ratio"]
-                        print("    peer: %s in %.3f s%s; ours %.3f s; ours/peer %s"
+                        cpu_ratio = ("-" if entry["cpu_ratio"] is None
+                                     else "%.3g" % entry["cpu_ratio"])
+                        print("    peer: %s in %.3f s%s; ours %.3f s; ours/peer %s; CPU ours "
+                              "%.3f s, peer %.3f s, ours/peer %s%s"
                               % (entry["peer_verdict"], entry["peer_seconds"],
                                  "" if entry["peer_exit_code"] is not None else " (timeout)",
-                                 ours, ratio))
+                                 ours, ratio, entry["cpu_seconds"], entry["peer_cpu_seconds"],
+                                 cpu_ratio,
+                                 "" if args.repeat == 1 else " (medians of %d)" % args.repeat))
                     sys.stdout.flush()
             continue
         model_rows, entry = compare_model(path, key, expected.get(key, []), args)
@@ -405,12 +414,18 @@ def main():
             peer = sum(m["peer_seconds"] for m in per_model)
             print("wall time: ours %.1f s, peer %.1f s, ours/peer %s"
                   % (ours, peer, "%.3g" % (ours / peer) if peer > 0 else "-"))
-            if not args.per_property:
-                ours_cpu = sum(m["cpu_seconds"] for m in per_model)
-                peer_cpu = sum(m["peer_cpu_seconds"] for m in per_model)
-                print("CPU time: ours %.1f s, peer %.1f s, ours/peer %s"
-                      % (ours_cpu, peer_cpu, "%.3g" % (ours_cpu / peer_cpu) if peer_cpu > 0
-                         else "-"))
+            compared = [m for m in per_model if m.get("cpu_ratio") is not None]
+            ours_cpu = sum(m["cpu_seconds"] for m in compared)
+            peer_cpu = sum(m["peer_cpu_seconds"] for m in compared)
+            print("CPU time of the %d runs compared: ours %.1f s, peer %.1f s, ours/peer %s"
+                  % (len(compared), ours_cpu, peer_cpu,
+                     "%.3g" % (ours_cpu / peer_cpu) if peer_cpu > 0 else "-"))
+            cpu_ratios = sorted(m["cpu_ratio"] for m in compared)
+            if cpu_ratios:
+                print("CPU ratio ours/peer per run: max %.3g, median %.3g; %d of %d at most 1, "
+                      "%d at most 1.5" % (cpu_ratios[-1], median(cpu_ratios),
+                                         sum(r <= 1 for r in cpu_ratios),
+                                         len(cpu_ratios), sum(r <= 1.5 for r in cpu_ratios)))
             ratios = [m["ratio"] for m in per_model if m.get("ratio")]
             if ratios:
                 print("ratio ours/peer per run: max %.3g, median %.3g; %d of %d runs faster than "

@@ -157,6 +157,21 @@ TEST(BenchmarksTest, RepeatPerPropertyAndItsBounds) {
   EXPECT_NE(zero.output.find("--repeat must be at least 1"), std::string::npos) << zero.output;
 }
 
+// A proof of the runs up to a time only (the flowpipe's "unreachable within 0.5" on nav2, which
+// it leaves at its bound of mode entries) is not the unbounded property's verdict: UNKNOWN.
+TEST(BenchmarksTest, BoundedProofIsNotTheExpectedVerdict) {
+  const ScriptRun run = RunScript("--json --method flowpipe nav2");
+  SKIP_WITHOUT_PYTHON(run);
+  ASSERT_EQ(ExitCode(run), 0) << run.output;
+  const nlohmann::json report = nlohmann::json::parse(run.output);
+  const nlohmann::json& target = Field(report, "properties", 0);
+  ASSERT_EQ(Field(target, "property"), "target");
+  EXPECT_TRUE(Field(target, "got").get<std::string>().starts_with("unreachable within "))
+      << target.dump();
+  EXPECT_EQ(Field(target, "status"), "UNKNOWN");
+  EXPECT_EQ(Field(report, "counts", "OK"), 0);
+}
+
 /// The rows (file, property, expected verdict) of a table of expected verdicts; comments and the
 /// header left out.
 std::set<std::array<std::string, 3>> ExpectedRows(const std::string& path) {
