@@ -1,5 +1,4 @@
-#ifndef HYBRID_GRIPPER_PARTITION_INDEX_H_
-#define HYBRID_GRIPPER_PARTITION_INDEX_H_
+#pragma once
 
 namespace hybrid {
 
@@ -21,5 +20,3 @@ long PartitionIndex(long lo, long hi, const Predicate& holds) {
 }
 
 }  // namespace hybrid
-
-#endif  // HYBRID_GRIPPER_PARTITION_INDEX_H_
