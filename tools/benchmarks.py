@@ -258,7 +258,9 @@ def compare_model(path, key, properties, args, only=None):
         entry.update({"peer_seconds": peer, "peer_cpu_seconds": peer_cpu,
                       "peer_exit_code": code, "peer_verdict": peer_verdict(peer_output),
                       "ratio": entry["seconds"] / peer if peer > 0 else None,
-                      "cpu_ratio": entry["cpu_seconds"] / peer_cpu if peer_cpu > 0 else None})
+                      # A peer killed at the timeout was not waited for: its CPU time is lost.
+                      "cpu_ratio": entry["cpu_seconds"] / peer_cpu
+                      if peer_cpu > 0 and code is not None else None})
     return rows, entry
 
 
@@ -295,7 +297,7 @@ def main():
                         help="an undecided verdict (unknown, timeout, error) is a failure too")
     parser.add_argument("--peer-command", metavar="TEMPLATE",
                         help="shell command of a peer tool, {model} replaced by the model's "
-                             "path; its wall time and the ratio ours/peer are printed")
+                             "path; its wall and CPU times and the ratios ours/peer are printed")
     parser.add_argument("--repeat", type=int, default=1, metavar="N",
                         help="run each model N times (in turns with the peer's) and report the "
                              "medians of the wall and CPU times (default 1)")
