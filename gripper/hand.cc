@@ -209,9 +209,8 @@ std::optional<Hand::FingerTouch> FirstTouch(const Hand& hand, double g0) {
   double g_eval = g0;
   ClosestLinks separation = Separations(previous, width);
   for (long k = 1; k <= count && !first; ++k) {
-    const long next = PartitionIndex(k, count + 1, [&](long j) {
-      return ProvedApart(hand, g_eval, at(j), separation);
-    });
+    const long next = PartitionIndex(
+        k, count + 1, [&](long j) { return ProvedApart(hand, g_eval, at(j), separation); });
     if (next > count) break;
     if (next > k) previous = LinksAt(hand, at(next - 1));
     k = next;
