@@ -122,22 +122,11 @@ def terminated(signum, frame):
 
 
 def run(command, timeout, shell=False):
-    """(exit code or None on timeout, stdout, stderr, wall seconds); the whole process group is
-    killed after `timeout` seconds."""
-    return run_timed(command, timeout, shell)[:4]
-
-
-def run_timed(command, timeout, shell=False):
-    """run()'s tuple and the CPU seconds (user + system) of the command and of every process it
-    waited for: the change of RUSAGE_CHILDREN across the run, the runs being one at a time."""
+    """(exit code or None on timeout, stdout, stderr, wall seconds, CPU seconds); the whole
+    process group is killed after `timeout` seconds. The CPU seconds (user + system) are those of
+    the command and of every process it waited for: the change of RUSAGE_CHILDREN across the run
+    (the runs are one at a time); a process group killed at the timeout loses its children's."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    code, out, err, wall = run_process(command, timeout, shell)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return code, out, err, wall, cpu
-
-
-def run_process(command, timeout, shell):
     start = time.monotonic()
     process = subprocess.Popen(command, shell=shell, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
@@ -153,8 +142,10 @@ def run_process(command, timeout, shell):
         kill_group(process)
         process.wait()
         raise
-    return code, out.decode(errors="replace"), err.decode(errors="replace"), \
-        time.monotonic() - start
+    wall = time.monotonic() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return code, out.decode(errors="replace"), err.decode(errors="replace"), wall, cpu
 
 
 def peer_verdict(text):
@@ -179,7 +170,7 @@ def check_model(hybrid, path, key, properties, args, only=None):
         command += ["--budget", str(args.budget)]
     if args.method:
         command += ["--method", args.method]
-    code, out, err, wall, cpu = run_timed(command, args.timeout)
+    code, out, err, wall, cpu = run(command, args.timeout)
     reported = {}
     failure = None
     if code is None:
@@ -242,7 +233,7 @@ def compare_model(path, key, properties, args, only=None):
         cpus.append(cpu)
         if args.peer_command:
             command = peer_template(args.peer_command, path, only)
-            code, out, err, peer_wall, peer_cpu = run_timed(command, args.timeout, shell=True)
+            code, out, err, peer_wall, peer_cpu = run(command, args.timeout, shell=True)
             peer_output = out + err
             peer_walls.append(peer_wall)
             peer_cpus.append(peer_cpu)
