@@ -10,17 +10,21 @@ namespace hybrid {
 
 InductionRound::InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigned resource_limit,
                                int k, std::vector<ProofCandidate*> candidates,
-                               std::uint64_t ceiling)
+                               std::uint64_t ceiling, std::vector<const ProofCandidate*> lemmas)
     : enc_(encoding),
       meter_(meter),
       ctx_(encoding.context()),
       resource_limit_(resource_limit),
       k_(k),
       ceiling_(ceiling),
-      set_(std::move(candidates)) {
+      set_(std::move(candidates)),
+      lemmas_(std::move(lemmas)) {
   HYBRID_ASSERT(k >= 1, "k-induction starts at k = 1");
   for (const ProofCandidate* c : set_) {
     HYBRID_ASSERT(c != nullptr && c->invariant, "induction candidates are invariants");
+  }
+  for (const ProofCandidate* c : lemmas_) {
+    HYBRID_ASSERT(c != nullptr && c->invariant && c->proved, "lemmas are proved invariants");
   }
   alive_.assign(set_.size(), true);
   path_from_.resize(enc_.automaton().num_modes());
@@ -161,6 +165,9 @@ const z3::expr& InductionRound::Hypotheses() {
     for (std::size_t j = 0; j < set_.size(); ++j) {
       if (!alive_[j]) continue;
       for (int i = 0; i < k_; ++i) e.push_back(!enc_.Holds(set_[j]->bad, i, 0.0));
+    }
+    for (const ProofCandidate* lemma : lemmas_) {
+      for (int i = 0; i < k_; ++i) e.push_back(!enc_.Holds(lemma->bad, i, 0.0));
     }
     e.push_back(enc_.TakeDefinitions());
     hypotheses_ = z3::mk_and(e);

@@ -39,8 +39,11 @@ class InductionRound {
   /// A round of `k`-induction (k >= 1) over `candidates` (invariants; borrowed, as are
   /// `encoding` and `meter`, which must be of one context: all must outlive the round), its
   /// queries drawing from `meter` up to `ceiling`, each at most `resource_limit` units.
+  /// `lemmas` (invariants already proved) are assumed at s_0 .. s_k-1 beside the candidates: the
+  /// survivors are then inductive relative to them.
   InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigned resource_limit, int k,
-                 std::vector<ProofCandidate*> candidates, std::uint64_t ceiling);
+                 std::vector<ProofCandidate*> candidates, std::uint64_t ceiling,
+                 std::vector<const ProofCandidate*> lemmas = {});
 
   InductionRound(const InductionRound&) = delete;
   InductionRound& operator=(const InductionRound&) = delete;
@@ -72,7 +75,8 @@ class InductionRound {
   void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
   // The path of the step query from mode m (any: m < 0), built on first use.
   const z3::expr& StepPath(int m);
-  // The living candidates hold at s_0 .. s_k-1: built on first use after each drop.
+  // The living candidates and the lemmas hold at s_0 .. s_k-1: built on first use after each
+  // drop.
   const z3::expr& Hypotheses();
 
   SmtEncoding& enc_;
@@ -82,6 +86,7 @@ class InductionRound {
   int k_;
   std::uint64_t ceiling_;
   std::vector<ProofCandidate*> set_;
+  std::vector<const ProofCandidate*> lemmas_;
   std::vector<bool> alive_;
   std::vector<std::optional<z3::expr>> path_from_;  // the path of k steps, per last mode
   std::optional<z3::expr> hypotheses_;              // of the alive candidates

@@ -101,19 +101,49 @@ void ProofRun::NoteRefuted() {
   }
 }
 
-// 4. Reach targets without a witness: unreachable if no initial state is a target and `not P`
-//    is inductive relative to the proved invariants.
+// 4. Reach targets without a witness: unreachable if no initial state is in them and their
+//    negations are 1-inductive together, relative to the proved invariants (Houdini, as the
+//    induction: a target entered only from other unreachable targets is proved with them).
 void ProofRun::UnreachableTargets() {
+  std::vector<ProofCandidate> negations;
   for (ProofCandidate& c : cands_) {
     if (c.decided || c.invariant || c.goal->result < 0) continue;
     const int starved = meter_.starved();
-    const bool unreachable = Unreachable(c);
+    if (InitiallyOutside(c)) negations.push_back({c.goal, c.bad, true});
     unreach_cut_ = unreach_cut_ || meter_.starved() > starved;
-    if (unreachable) {
+  }
+  if (negations.empty()) return;
+  std::vector<ProofCandidate*> set;
+  for (ProofCandidate& n : negations) set.push_back(&n);
+  std::vector<const ProofCandidate*> lemmas;
+  for (const ProofCandidate& c : cands_) {
+    if (c.invariant && c.proved) lemmas.push_back(&c);
+  }
+  const int starved = meter_.starved();
+  InductionRound round(enc_, meter_, options_.resource_limit, 1, std::move(set), Ceiling(1.0),
+                       std::move(lemmas));
+  round.Run();
+  unreach_cut_ = unreach_cut_ || round.cut() || meter_.starved() > starved;
+  const std::vector<ProofCandidate*> inductive = round.Inductive();
+  const std::string others = std::to_string(inductive.size() - 1);
+  for (const ProofCandidate* n : inductive) {
+    for (ProofCandidate& c : cands_) {
+      if (c.goal != n->goal || c.invariant) continue;
       Decide(c, Verdict::kUnreachable,
-             "proved by 1-induction of its negation, with the proved invariants as lemmas");
+             "proved by 1-induction of its negation, together with the negations of " + others +
+                 " other unreachable target(s) and with the proved invariants as lemmas");
     }
   }
+}
+
+// No initial state of the job is in `reach` target `c`.
+bool ProofRun::InitiallyOutside(const ProofCandidate& c) {
+  const std::uint64_t ceiling = Ceiling(1.0);
+  if (!meter_.Afford(StepUnits(a_), ceiling)) return false;
+  z3::solver base = MakeSolver(ctx_);
+  AddWithDefinitions(base, enc_, enc_.Initial() && enc_.State(0) && enc_.Holds(c.bad, 0, 0.0));
+  return meter_.Check(base, options_.resource_limit, ceiling, "unreachability, initial") ==
+         z3::unsat;
 }
 
 bool ProofRun::Open() const {
@@ -304,38 +334,6 @@ void ProofRun::DeepSearch() {
     }
     if (search_cut_) break;
   }
-}
-
-// `reach` target `c`: no initial state is in it, and `not P` is inductive relative to the proved
-// invariants (checked per mode, as the induction).
-bool ProofRun::Unreachable(const ProofCandidate& c) {
-  const std::uint64_t ceiling = Ceiling(1.0);
-  if (!meter_.Afford(StepUnits(a_), ceiling)) return false;
-  z3::solver base = MakeSolver(ctx_);
-  AddWithDefinitions(base, enc_, enc_.Initial() && enc_.State(0) && enc_.Holds(c.bad, 0, 0.0));
-  if (meter_.Check(base, options_.resource_limit, ceiling, "unreachability, initial") !=
-      z3::unsat) {
-    return false;
-  }
-  for (int m = 0; m < a_.num_modes(); ++m) {
-    if (!meter_.Afford(PathUnits(a_, 1, m), ceiling)) return false;
-    z3::solver s = MakeSolver(ctx_);
-    z3::expr_vector e(ctx_);
-    e.push_back(enc_.State(0));
-    e.push_back(enc_.State(1));
-    e.push_back(enc_.TransitionFrom(0, ModeId(m)));
-    e.push_back(!enc_.Holds(c.bad, 0, 0.0));
-    e.push_back(enc_.Holds(c.bad, 1, 0.0));
-    for (const ProofCandidate& lemma : cands_) {
-      if (lemma.invariant && lemma.proved) e.push_back(!enc_.Holds(lemma.bad, 0, 0.0));
-    }
-    AddWithDefinitions(s, enc_, z3::mk_and(e));
-    if (meter_.Check(s, options_.resource_limit, ceiling, "unreachability, one mode") !=
-        z3::unsat) {
-      return false;
-    }
-  }
-  return true;
 }
 
 void ProofRun::Conclude() {

@@ -33,8 +33,8 @@ namespace hybrid {
 ///    found is turned into a Trace (TraceBuilder) and replayed by the simulator: `violated`
 ///    (`reachable`) if it replays.
 /// 4. For `reach` targets without a witness: `unreachable` if no initial state is a target and
-///    the target's negation is 1-inductive relative to the proved invariants (the rest of the
-///    share).
+///    the targets' negations are 1-inductive together, relative to the proved invariants
+///    (InductionRound: the largest such set; the rest of the share).
 /// 5. Every goal still open is `unknown`, its reason saying which phase ran out of what.
 /// Each decided goal's results (ProofGoal::result and ProofGoal::also) are written with
 /// CheckResult::seconds measured from `start`; lemmas (result -1) are decided without a result.
@@ -73,7 +73,7 @@ class ProofRun {
   void NoteRefuted();
   // Phase 4.
   void UnreachableTargets();
-  bool Unreachable(const ProofCandidate& c);
+  bool InitiallyOutside(const ProofCandidate& c);
   // Phase 5.
   void Conclude();
 

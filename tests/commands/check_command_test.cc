@@ -447,13 +447,13 @@ system s { share sync; instance A = compA; instance B = compB;
 }
 
 // The finger's 31 modes (issue 33: 16 to 18 decided in 220 to 460 s by the prover alone): sampled
-// witnesses first, then induction with the declared invariants. The oracle of `unreachable`: the
-// simulator (not the prover) never enters such a mode on a grid of object positions (every link
-// touching early, late or never, in every order) closing fully, then opening; every `reachable`
-// mode's witness ends in it.
-// Release stage only: 31 x 200 sampled runs and the grid take about 2 minutes under the
-// sanitizers (4 in CI), and ModesOfAComposedSystemComeComponentByComponent runs the same code
-// (sampling, then the checkers on the open modes) under them.
+// witnesses first, then induction with the declared invariants, of the unreachable ones together.
+// The oracle of `unreachable`: the simulator (not the prover) never enters such a mode on a grid of
+// object positions (every link touching early, late or never, in every order) closing fully, then
+// opening; every `reachable` mode's witness ends in it. Release stage only: 31 x 200 sampled runs
+// and the grid take about 2 minutes under the sanitizers (4 in CI), and
+// ModesOfAComposedSystemComeComponentByComponent runs the same code (sampling, then the checkers on
+// the open modes) under them.
 TEST(CheckCommand, FingerModesAreDecidedAndNeverContradictedBySimulation) {
   if (testing::kAddressSanitizer) GTEST_SKIP() << "Release stage only (CI time)";
   const json report =
@@ -470,8 +470,13 @@ TEST(CheckCommand, FingerModesAreDecidedAndNeverContradictedBySimulation) {
     }
     decided += verdict != "unknown";
   }
-  EXPECT_GE(decided, 26) << modes.dump(2);
-  EXPECT_GE(unreachable.size(), 5u) << modes.dump(2);
+  // 21 reachable and 8 unreachable (c000_l110, c001_l110 and c000_l111 only together with
+  // c000_l100: the joint induction of the unreachable targets). c011_l100 and c101_l00n are
+  // reached only for narrow object positions (`hybrid simulate spec/finger.ha --set gob2=150
+  // --set gob3=160` enters the first, `--set gob1=120 --set gob3=130` the second), which neither
+  // the sampled runs nor the one-step search find.
+  EXPECT_GE(decided, 29) << modes.dump(2);
+  EXPECT_GE(unreachable.size(), 8u) << modes.dump(2);
   System finger = ParseModelFile(kFinger);
   std::set<std::string> visited;
   for (const double gob1 : {60.0, 120.0, 256.0}) {
@@ -565,13 +570,13 @@ void ExpectChainVerdicts(const json& report) {
 
 // The budget counts Z3's resource units, not seconds, so what it stops is the same on a loaded
 // machine (no wall-clock assertion here: docs/verification.md gives the measured times).
-TEST(CheckCommand, BudgetFiveStopsAThreeHundredModeChain) {
+TEST(CheckCommand, BudgetOneStopsAThreeHundredModeChain) {
   TempDir dir;
   const std::string model = dir.Write("chain300.ha", Chain(300)).string();
   const json report = JsonHere(ArgsOf<cli::CheckArgs>(model,
                                                       [&](cli::CheckArgs& a) {
                                                         a.method = "prove";
-                                                        a.budget = 5;
+                                                        a.budget = 1;
                                                       }),
                                7);
   ExpectChainVerdicts(report);

@@ -174,6 +174,45 @@ TEST(PropertyProver, ImpossibleTargetIsUnreachable) {
   EXPECT_FALSE(r.trace.has_value());
 }
 
+// Mode `far` is entered only over a guard (x >= 20) that the invariant of `run` (x <= 10) never
+// meets; `beyond` only from `far`. Neither target's negation is inductive alone from `far` with
+// `beyond`'s (a state in `far` steps into `beyond`), but both are together, so both are
+// unreachable; `near` (x >= 5) is reached.
+constexpr std::string_view kChainModel = R"(
+automaton chain {
+  var x;
+  input u in [0, 1];
+  mode run { x' = u; inv x <= 10; }
+  mode near { }
+  mode far { }
+  mode beyond { }
+  transition to_near: run -> near { guard x >= 5; }
+  transition to_far: run -> far { guard x >= 20; }
+  transition on: far -> beyond { guard x >= 0; }
+  init run { x = 0; }
+  scenario { until 20; }
+  property near: reach in near;
+  property far: reach in far;
+  property beyond: reach in beyond;
+}
+)";
+
+TEST(PropertyProver, TargetsEnteredOnlyFromUnreachableOnesAreUnreachableTogether) {
+  const System system = Parse(kChainModel);
+  const std::vector<CheckResult> results =
+      PropertyProver(Small()).Check(system, system.properties());
+  ASSERT_EQ(results.size(), 3u);
+  EXPECT_EQ(results[0].verdict, Verdict::kReachable) << results[0].reason;
+  for (int i : {1, 2}) {
+    EXPECT_EQ(results[i].verdict, Verdict::kUnreachable) << results[i].reason;
+    EXPECT_NE(results[i].reason.find("1 other unreachable target"), std::string::npos)
+        << results[i].reason;
+  }
+  // Alone, `beyond` is not proved: from a state in `far` it is entered.
+  const CheckResult alone = CheckOne(system, "beyond");
+  EXPECT_EQ(alone.verdict, Verdict::kUnknown) << alone.reason;
+}
+
 TEST(PropertyProver, ResultsComeInOrder) {
   const System system = Parse(kLimitedModel);
   const std::vector<CheckResult> results =
@@ -745,6 +784,12 @@ TEST(PropertyProverFinger, ReachableModes) {
   // Link 1 at its limit with link 3 free would need theta3 = -theta1 - theta2 <= -70, below
   // its lower limit of -55 (distal_coupling, limits_exact): unreachable.
   EXPECT_TRUE(unreachable.contains("c000_l100")) << modes[a.FindMode("c000_l100")->value()].reason;
+  // c000_l110 is entered from c000_l100 and from c000_l11n over theta1 + theta2 <= 55 (where
+  // theta1 + theta2 = 70 + 90: limits_exact); c001_l110 and c000_l111 only from c000_l110, which
+  // they lead back to. Unreachable together, not one by one.
+  for (const char* m : {"c000_l110", "c001_l110", "c000_l111"}) {
+    EXPECT_TRUE(unreachable.contains(m)) << m << ": " << modes[a.FindMode(m)->value()].reason;
+  }
   for (const std::string& m : kReachableFingerModes) EXPECT_FALSE(unreachable.contains(m)) << m;
 }
 
