@@ -545,7 +545,8 @@ class SkippingChecker : public PropertyChecker {
 // run, whose replayed trace decides them at a fraction of a proof's cost. Then --method on what
 // they leave open (auto: reach, flowpipe, prove), its prover searching witnesses one step deep
 // only (the samples searched the longer paths): what is left is mostly unreachable, which
-// induction with the invariants proves or not.
+// induction with the invariants proves or not. Last, with auto and prove, the prover's deep
+// search on the few modes still open.
 std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodContext& context,
                                                                    const System& system) {
   std::vector<Property> queries;
@@ -571,6 +572,13 @@ std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodC
     checkers.push_back(MakeProve(shallow));
   } else if (context.args.method != "sample") {
     checkers.push_back(Methods(shallow).Make(context.args.method));
+  }
+  // The few modes left open: witnesses searched as deep as --depth, which sampling missed (a
+  // mode reached only for a narrow choice of the parameters).
+  MethodContext deep = context;
+  deep.reach_set = nullptr;
+  if (context.args.method == "auto" || context.args.method == "prove") {
+    checkers.push_back(MakeProve(deep));
   }
   const std::vector<CheckResult> results =
       FallbackChecker("modes", std::move(checkers)).Check(system, queries);

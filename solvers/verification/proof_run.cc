@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <random>
 #include <utility>
 
 #include "automaton/internal_assert.h"
@@ -198,13 +199,54 @@ bool ProofRun::ReplayPath(const std::vector<SmtEncoding::PathStep>& path, ProofC
         Log(LogLevel::kDebug, "prove", line);
       }
     }
-    return false;
+    std::optional<Trace> moved = OffTie(c, trace);
+    if (!moved) return false;
+    Decide(c, c.invariant ? Verdict::kViolated : Verdict::kReachable,
+           std::string(c.invariant ? "counterexample" : "witness") + " near a path of " +
+               std::to_string(depth) +
+               " steps found by bounded model checking (its parameters moved off a tie between "
+               "events), replayed by the simulator",
+           std::move(*moved));
+    return true;
   }
   Decide(c, c.invariant ? Verdict::kViolated : Verdict::kReachable,
          std::string(c.invariant ? "counterexample" : "witness") + " of " + std::to_string(depth) +
              " steps found by bounded model checking, replayed by the simulator",
          std::move(trace));
   return true;
+}
+
+// A path whose events fall at one instant for its parameter values (a tie: gob1 = gob2 = 140)
+// need not replay: the simulator breaks ties by declaration order, the path may not. The trace
+// again with its uncertain parameters moved off the tie, each by a random fraction of its range
+// (up to 1/64, kOffTieTries tries from a fixed seed: the same on every run) within the range,
+// and its horizon 10% longer for the events moved later.
+std::optional<Trace> ProofRun::OffTie(const ProofCandidate& c, const Trace& trace) {
+  if (trace.parameters.empty()) return std::nullopt;
+  std::vector<UncertainParameter> ranges;
+  for (const auto& [name, value] : trace.parameters) {
+    for (const UncertainParameter& u : UncertainParameters(system_)) {
+      if (u.name == name) ranges.push_back(u);
+    }
+  }
+  if (ranges.size() != trace.parameters.size()) return std::nullopt;
+  std::mt19937_64 bits(0x6A09E667F3BCC909ull + static_cast<std::uint64_t>(c.replays));
+  for (int attempt = 0; attempt < kOffTieTries; ++attempt) {
+    Trace moved = trace;
+    moved.inputs.until *= 1.1;
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+      const double unit = static_cast<double>(bits() >> 11) * 0x1.0p-53;  // in [0, 1)
+      const double width = ranges[i].hi - ranges[i].lo;
+      double& value = moved.parameters[i].second;
+      value = std::clamp(value + (2.0 * unit - 1.0) * width / 64.0, ranges[i].lo, ranges[i].hi);
+    }
+    try {
+      if (ReplayTrace(system_, c.goal->original, moved)) return moved;
+    } catch (const std::exception& e) {
+      Log(LogLevel::kDebug, "prove", std::string("the replay failed: ") + e.what());
+    }
+  }
+  return std::nullopt;
 }
 
 bool ProofRun::Extend(int n, std::uint64_t ceiling) {

@@ -94,6 +94,10 @@ class ProofRun {
   // Replays `trace` (of `path`) for `c`: if it replays, decides `c` violated (reachable for
   // `reach`) with it; false otherwise (and logs the path at kDebug).
   bool ReplayPath(const std::vector<SmtEncoding::PathStep>& path, ProofCandidate& c, Trace trace);
+  // `trace`, which does not replay for `c`, with its uncertain parameters moved a little at
+  // random (kOffTieTries tries): the first that replays, if any.
+  std::optional<Trace> OffTie(const ProofCandidate& c, const Trace& trace);
+  static constexpr int kOffTieTries = 16;
 
   const System& system_;
   const PropertyProver::Options& options_;

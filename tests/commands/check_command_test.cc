@@ -470,12 +470,12 @@ TEST(CheckCommand, FingerModesAreDecidedAndNeverContradictedBySimulation) {
     }
     decided += verdict != "unknown";
   }
-  // 21 reachable and 8 unreachable (c000_l110, c001_l110 and c000_l111 only together with
-  // c000_l100: the joint induction of the unreachable targets). c011_l100 and c101_l00n are
+  // All 31: 23 reachable and 8 unreachable (c000_l110, c001_l110 and c000_l111 only together
+  // with c000_l100: the joint induction of the unreachable targets). c011_l100 and c101_l00n are
   // reached only for narrow object positions (`hybrid simulate spec/finger.ha --set gob2=150
-  // --set gob3=160` enters the first, `--set gob1=120 --set gob3=130` the second), which neither
-  // the sampled runs nor the one-step search find.
-  EXPECT_GE(decided, 29) << modes.dump(2);
+  // --set gob3=160` enters the first, `--set gob1=120 --set gob3=130` the second), which the
+  // sampled runs miss and the prover's deep search finds.
+  EXPECT_EQ(decided, 31) << modes.dump(2);
   EXPECT_GE(unreachable.size(), 8u) << modes.dump(2);
   System finger = ParseModelFile(kFinger);
   std::set<std::string> visited;

@@ -793,5 +793,34 @@ TEST(PropertyProverFinger, ReachableModes) {
   for (const std::string& m : kReachableFingerModes) EXPECT_FALSE(unreachable.contains(m)) << m;
 }
 
+// Modes reached only for narrow object positions: c011_l100 (link 1 at its limit at g = 140,
+// then link 2 and link 3 blocked before theta3 reaches its limit, e.g. gob2 = 150, gob3 = 160)
+// and c101_l00n (link 3 at its lower limit at g = 110, then link 1 and link 3 blocked, e.g.
+// gob1 = 120, gob3 = 130). The first paths the search finds put the contacts at one instant
+// (gob1 = gob2 = gob3 = 140), which the simulator resolves otherwise; moved off that tie, they
+// replay. Oracle: the simulator, run here from the trace's values, enters the mode.
+TEST(PropertyProverFinger, ModesReachedForNarrowObjectPositionsHaveWitnesses) {
+  const System finger = Finger();
+  const Automaton& a = finger.components()[0].automaton;
+  const std::vector<std::string> modes = {"c011_l100", "c101_l00n"};
+  std::vector<Property> targets;
+  for (const std::string& mode : modes) {
+    targets.push_back(
+        {"reach " + mode, Property::Kind::kReach, Predicate::InMode(mode), std::nullopt});
+  }
+  const std::vector<CheckResult> results = PropertyProver().Check(finger, targets);
+  ASSERT_EQ(results.size(), modes.size());
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    const CheckResult& r = results[i];
+    ASSERT_EQ(r.verdict, Verdict::kReachable) << modes[i] << ": " << r.reason;
+    ASSERT_TRUE(r.trace.has_value());
+    bool entered = false;
+    testing::ForEachTraceState(finger, *r.trace, 1000, [&](const Simulator&, const StateSample& s) {
+      entered = entered || s.modes.at(0) == a.FindMode(modes[i])->value();
+    });
+    EXPECT_TRUE(entered) << modes[i] << ": " << r.reason;
+  }
+}
+
 }  // namespace
 }  // namespace hybrid
