@@ -33,7 +33,13 @@ std::uint64_t PathUnits(const Automaton& automaton, int k, int m) {
           last);
 }
 
-z3::solver MakeSolver(z3::context& ctx) { return z3::tactic(ctx, "qfnra-nlsat").mk_solver(); }
+z3::solver MakeSolver(z3::context& ctx) {
+  const z3::tactic pre = z3::tactic(ctx, "simplify") & z3::tactic(ctx, "propagate-values") &
+                         z3::tactic(ctx, "solve-eqs");
+  return (pre & z3::cond(z3::probe(ctx, "is-qflra"), z3::tactic(ctx, "qflra"),
+                         z3::tactic(ctx, "qfnra-nlsat")))
+      .mk_solver();
+}
 
 z3::solver MakeIncremental(z3::context& ctx) {
   z3::solver s(ctx);

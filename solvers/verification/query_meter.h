@@ -30,9 +30,11 @@ std::uint64_t StepUnits(const Automaton& automaton);
 /// (from m: its flow and its outgoing transitions only).
 std::uint64_t PathUnits(const Automaton& automaton, int k, int m);
 
-/// The solver for the induction and unreachability queries: Z3's nlsat (complete for polynomial
-/// real arithmetic, with Boolean structure), which handles the separable (nonlinear) flows far
-/// better than the default core. Its limits are set per query (QueryMeter).
+/// The solver for the induction and unreachability queries: the formula simplified (Z3's
+/// simplify, propagate-values, solve-eqs), then Z3's simplex (qflra) if it is linear, else nlsat
+/// (qfnra-nlsat: complete for polynomial real arithmetic, with Boolean structure), which handles
+/// the separable (nonlinear) flows far better than the default core. Its limits are set per query
+/// (QueryMeter).
 z3::solver MakeSolver(z3::context& ctx);
 
 /// Z3's default solver, for bounded model checking (incremental) and the one-query induction
