@@ -223,9 +223,10 @@ bool ProofRun::ReplayPath(const std::vector<SmtEncoding::PathStep>& path, ProofC
 // and its horizon 10% longer for the events moved later.
 std::optional<Trace> ProofRun::OffTie(const ProofCandidate& c, const Trace& trace) {
   if (trace.parameters.empty()) return std::nullopt;
+  const std::vector<UncertainParameter> uncertain = UncertainParameters(system_);
   std::vector<UncertainParameter> ranges;
   for (const auto& [name, value] : trace.parameters) {
-    for (const UncertainParameter& u : UncertainParameters(system_)) {
+    for (const UncertainParameter& u : uncertain) {
       if (u.name == name) ranges.push_back(u);
     }
   }
