@@ -153,10 +153,26 @@ const z3::expr& InductionRound::StepPath(int m) {
     for (int i = 0; i <= k; ++i) e.push_back(enc_.State(i));
     for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
     e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
+    if (m >= 0) e.push_back(OnlyModesOfTheStep(m));
     e.push_back(enc_.TakeDefinitions());
     path = z3::mk_and(e);
   }
   return *path;
+}
+
+z3::expr InductionRound::OnlyModesOfTheStep(int m) {
+  const Automaton& a = enc_.automaton();
+  std::vector<bool> next(static_cast<std::size_t>(a.num_modes()), false);
+  next[static_cast<std::size_t>(m)] = true;
+  for (const Transition& t : a.transitions()) {
+    if (t.source.value() == m) next[static_cast<std::size_t>(t.target.value())] = true;
+  }
+  z3::expr_vector e(ctx_);
+  for (int n = 0; n < a.num_modes(); ++n) {
+    if (n != m) e.push_back(!enc_.InMode(k_ - 1, ModeId(n)));
+    if (!next[static_cast<std::size_t>(n)]) e.push_back(!enc_.InMode(k_, ModeId(n)));
+  }
+  return z3::mk_and(e);
 }
 
 const z3::expr& InductionRound::Hypotheses() {

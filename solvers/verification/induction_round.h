@@ -73,6 +73,10 @@ class InductionRound {
                              std::vector<std::size_t>& failed);
   // Logs (kDebug) that the step from mode m (any: m < 0) fails for the candidates `failed`.
   void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
+  // What the step from mode m implies of the modes (s_k-1 in m alone, s_k in m or a target of a
+  // transition from m), spelt out so that Z3's simplification drops the other modes' constraints
+  // before the solver sees them.
+  z3::expr OnlyModesOfTheStep(int m);
   // The path of the step query from mode m (any: m < 0), built on first use.
   const z3::expr& StepPath(int m);
   // The living candidates and the lemmas hold at s_0 .. s_k-1: built on first use after each
