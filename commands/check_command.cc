@@ -547,6 +547,8 @@ class SkippingChecker : public PropertyChecker {
 // only (the samples searched the longer paths): what is left is mostly unreachable, which
 // induction with the invariants proves or not. Last, with auto and prove, the prover's deep
 // search on the few modes still open.
+constexpr std::size_t kModesSampledFirst = 500;
+
 std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodContext& context,
                                                                    const System& system) {
   std::vector<Property> queries;
@@ -565,7 +567,14 @@ std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodC
   shallow.prove.max_depth = 1;
   shallow.reach_set = nullptr;
   std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(std::make_unique<SkippingChecker>(MakeSample(shallow), lemma_names));
+  // Each witness a sampled run finds is replayed on the model compiled again, which costs in
+  // proportion to its modes: past kModesSampledFirst modes, sampling first would take a time
+  // quadratic in them (a chain of 10^4 modes: over 10 minutes), so there it runs only as the
+  // method asked for.
+  const std::size_t mode_queries = queries.size() - lemmas;
+  if (mode_queries <= kModesSampledFirst || context.args.method == "sample") {
+    checkers.push_back(std::make_unique<SkippingChecker>(MakeSample(shallow), lemma_names));
+  }
   if (context.args.method == "auto") {  // auto's engines, its sampling already done
     checkers.push_back(MakeReach(shallow));
     checkers.push_back(MakeFlowpipe(shallow));

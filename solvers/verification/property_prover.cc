@@ -97,6 +97,11 @@ std::vector<PropertyProver::ModeReachability> PropertyProver::ModeResults(
     r.verdict = results[m].verdict;
     r.reason = results[m].reason;
     r.trace = results[m].trace;
+    if (results[m].within) {  // whether a run ever enters the mode: a bounded answer is none
+      r.verdict = Verdict::kUnknown;
+      r.reason = "unreachable within " + FormatNumber(*results[m].within) +
+                 " only, not decided beyond: " + r.reason;
+    }
     out.push_back(std::move(r));
   }
   return out;

@@ -123,7 +123,8 @@ class PropertyProver {
   /// mode order, named "reach MODE" (the qualified mode name).
   static std::vector<Property> ModeQueries(const System& system, int component);
   /// ReachableModes' answer from `results`, the verdicts of ModeQueries(system, component) in
-  /// order (by any checker).
+  /// order (by any checker). A verdict up to a time only (CheckResult::within) is `unknown`
+  /// here, its reason saying so: whether a run ever enters a mode has no horizon.
   static std::vector<ModeReachability> ModeResults(const System& system, int component,
                                                    std::span<const CheckResult> results);
 
