@@ -539,6 +539,9 @@ class SkippingChecker : public PropertyChecker {
   std::set<std::string> skip_;
 };
 
+// Up to how many modes --modes samples runs first (see ModesOf).
+constexpr std::size_t kModesSampledFirst = 500;
+
 // --modes: `reach in MODE` for every mode of every component (PropertyProver::ModeQueries), with
 // the model's declared invariants beside them as lemmas for the prover's induction (their verdicts
 // are not reported again). Sampled runs first, on the modes alone: most modes are reached by some
@@ -547,8 +550,6 @@ class SkippingChecker : public PropertyChecker {
 // only (the samples searched the longer paths): what is left is mostly unreachable, which
 // induction with the invariants proves or not. Last, with auto and prove, the prover's deep
 // search on the few modes still open.
-constexpr std::size_t kModesSampledFirst = 500;
-
 std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodContext& context,
                                                                    const System& system) {
   std::vector<Property> queries;
@@ -575,7 +576,7 @@ std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodC
   if (mode_queries <= kModesSampledFirst || context.args.method == "sample") {
     checkers.push_back(std::make_unique<SkippingChecker>(MakeSample(shallow), lemma_names));
   }
-  if (context.args.method == "auto") {  // auto's engines, its sampling already done
+  if (context.args.method == "auto") {  // auto's engines, its sampling done (or left out) above
     checkers.push_back(MakeReach(shallow));
     checkers.push_back(MakeFlowpipe(shallow));
     checkers.push_back(MakeProve(shallow));
