@@ -585,9 +585,9 @@ std::vector<std::vector<PropertyProver::ModeReachability>> ModesOf(const MethodC
   }
   // The few modes left open: witnesses searched as deep as --depth, which sampling missed (a
   // mode reached only for a narrow choice of the parameters).
-  MethodContext deep = context;
-  deep.reach_set = nullptr;
   if (context.args.method == "auto" || context.args.method == "prove") {
+    MethodContext deep = context;
+    deep.reach_set = nullptr;
     checkers.push_back(MakeProve(deep));
   }
   const std::vector<CheckResult> results =

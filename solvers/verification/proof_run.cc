@@ -106,11 +106,15 @@ void ProofRun::NoteRefuted() {
 //    negations are 1-inductive together, relative to the proved invariants (Houdini, as the
 //    induction: a target entered only from other unreachable targets is proved with them).
 void ProofRun::UnreachableTargets() {
+  std::vector<ProofCandidate*> targets;  // of the negations, in order
   std::vector<ProofCandidate> negations;
   for (ProofCandidate& c : cands_) {
     if (c.decided || c.invariant || c.goal->result < 0) continue;
     const int starved = meter_.starved();
-    if (InitiallyOutside(c)) negations.push_back({c.goal, c.bad, true});
+    if (InitiallyOutside(c)) {
+      targets.push_back(&c);
+      negations.push_back({c.goal, c.bad, true});
+    }
     unreach_cut_ = unreach_cut_ || meter_.starved() > starved;
   }
   if (negations.empty()) return;
@@ -128,12 +132,9 @@ void ProofRun::UnreachableTargets() {
   const std::vector<ProofCandidate*> inductive = round.Inductive();
   const std::string others = std::to_string(inductive.size() - 1);
   for (const ProofCandidate* n : inductive) {
-    for (ProofCandidate& c : cands_) {
-      if (c.goal != n->goal || c.invariant) continue;
-      Decide(c, Verdict::kUnreachable,
-             "proved by 1-induction of its negation, together with the negations of " + others +
-                 " other unreachable target(s) and with the proved invariants as lemmas");
-    }
+    Decide(*targets[static_cast<std::size_t>(n - negations.data())], Verdict::kUnreachable,
+           "proved by 1-induction of its negation, together with the negations of " + others +
+               " other unreachable target(s) and with the proved invariants as lemmas");
   }
 }
 

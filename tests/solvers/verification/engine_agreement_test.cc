@@ -231,6 +231,8 @@ struct Summary {
   int replays = 0;              // traces confirmed by ReplayTrace
   int text_replays = 0;         // traces confirmed from model text by the test's evaluator
   int boundary_witnesses = 0;   // of which `reach` witnesses only within the tolerance
+  int off_tie = 0;              // prove's traces replayed with parameters moved off a tie
+  int joint_unreachable = 0;    // prove's `unreachable` together with other targets only
   int boundary_disagreements = 0;  // disagreements whose witnesses are all such
   int agreements = 0;              // properties with definite verdicts of two engines that agree
   std::vector<std::string> contradictions;
@@ -268,6 +270,8 @@ std::string SummaryText(const Settings& settings, const Summary& s) {
       << " cut at a state outside the invariants), states checked " << s.states << "\n"
       << "  traces replayed: ReplayTrace " << s.replays << ", from model text " << s.text_replays
       << " (" << s.boundary_witnesses << " of them reach witnesses within the tolerance only)"
+      << "\n  prove: traces with parameters moved off a tie " << s.off_tie
+      << ", unreachable only together with other targets " << s.joint_unreachable
       << "\n  properties with agreeing definite verdicts of two engines " << s.agreements
       << "\n  contradictions " << s.contradictions.size() << ", disagreements "
       << s.disagreements.size() << " (" << s.boundary_disagreements
@@ -625,6 +629,13 @@ void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, in
       }
       const CheckResult& r = run.results[i];
       if (r.reason.rfind(kSampleRefused, 0) == 0) ++s.sample_refused;
+      if (run.engine == "prove") {  // the prover's verdict paths, to see them attacked
+        if (r.reason.find("moved off a tie") != std::string::npos) ++s.off_tie;
+        if (r.reason.find("together with the negations of") != std::string::npos &&
+            r.reason.find("of 0 other") == std::string::npos) {
+          ++s.joint_unreachable;
+        }
+      }
       ++s.verdicts[run.engine][VerdictText(r.verdict)];
       if (run.engine == "reach" && r.verdict == Verdict::kUnknown &&
           r.reason.find("not a linear") != std::string::npos) {
