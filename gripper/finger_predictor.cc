@@ -162,39 +162,67 @@ std::vector<std::pair<std::string, double>> FingerPredictor::RunParameters(const
 std::vector<double> MotorPositions(std::span<const double> requests,
                                    std::span<const ControllerStop> stops) {
   std::vector<double> motor(requests.size());
-  std::optional<double> held;
+  double held = kNaN;  // NaN: following the requests (a stop is never NaN: FirstStall)
   size_t next = 0;
   for (size_t k = 0; k < requests.size(); ++k) {
     while (next < stops.size() && stops[next].index <= k) {
       if (stops[next].index == k) held = stops[next].motor;
       ++next;
     }
-    if (held && requests[k] < *held) held.reset();  // a more open request: follow it
-    motor[k] = held ? *held : requests[k];
+    if (requests[k] < held) held = kNaN;  // a more open request: follow it
+    motor[k] = std::isnan(held) ? requests[k] : held;
   }
   return motor;
 }
 
-FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEffects& e) const {
+namespace {
+
+// The controller's stop at stall sample k: the motor stopped where the engaged transmission
+// (q = p - offset) put the finger's g.
+ControllerStop StopAt(const FingerPrediction& p, size_t k, const FingerEffects& e) {
+  return {k, std::clamp(p.model_g[k] + e.motor_offset, 0.0, kMotorMax)};
+}
+
+// The first sample from `from` on where the finger's g lags the drive (it has stalled), or the
+// sample count when there is none (samples the run did not reach are NaN: never a stall).
+size_t FirstStall(const FingerPrediction& p, size_t from) {
   // Where the finger's g lags the drive by more than this (counts), it has stalled.
   constexpr double kStallGap = 1e-3;
+  size_t k = from;
+  while (k < p.drive.size() && !(p.drive[k] - p.model_g[k] > kStallGap)) ++k;
+  return k;
+}
+
+}  // namespace
+
+FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEffects& e) const {
   constexpr int kMaxPasses = 16;
   std::vector<ControllerStop> stops;
   FingerPrediction p;
   for (int pass = 0;; ++pass) {
-    p = PredictAlong(run, e, MotorPositions(run.g, stops));
+    const std::vector<double> motor = MotorPositions(run.g, stops);
+    const size_t from = stops.empty() ? 0 : stops.back().index + 1;
+    p = PredictAlong(run, e, motor, /*to_the_range_ends=*/false);
+    // A run that left the motor range (the finger's g lagging the drive) stalled before it did:
+    // the samples before the violation are those of the run taken to the range's ends, so a
+    // stall among them is the stall that run finds, without taking it there.
+    const bool out_of_range = p.status == SimulationStatus::kInvariantViolated;
+    if (out_of_range && pass + 1 < kMaxPasses && FirstStall(p, from) < p.drive.size()) {
+      stops.push_back(StopAt(p, FirstStall(p, from), e));
+      continue;
+    }
+    if (out_of_range) p = PredictAlong(run, e, motor, /*to_the_range_ends=*/true);
     if (p.status != SimulationStatus::kCompleted || pass + 1 >= kMaxPasses) break;
-    size_t k = stops.empty() ? 0 : stops.back().index + 1;
-    while (k < p.drive.size() && !(p.drive[k] - p.model_g[k] > kStallGap)) ++k;
+    const size_t k = FirstStall(p, from);
     if (k == p.drive.size()) break;
-    // The motor stopped where the engaged transmission (q = p - offset) put the finger's g.
-    stops.push_back({k, std::clamp(p.model_g[k] + e.motor_offset, 0.0, kMotorMax)});
+    stops.push_back(StopAt(p, k, e));
   }
   return p;
 }
 
 FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const FingerEffects& e,
-                                               std::vector<double> motor) const {
+                                               std::vector<double> motor,
+                                               bool to_the_range_ends) const {
   const size_t n = run.g.size();
   FingerPrediction p;
   p.drive = DrivePositions(motor, e.backlash, e.motor_offset);
@@ -218,7 +246,11 @@ FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const Fin
   const int g_index =
       static_cast<int>(std::find(sim->variable_names().begin(), sim->variable_names().end(), "g") -
                        sim->variable_names().begin());
-  const SimulationResult r = RunToTheRangeEnds(*sim, options, g_index, std::move(points));
+  const std::vector<InputSignal> signals = {
+      InputSignal{*sim->system().symbols().Find("u"), InputSignal::Shape::kStep, points}};
+  const SimulationResult r = to_the_range_ends
+                                 ? RunToTheRangeEnds(*sim, options, g_index, std::move(points))
+                                 : sim->Run(options, signals);
   p.status = r.status;
   p.message = r.message;
   p.model_g.assign(n, kNaN);

@@ -115,9 +115,11 @@ class FingerPredictor {
   // (SimulationOptions::parameters). Throws std::invalid_argument for bad effects.
   static std::vector<std::pair<std::string, double>> RunParameters(const MeasuredRun& run,
                                                                    const FingerEffects& effects);
-  // The prediction along the motor path `motor` (one position per sample of `run`).
+  // The prediction along the motor path `motor` (one position per sample of `run`); with
+  // `to_the_range_ends`, a run that leaves the motor range is taken on as RunToTheRangeEnds says,
+  // else it stops there (kInvariantViolated).
   FingerPrediction PredictAlong(const MeasuredRun& run, const FingerEffects& effects,
-                                std::vector<double> motor) const;
+                                std::vector<double> motor, bool to_the_range_ends) const;
   Automaton finger_;
   Options options_;
   mutable std::mutex mutex_;
