@@ -94,6 +94,21 @@ SimulationResult RunToTheRangeEnds(const Simulator& sim, const SimulationOptions
   return r;
 }
 
+// Whether the finger's g lags the drive position: it has stalled.
+bool IsStall(double drive, double g) {
+  // Where the finger's g lags the drive by more than this (counts), it has stalled.
+  constexpr double kStallGap = 1e-3;
+  return drive - g > kStallGap;
+}
+
+// The first sample from `from` on where the finger has stalled, or the sample count when there
+// is none (samples the run did not reach are NaN: never a stall).
+size_t FirstStall(const FingerPrediction& p, size_t from) {
+  size_t k = from;
+  while (k < p.drive.size() && !IsStall(p.drive[k], p.model_g[k])) ++k;
+  return k;
+}
+
 }  // namespace
 
 FingerPredictor::FingerPredictor(Automaton finger) : FingerPredictor(std::move(finger), {}) {}
@@ -175,54 +190,27 @@ std::vector<double> MotorPositions(std::span<const double> requests,
   return motor;
 }
 
-namespace {
-
-// The controller's stop at stall sample k: the motor stopped where the engaged transmission
-// (q = p - offset) put the finger's g.
-ControllerStop StopAt(const FingerPrediction& p, size_t k, const FingerEffects& e) {
-  return {k, std::clamp(p.model_g[k] + e.motor_offset, 0.0, kMotorMax)};
-}
-
-// The first sample from `from` on where the finger's g lags the drive (it has stalled), or the
-// sample count when there is none (samples the run did not reach are NaN: never a stall).
-size_t FirstStall(const FingerPrediction& p, size_t from) {
-  // Where the finger's g lags the drive by more than this (counts), it has stalled.
-  constexpr double kStallGap = 1e-3;
-  size_t k = from;
-  while (k < p.drive.size() && !(p.drive[k] - p.model_g[k] > kStallGap)) ++k;
-  return k;
-}
-
-}  // namespace
-
 FingerPrediction FingerPredictor::Predict(const MeasuredRun& run, const FingerEffects& e) const {
   constexpr int kMaxPasses = 16;
   std::vector<ControllerStop> stops;
   FingerPrediction p;
   for (int pass = 0;; ++pass) {
-    const std::vector<double> motor = MotorPositions(run.g, stops);
     const size_t from = stops.empty() ? 0 : stops.back().index + 1;
-    p = PredictAlong(run, e, motor, /*to_the_range_ends=*/false);
-    // A run that left the motor range (the finger's g lagging the drive) stalled before it did:
-    // the samples before the violation are those of the run taken to the range's ends, so a
-    // stall among them is the stall that run finds, without taking it there.
-    const bool out_of_range = p.status == SimulationStatus::kInvariantViolated;
-    if (out_of_range && pass + 1 < kMaxPasses && FirstStall(p, from) < p.drive.size()) {
-      stops.push_back(StopAt(p, FirstStall(p, from), e));
-      continue;
-    }
-    if (out_of_range) p = PredictAlong(run, e, motor, /*to_the_range_ends=*/true);
-    if (p.status != SimulationStatus::kCompleted || pass + 1 >= kMaxPasses) break;
+    // Each pass but the last ends at its first stall (nothing after it is used).
+    const std::optional<size_t> stall_from =
+        pass + 1 < kMaxPasses ? std::optional<size_t>(from) : std::nullopt;
+    p = PredictAlong(run, e, MotorPositions(run.g, stops), stall_from);
+    if (p.status != SimulationStatus::kStopped) break;
+    // The motor stopped where the engaged transmission (q = p - offset) put the finger's g.
     const size_t k = FirstStall(p, from);
-    if (k == p.drive.size()) break;
-    stops.push_back(StopAt(p, k, e));
+    stops.push_back({k, std::clamp(p.model_g[k] + e.motor_offset, 0.0, kMotorMax)});
   }
   return p;
 }
 
 FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const FingerEffects& e,
                                                std::vector<double> motor,
-                                               bool to_the_range_ends) const {
+                                               std::optional<size_t> stall_from) const {
   const size_t n = run.g.size();
   FingerPrediction p;
   p.drive = DrivePositions(motor, e.backlash, e.motor_offset);
@@ -246,11 +234,12 @@ FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const Fin
   const int g_index =
       static_cast<int>(std::find(sim->variable_names().begin(), sim->variable_names().end(), "g") -
                        sim->variable_names().begin());
-  const std::vector<InputSignal> signals = {
-      InputSignal{*sim->system().symbols().Find("u"), InputSignal::Shape::kStep, points}};
-  const SimulationResult r = to_the_range_ends
-                                 ? RunToTheRangeEnds(*sim, options, g_index, std::move(points))
-                                 : sim->Run(options, signals);
+  if (stall_from) {
+    options.monitor = [&p, g_index, from = *stall_from](size_t k, const StateSample& s) {
+      return !(k >= from && k < p.drive.size() && IsStall(p.drive[k], s.x[g_index]));
+    };
+  }
+  const SimulationResult r = RunToTheRangeEnds(*sim, options, g_index, std::move(points));
   p.status = r.status;
   p.message = r.message;
   p.model_g.assign(n, kNaN);

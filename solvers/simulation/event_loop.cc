@@ -47,6 +47,7 @@ SimulationResult EventLoop::Simulate() {
   if (running && ZenoCheck()) running = false;
   // Listed times already reached (0, or before the first step): recorded now, after the start.
   RecordListed();
+  if (running && StopAsked()) running = false;
   EvaluateRoots(t_, x_, &g_prev_);
   while (running && t_ < until_) running = RunPass();
   return Finish();
@@ -358,6 +359,7 @@ bool EventLoop::ReachStopTimes(bool* restart) {
   // the current time).
   if (samples_.TakeUniform(t_)) Record(StateSample::Kind::kSample);
   RecordListed();
+  if (StopAsked()) return false;
   if (next_break_ < breakpoints_.size() && t_ >= breakpoints_[next_break_]) {
     run_.SetStepInputs(t_);
     run_.Load(t_, x_.data());
@@ -560,6 +562,16 @@ bool EventLoop::InputJump() {
 
 void EventLoop::Record(StateSample::Kind kind) {
   result_.samples.push_back({t_, kind, run_.modes(), x_.head(n_)});
+  if (kind == StateSample::Kind::kSample && options_.monitor && !stop_asked_) {
+    stop_asked_ = !options_.monitor(monitored_++, result_.samples.back());
+  }
+}
+
+bool EventLoop::StopAsked() {
+  if (!stop_asked_) return false;
+  result_.status = SimulationStatus::kStopped;
+  result_.message = "stopped by the monitor at t = " + FormatNumber(t_);
+  return true;
 }
 
 void EventLoop::RecordListed() {

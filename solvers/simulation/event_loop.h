@@ -148,8 +148,10 @@ class EventLoop {
   bool InputJump();
 
   // Helpers.
-  // Records (t_, modes, x_) as a sample of `kind`.
+  // Records (t_, modes, x_) as a sample of `kind`; gives a kSample to options_.monitor.
   void Record(StateSample::Kind kind);
+  // Whether the monitor asked the run to stop; if so, sets the status kStopped.
+  bool StopAsked();
   // Records the listed sample times already reached.
   void RecordListed();
   // The root functions at (time, state), into *g (resized to their number).
@@ -187,7 +189,9 @@ class EventLoop {
   std::vector<int> crossed_;
   SettledRoots settled_;
   int stalled_ = 0;
-  long passes_ = 0;  // SimulationOptions::max_steps
+  size_t monitored_ = 0;     // samples given to options_.monitor
+  bool stop_asked_ = false;  // the monitor returned false
+  long passes_ = 0;          // SimulationOptions::max_steps
 };
 
 }  // namespace hybrid

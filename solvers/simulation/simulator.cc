@@ -29,6 +29,8 @@ std::string_view StatusName(SimulationStatus status) {
       return "step_limit";
     case SimulationStatus::kUnresolved:
       return "unresolved";
+    case SimulationStatus::kStopped:
+      return "stopped";
   }
   return "?";
 }

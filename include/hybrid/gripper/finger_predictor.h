@@ -115,11 +115,11 @@ class FingerPredictor {
   // (SimulationOptions::parameters). Throws std::invalid_argument for bad effects.
   static std::vector<std::pair<std::string, double>> RunParameters(const MeasuredRun& run,
                                                                    const FingerEffects& effects);
-  // The prediction along the motor path `motor` (one position per sample of `run`); with
-  // `to_the_range_ends`, a run that leaves the motor range is taken on as RunToTheRangeEnds says,
-  // else it stops there (kInvariantViolated).
+  // The prediction along the motor path `motor` (one position per sample of `run`). With
+  // `stall_from`, the run ends (kStopped) at the first sample from that index on where the finger
+  // has stalled.
   FingerPrediction PredictAlong(const MeasuredRun& run, const FingerEffects& effects,
-                                std::vector<double> motor, bool to_the_range_ends) const;
+                                std::vector<double> motor, std::optional<size_t> stall_from) const;
   Automaton finger_;
   Options options_;
   mutable std::mutex mutex_;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -23,6 +24,8 @@ struct ScheduledJump {
   std::vector<std::pair<int, int>> transitions;
   friend bool operator==(const ScheduledJump&, const ScheduledJump&) = default;
 };
+
+struct StateSample;
 
 /// Settings of one simulation run. Defaults suit models whose time scale is between 1e-3 and
 /// 1e4 (seconds, or any unit). Run throws std::invalid_argument for a setting out of its range.
@@ -110,6 +113,13 @@ struct SimulationOptions {
   /// a value that is not finite, or a state outside its modes' invariants.
   std::vector<int> start_modes;
   Eigen::VectorXd start_x;
+  /// Called with each state recorded at a sample time (StateSample::Kind::kSample), in time
+  /// order, with its index among them (0, 1, ...; a listed time 0 included). Returning false ends
+  /// the run at that instant with status kStopped: the states recorded up to there are those a
+  /// run to the horizon records (other samples due at the same instant are recorded too, without
+  /// a further call), then the end state. For a caller that looks for a condition on the samples
+  /// and needs nothing after it (as a Drake simulator's monitor ends a simulation). Empty: none.
+  std::function<bool(size_t index, const StateSample& sample)> monitor;
 };
 
 /// Throws std::invalid_argument, with a message for the user, if the horizon `until` (the one the
@@ -141,10 +151,12 @@ enum class SimulationStatus {
   /// (SimulationOptions::resolution_tolerance). No recorded state after the message's time is
   /// trustworthy.
   kUnresolved,
+  /// SimulationOptions::monitor ended the run at a sample it was given.
+  kStopped,
 };
 
 /// "completed", "zeno", "invariant_violated", "solver_failure", "event_limit", "step_limit",
-/// "unresolved".
+/// "unresolved", "stopped".
 std::string_view StatusName(SimulationStatus status);
 
 /// One recorded state.

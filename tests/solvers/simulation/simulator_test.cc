@@ -799,6 +799,53 @@ TEST(SimulatorTest, ListedSampleTimesRecordOneSamplePerEntry) {
   EXPECT_THROW(m.Run(o), std::invalid_argument);
 }
 
+// A monitor ends the run at the first sample it refuses (SimulationOptions::monitor): the finger
+// closing in free space, theta1 = t / 2 and theta3 = -t / 2 (to its limit at t = 110), stopped at
+// the first sample with theta1 >= 30 (t = 60; samples at 60 twice: both recorded, one call).
+TEST(SimulatorTest, AMonitorStopsTheRunAtTheSampleItRefuses) {
+  const Model m(SpecText("finger"));
+  SimulationOptions o = Until(120.0);
+  o.sample_times = {0.0, 20.0, 40.0, 60.0, 60.0, 80.0, 100.0};
+  std::vector<size_t> calls;
+  o.monitor = [&](size_t index, const StateSample& s) {
+    EXPECT_EQ(s.kind, StateSample::Kind::kSample);
+    EXPECT_EQ(s.time, o.sample_times[index]);
+    calls.push_back(index);
+    return s.x[m.Var("theta1")] < 30.0;
+  };
+  const std::vector<InputSignal> close = {m.Signal("u", InputSignal::Shape::kStep, {{0.0, 1.0}})};
+  const SimulationResult r = m.Run(o, close);
+  ASSERT_EQ(r.status, SimulationStatus::kStopped) << r.message;
+  EXPECT_EQ(StatusName(r.status), "stopped");
+  EXPECT_EQ(calls, (std::vector<size_t>{0, 1, 2, 3}));
+  std::vector<double> times;
+  for (const StateSample& s : r.samples) {
+    if (s.kind != StateSample::Kind::kSample) continue;
+    times.push_back(s.time);
+    EXPECT_NEAR(s.x[m.Var("theta1")], 0.5 * s.time, 1e-9);
+    EXPECT_NEAR(s.x[m.Var("theta3")], -0.5 * s.time, 1e-9);
+  }
+  EXPECT_EQ(times, (std::vector<double>{0.0, 20.0, 40.0, 60.0, 60.0}));
+  EXPECT_EQ(r.samples.back().kind, StateSample::Kind::kEnd);
+  EXPECT_EQ(r.samples.back().time, 60.0);
+  // A monitor that refuses the listed sample at time 0 stops the run at its start.
+  o.monitor = [](size_t, const StateSample&) { return false; };
+  const SimulationResult at_start = m.Run(o, close);
+  EXPECT_EQ(at_start.status, SimulationStatus::kStopped);
+  EXPECT_EQ(at_start.samples.back().time, 0.0);
+  // One that accepts every sample leaves the run as it is without one.
+  o.monitor = [](size_t, const StateSample&) { return true; };
+  const SimulationResult accepted = m.Run(o, close);
+  o.monitor = nullptr;
+  const SimulationResult plain = m.Run(o, close);
+  ASSERT_EQ(accepted.status, SimulationStatus::kCompleted) << accepted.message;
+  ASSERT_EQ(accepted.samples.size(), plain.samples.size());
+  for (size_t i = 0; i < plain.samples.size(); ++i) {
+    EXPECT_EQ(accepted.samples[i].time, plain.samples[i].time);
+    EXPECT_EQ(accepted.samples[i].x, plain.samples[i].x);
+  }
+}
+
 std::string PriorityModel(const std::string& transitions) {
   return R"(
 automaton priority {
