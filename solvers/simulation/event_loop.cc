@@ -75,7 +75,54 @@ bool EventLoop::RunPass() {
     if (!HandleCrossings(p, &restart)) return false;
   }
   if (!ReachStopTimes(&restart)) return false;
-  return EndPass(p, restart);
+  if (!EndPass(p, restart)) return false;
+  // An exact segment that ended at a sample with nothing crossed goes on along its line.
+  const bool on_line = p.exact && p.status == CvodeIntegrator::Status::kReachedTime && !restart &&
+                       !p.at_breakpoint && result_.events.size() == p.events_before && anchor_.set;
+  return on_line ? SamplesOnTheLine() : true;
+}
+
+bool EventLoop::SamplesOnTheLine() {
+  // The earliest time a root function crosses on the anchor's line (ExactCrossing's `toward`).
+  double first = until_;
+  slopes_.resize(g_prev_.size());
+  for (size_t i = 0; i < g_prev_.size(); ++i) {
+    slopes_[i] = run_.Slope(static_cast<int>(i), rate_);
+    const int dir = run_.roots()[i].direction;
+    const double g0 = anchor_.g[i], slope = slopes_[i];
+    const bool toward =
+        (dir <= 0 && g0 > 0.0 && slope < 0.0) || (dir >= 0 && g0 < 0.0 && slope > 0.0);
+    if (toward) first = std::min(first, anchor_.t - g0 / slope);
+  }
+  for (;;) {
+    while (next_break_ < breakpoints_.size() && breakpoints_[next_break_] <= t_) ++next_break_;
+    const double hard =
+        next_break_ < breakpoints_.size() ? std::min(until_, breakpoints_[next_break_]) : until_;
+    const double stop = samples_.Next();
+    const double tie = 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(stop));
+    // The next pass is one of these only if it is exact (ExactSegmentApplies), ends at a sample
+    // (not at an input breakpoint or the horizon) and nothing crosses up to a tie after it.
+    if (!(stop < hard) || !(stop + tie < first) || !StaysOnTheLine()) return true;
+    if (StepLimitExceeded()) return false;
+    t_ = stop;
+    x_ = anchor_.x + rate_.head(x_.size()) * (t_ - anchor_.t);
+    run_.Load(t_, x_.data());
+    jumps_.ForgetAll();
+    if (samples_.TakeUniform(t_)) Record(StateSample::Kind::kSample);
+    RecordListed();
+    if (StopAsked()) return false;
+    EvaluateRoots(t_, x_, &g_prev_);
+    stalled_ = 0;
+  }
+}
+
+bool EventLoop::StaysOnTheLine() const {
+  for (size_t i = 0; i < g_prev_.size(); ++i) {
+    const bool boundary =
+        g_prev_[i] == 0.0 ? anchor_.t - anchor_.g[i] / slopes_[i] == t_ : OnBoundary(i);
+    if (boundary && run_.roots()[i].direction * slopes_[i] > 0.0) return false;
+  }
+  return true;
 }
 
 bool EventLoop::StepLimitExceeded() {

@@ -73,6 +73,17 @@ class EventLoop {
   // One pass: integrate to the next stop, locate crossings, act on them, reach the stop times.
   // Returns false when the run must stop (status set, or an early stop such as kUnresolved).
   bool RunPass();
+  // After an exact pass that ended at a sample with nothing crossed: the passes to the next
+  // samples on the same line (constant rates, the anchor unchanged), each taken here as RunPass
+  // takes it (the state on the anchor's line, recorded, the root functions evaluated there) but
+  // without locating crossings, while no root function can cross up to a tie after the sample
+  // and the next pass stays exact. Leaves the first pass that may differ from such a pass (a
+  // crossing near, a boundary, an input breakpoint, the horizon) to RunPass. Returns false when
+  // the run must stop (step limit, monitor).
+  bool SamplesOnTheLine();
+  // Whether a pass starting at t_ is exact on the anchor's line: ExactSegmentApplies with the
+  // rates unchanged (slopes_ of the line, g_prev_ at t_).
+  bool StaysOnTheLine() const;
   // Counts the pass; beyond options.max_steps sets kStepLimit and returns true.
   bool StepLimitExceeded();
   // Starts a pass at (t_, x_): skips breakpoints already reached, chooses the stop time, saves
@@ -183,6 +194,7 @@ class EventLoop {
   size_t next_break_ = 0;
   size_t next_scheduled_ = 0;  // the first entry of options_.lazy_schedule not yet due
   std::vector<double> g_prev_, g_mid_;
+  std::vector<double> slopes_;  // of the root functions on the anchor's line (SamplesOnTheLine)
   Eigen::VectorXd x_new_, x_mid_, x_start_;
   // Per-step buffers, reused so that a step allocates nothing.
   std::vector<double> ga_, gm_;
