@@ -84,7 +84,11 @@ FingerDiagnosisModel::FingerDiagnosisModel(const FingerPredictor& predictor,
                                            std::vector<FingerPrediction> baseline)
     : predictor_(predictor),
       data_(data),
-      baseline_(std::move(baseline)),
+      baseline_([&] {
+        std::vector<RunPrediction> out;
+        for (FingerPrediction& p : baseline) out.push_back(AsRunPrediction(std::move(p)));
+        return out;
+      }()),
       effects_(AllEffectParameters()) {
   for (const EffectParameter& p : effects_) {
     const auto [lo, hi] = SearchRange(p);
@@ -129,28 +133,28 @@ FingerPrediction FingerDiagnosisModel::Checked(int r, const FingerEffects& e) co
   return p;
 }
 
-FingerPrediction FingerDiagnosisModel::Memoised(int r, const FingerEffects& dynamic) const {
+RunPrediction FingerDiagnosisModel::Memoised(int r, const FingerEffects& dynamic) const {
   const std::string key = MemoKey(representative_[r], dynamic);
   {
     std::lock_guard<std::mutex> lock(memo_mutex_);
     const auto it = memo_.find(key);
     if (it != memo_.end()) return *it->second;
   }
-  FingerPrediction p = Checked(representative_[r], dynamic);
+  auto p =
+      std::make_shared<const RunPrediction>(AsRunPrediction(Checked(representative_[r], dynamic)));
   std::lock_guard<std::mutex> lock(memo_mutex_);
-  memo_.emplace(key, std::make_shared<const FingerPrediction>(p));
-  return p;
+  return *memo_.emplace(key, std::move(p)).first->second;
 }
 
 RunPrediction FingerDiagnosisModel::Predict(int r, const ParameterValues& values) const {
-  if (values.empty()) return AsRunPrediction(baseline_[r]);
+  if (values.empty()) return baseline_[r];
   const FingerEffects e = Effects(values);
   const FingerEffects dynamic = WithoutBias(e);
-  FingerPrediction p = NeutralDrive(dynamic) ? baseline_[r] : Memoised(r, dynamic);
+  RunPrediction p = NeutralDrive(dynamic) ? baseline_[r] : Memoised(r, dynamic);
   for (int j = 0; j < 3; ++j) {
-    for (double& v : p.theta[j]) v += e.sensor_bias[j];
+    for (double& v : p.channels[j]) v += e.sensor_bias[j];
   }
-  return AsRunPrediction(std::move(p));
+  return p;
 }
 
 bool FingerDiagnosisModel::Affects(int parameter, int r, const RunPrediction& reference) const {

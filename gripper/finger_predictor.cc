@@ -227,6 +227,8 @@ FingerPrediction FingerPredictor::PredictAlong(const MeasuredRun& run, const Fin
   options.relative_tolerance = options_.relative_tolerance;
   options.absolute_tolerance = options_.absolute_tolerance;
   options.dense_checks = options_.dense_checks;
+  options.interpolate_samples = options_.interpolate_samples;
+  options.fixed_point_iteration = options_.fixed_point_iteration;
   options.parameters = RunParameters(run, e);
   std::vector<std::pair<double, double>> points = DriveTimeline(p.drive, options);
   const std::shared_ptr<const Entry> entry = SimulatorFor(e);

@@ -5,6 +5,7 @@
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +27,7 @@ struct CvodeIntegrator::Handles {
   N_Vector dky = nullptr;  // Interpolate's output, allocated once
   SUNMatrix matrix = nullptr;
   SUNLinearSolver solver = nullptr;
+  SUNNonlinearSolver fixed_point = nullptr;  // Options::fixed_point_iteration only
   void* cvode = nullptr;
   bool initialised = false;
   Options options;
@@ -39,6 +41,7 @@ struct CvodeIntegrator::Handles {
 
   ~Handles() {
     if (cvode) CVodeFree(&cvode);
+    if (fixed_point) SUNNonlinSolFree(fixed_point);
     if (solver) SUNLinSolFree(solver);
     if (matrix) SUNMatDestroy(matrix);
     if (dky) N_VDestroy(dky);
@@ -106,10 +109,16 @@ CvodeIntegrator::CvodeIntegrator(OdeSystem* system, int dimension, const Options
   }
   h_->y = N_VNew_Serial(dimension, h_->context);
   h_->dky = N_VNew_Serial(dimension, h_->context);
-  h_->matrix = SUNDenseMatrix(dimension, dimension, h_->context);
-  h_->solver = SUNLinSol_Dense(h_->y, h_->matrix, h_->context);
+  if (options.fixed_point_iteration) {
+    h_->fixed_point = SUNNonlinSol_FixedPoint(h_->y, 0, h_->context);
+  } else {
+    h_->matrix = SUNDenseMatrix(dimension, dimension, h_->context);
+    h_->solver = SUNLinSol_Dense(h_->y, h_->matrix, h_->context);
+  }
   h_->cvode = CVodeCreate(CV_ADAMS, h_->context);
-  if (!h_->y || !h_->dky || !h_->matrix || !h_->solver || !h_->cvode) {
+  const bool solver =
+      options.fixed_point_iteration ? h_->fixed_point != nullptr : h_->matrix && h_->solver;
+  if (!h_->y || !h_->dky || !solver || !h_->cvode) {
     throw std::runtime_error("the ODE solver CVODE could not allocate its vectors and matrices");
   }
   // The library never prints: CVODE's messages are kept and reported through message(). Handles
@@ -133,7 +142,11 @@ void CvodeIntegrator::Restart(double t0, const Eigen::VectorXd& x0,
     check(CVodeSStolerances(h_->cvode, h_->options.relative_tolerance,
                             h_->options.absolute_tolerance),
           "CVodeSStolerances");
-    check(CVodeSetLinearSolver(h_->cvode, h_->solver, h_->matrix), "CVodeSetLinearSolver");
+    if (h_->fixed_point) {
+      check(CVodeSetNonlinearSolver(h_->cvode, h_->fixed_point), "CVodeSetNonlinearSolver");
+    } else {
+      check(CVodeSetLinearSolver(h_->cvode, h_->solver, h_->matrix), "CVodeSetLinearSolver");
+    }
     check(CVodeSetMaxNumSteps(h_->cvode, h_->options.max_steps), "CVodeSetMaxNumSteps");
     if (h_->options.max_step > 0.0 && std::isfinite(h_->options.max_step)) {
       check(CVodeSetMaxStep(h_->cvode, h_->options.max_step), "CVodeSetMaxStep");

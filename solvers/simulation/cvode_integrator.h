@@ -28,8 +28,9 @@ double InitialStepTarget(double t, double t_stop);
 /// finding. Not copyable; movable.
 ///
 /// Method: Adams-Moulton with Newton iteration and a dense linear solver (finite-difference
-/// Jacobian), suited to the small, mostly non-stiff flows of hybrid models. Root functions are
-/// located by CVODE's Illinois method to about 100 * unit roundoff * (|t| + |h|).
+/// Jacobian), suited to the small, mostly non-stiff flows of hybrid models; or, with
+/// Options::fixed_point_iteration, with fixed-point iteration (no Jacobian, no linear solves). Root
+/// functions are located by CVODE's Illinois method to about 100 * unit roundoff * (|t| + |h|).
 ///
 /// The integrator never prints: CVODE's error handler is replaced by one that keeps the last
 /// message (errors and warnings), which failures report in message() (and setup errors in the
@@ -50,6 +51,9 @@ class CvodeIntegrator {
     /// ("CV_TOO_MUCH_WORK"), so that a run whose steps collapse (a sliding mode such as
     /// x' = -sign(x), or a flow that turns NaN) ends instead of crawling on for ever.
     int max_steps = 100000;
+    /// Solve each implicit Adams step by fixed-point (functional) iteration instead of Newton's
+    /// method (SimulationOptions::fixed_point_iteration).
+    bool fixed_point_iteration = false;
   };
   /// Outcome of Advance.
   enum class Status { kStep, kReachedTime, kRoot, kFailure };

@@ -65,6 +65,7 @@ bool EventLoop::RunPass() {
   }
   CollectSolverRoots(p);
   FindInteriorCrossing(p);
+  if (!RecordInsideStep(p)) return false;
   t_ = p.t_new;
   x_ = x_new_;
   run_.Load(t_, x_.data());
@@ -154,6 +155,12 @@ void EventLoop::IntegrateToStop(Pass& p) {
   // A root function starting on its boundary is left to the solver path (its conventions for
   // that case apply), so both paths fire the same events.
   p.exact = ExactSegmentApplies(p);
+  if (!p.exact && options_.interpolate_samples && !p.at_breakpoint && p.t_stop < until_) {
+    // A solver step goes on past the samples (RecordInsideStep records them).
+    const bool breakpoint = next_break_ < breakpoints_.size() && breakpoints_[next_break_] < until_;
+    p.t_stop = breakpoint ? breakpoints_[next_break_] : until_;
+    p.at_breakpoint = breakpoint;
+  }
   if (p.exact) {
     ExactSegment(p);
   } else if (stale_ && p.t_stop - t_ <= kShortGap * std::max(std::abs(t_), std::abs(p.t_stop))) {
@@ -268,6 +275,7 @@ void EventLoop::SolverStep(Pass& p) {
     integrator_options.relative_tolerance = options_.relative_tolerance;
     integrator_options.absolute_tolerance = options_.absolute_tolerance;
     integrator_options.max_step = options_.max_step;
+    integrator_options.fixed_point_iteration = options_.fixed_point_iteration;
     integrator_.emplace(&run_, std::max(n_, 1), integrator_options);
   }
   if (stale_) {
@@ -607,8 +615,26 @@ bool EventLoop::InputJump() {
   return !ZenoCheck();
 }
 
-void EventLoop::Record(StateSample::Kind kind) {
-  result_.samples.push_back({t_, kind, run_.modes(), x_.head(n_)});
+bool EventLoop::RecordInsideStep(const Pass& p) {
+  if (p.exact || p.short_gap || !options_.interpolate_samples) return true;
+  for (double t = samples_.Next(); t < p.t_new; t = samples_.Next()) {
+    HYBRID_ASSERT(t > p.t_prev, "the samples up to the pass's start are taken");
+    if (!integrator_->Interpolate(t, &x_mid_)) return true;  // left to the stops (never here)
+    if (samples_.TakeUniform(t)) RecordAt(StateSample::Kind::kSample, t, x_mid_);
+    while (samples_.TakeListed(t)) RecordAt(StateSample::Kind::kSample, t, x_mid_);
+    if (stop_asked_) {
+      t_ = t;
+      x_ = x_mid_;
+      return !StopAsked();
+    }
+  }
+  return true;
+}
+
+void EventLoop::Record(StateSample::Kind kind) { RecordAt(kind, t_, x_); }
+
+void EventLoop::RecordAt(StateSample::Kind kind, double t, const Eigen::VectorXd& x) {
+  result_.samples.push_back({t, kind, run_.modes(), x.head(n_)});
   if (kind == StateSample::Kind::kSample && options_.monitor && !stop_asked_) {
     stop_asked_ = !options_.monitor(monitored_++, result_.samples.back());
   }

@@ -161,6 +161,11 @@ class EventLoop {
   // Helpers.
   // Records (t_, modes, x_) as a sample of `kind`; gives a kSample to options_.monitor.
   void Record(StateSample::Kind kind);
+  void RecordAt(StateSample::Kind kind, double t, const Eigen::VectorXd& x);
+  // With options_.interpolate_samples, after a solver step: records the samples due strictly
+  // before the pass's end on the step's interpolant. Returns false when the monitor stops the
+  // run at one of them ((t_, x_) then that sample's).
+  bool RecordInsideStep(const Pass& p);
   // Whether the monitor asked the run to stop; if so, sets the status kStopped.
   bool StopAsked();
   // Records the listed sample times already reached.

@@ -166,8 +166,16 @@ TEST(MotorPositionsTest, HoldsAtAStopUntilAMoreOpenRequest) {
 // The report's protocol (requests up to 255, past the stop, and back; one reversal on the way up)
 // against the independent rig: the motor is the rig's min(request, stop) and the angles are the
 // rig's, for no object, an object on link 1 and one on link 2, with play and offset.
-TEST(FingerPredictorTest, RequestsPastTheStopFollowTheIndependentRig) {
-  const FingerPredictor predictor(Finger());
+// Both integration settings: the default, and diagnose's FastOptions (looser tolerances, samples
+// on the solver's interpolant), within 1e-5 and 1e-3 deg of the rig (motor stops within 1e-6 and
+// 1e-3 counts).
+class FingerPredictorRigTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(FingerPredictorRigTest, RequestsPastTheStopFollowTheIndependentRig) {
+  const bool fast = GetParam();
+  const FingerPredictor predictor(
+      Finger(), fast ? FingerPredictor::FastOptions() : FingerPredictor::Options{});
+  const double tolerance = fast ? 1e-3 : 1e-5;
   struct Case {
     std::optional<double> gob1, gob2;
     double backlash, offset;
@@ -198,11 +206,16 @@ TEST(FingerPredictorTest, RequestsPastTheStopFollowTheIndependentRig) {
     for (size_t k = 0; k < requests.size(); ++k) {
       SCOPED_TRACE("link " + std::to_string(link) + " request " + std::to_string(requests[k]) +
                    " sample " + std::to_string(k));
-      EXPECT_NEAR(p.motor[k], std::min(requests[k], motor_stop), 1e-6);
-      for (int j = 0; j < 3; ++j) EXPECT_NEAR(p.theta[j][k], samples[k].theta[j], 1e-5);
+      EXPECT_NEAR(p.motor[k], std::min(requests[k], motor_stop), fast ? 1e-3 : 1e-6);
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(p.theta[j][k], samples[k].theta[j], tolerance);
     }
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Settings, FingerPredictorRigTest, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "Fast" : "Default";
+                         });
 
 // The law: for random effects, objects and request paths with reversals (which may go past where
 // the finger stalls), the predictor equals the extended automaton driven along its motor path
@@ -238,6 +251,12 @@ RC_GTEST_PROP(FingerPredictorProperty, EqualsTheExtendedAutomaton, ()) {
   along_motor.g = p.motor;
   const double diff = MaxDifference(p, SimulateExtended(predictor, along_motor, e));
   RC_ASSERT(diff < 1e-6);
+  // Diagnose's settings (FastOptions: looser tolerances, samples on the solver's interpolant)
+  // stop the motor at the same samples, and stay within 1e-3 deg.
+  static const FingerPredictor fast(Finger(), FingerPredictor::FastOptions());
+  const FingerPrediction q = fast.Predict(run, e);
+  RC_ASSERT(q.status == SimulationStatus::kCompleted);
+  RC_ASSERT(MaxDifference(q, {p.theta[0], p.theta[1], p.theta[2]}) < 1e-3);
 }
 
 }  // namespace

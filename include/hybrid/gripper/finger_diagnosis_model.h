@@ -49,16 +49,18 @@ class FingerDiagnosisModel : public DiagnosisModel {
 
  private:
   FingerPrediction Checked(int run, const FingerEffects& effects) const;
-  FingerPrediction Memoised(int run, const FingerEffects& dynamic) const;
+  // The prediction of `run` under `dynamic` (no sensor biases): from the memo, or simulated
+  // (Checked) for its representative and kept there.
+  RunPrediction Memoised(int run, const FingerEffects& dynamic) const;
 
   const FingerPredictor& predictor_;
   const MeasuredData& data_;
-  std::vector<FingerPrediction> baseline_;
+  std::vector<RunPrediction> baseline_;
   std::vector<EffectParameter> effects_;
   std::vector<CandidateParameter> candidates_;
   std::vector<int> representative_;  // the first run with the same motor path and object
   mutable std::mutex memo_mutex_;
-  mutable std::map<std::string, std::shared_ptr<const FingerPrediction>> memo_;
+  mutable std::map<std::string, std::shared_ptr<const RunPrediction>> memo_;
 };
 
 }  // namespace hybrid

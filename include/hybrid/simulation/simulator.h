@@ -67,6 +67,19 @@ struct SimulationOptions {
   /// the step's interpolating polynomial, to find a guard that crosses twice inside one step (the
   /// integrator looks only at step ends). 0 disables the check. At most 1000.
   int dense_checks = 4;
+  /// Samples inside a solver step (listed and uniform ones that fall strictly inside it) are
+  /// recorded on the step's interpolating polynomial (the integrator's dense output, accurate to
+  /// about the tolerances) instead of ending a step at each one: far fewer steps when the samples
+  /// are denser than the dynamics need, states within the tolerances of those the default records.
+  /// Samples on exact (constant-rate) segments, at events and at input breakpoints are recorded
+  /// as without it.
+  bool interpolate_samples = false;
+  /// Solve the integrator's implicit (Adams-Moulton) steps by fixed-point iteration instead of
+  /// Newton's method with a finite-difference Jacobian: cheaper steps for a non-stiff flow (no
+  /// Jacobian, no linear solves); on a stiff one the steps shrink until the iteration converges,
+  /// and the run may end as kSolverFailure where Newton's would not. The same solution within the
+  /// tolerances.
+  bool fixed_point_iteration = false;
   /// Largest internal step (0: unlimited).
   double max_step = 0.0;
   /// Jumps allowed at one instant before the run stops as Zeno (event iteration bound).

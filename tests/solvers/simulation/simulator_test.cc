@@ -438,6 +438,75 @@ TEST(SimulatorTest, ARunContinuedFromItsStateMatchesTheAnalyticBounces) {
   EXPECT_THROW(m.Run(options), std::invalid_argument);
 }
 
+// Samples on the solver's interpolant (SimulationOptions::interpolate_samples): the ball's height,
+// sampled every 0.01 s over its first 12 bounces, follows the analytic parabolas within 1e-7 of
+// h0; the bounces fall where they do without it, and the solver takes fewer steps.
+TEST(SimulatorTest, InterpolatedSamplesFollowTheAnalyticBall) {
+  const BallParameters p;
+  const Model m(BallText(p));
+  const auto impacts = BallImpacts(p, 12);
+  SimulationOptions o = Until(impacts.back().time);
+  o.sample_step = 0.01;
+  const SimulationResult stops = m.Run(o);
+  o.interpolate_samples = true;
+  const SimulationResult r = m.Run(o);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  ASSERT_EQ(r.events.size(), stops.events.size());
+  for (size_t k = 0; k < r.events.size(); ++k) {
+    EXPECT_NEAR(r.events[k].time, impacts[k].time, 1e-9 * BallZenoTime(p)) << "bounce " << k;
+  }
+  EXPECT_LT(r.steps, stops.steps / 2);
+  Measured("ball sampled every 0.01 s: solver steps with samples on the interpolant / without",
+           static_cast<double>(r.steps) / static_cast<double>(stops.steps));
+  const int h = m.Var("h");
+  size_t samples = 0;
+  for (const StateSample& s : r.samples) {
+    if (s.kind != StateSample::Kind::kSample) continue;
+    ++samples;
+    // The last impact at or before s.time, and the parabola since.
+    double t0 = 0.0, v0 = 0.0, h0 = p.h0;
+    for (const auto& impact : impacts) {
+      if (impact.time > s.time) break;
+      t0 = impact.time;
+      v0 = p.e * impact.speed;
+      h0 = 0.0;
+    }
+    const double dt = s.time - t0;
+    EXPECT_NEAR(s.x[h], h0 + v0 * dt - 0.5 * p.g * dt * dt, 1e-7 * p.h0) << "t = " << s.time;
+  }
+  // The same samples as with stops at them, more than a thousand.
+  EXPECT_EQ(samples, static_cast<size_t>(std::count_if(
+                         stops.samples.begin(), stops.samples.end(), [](const StateSample& s) {
+                           return s.kind == StateSample::Kind::kSample;
+                         })));
+  EXPECT_GT(samples, 1000u);
+  // A monitor stops the run at an interpolated sample: the first below h0 / 2, at
+  // t = sqrt(h0 / g) = 1.0096 s, is the one at 1.01 s.
+  o.monitor = [&](size_t, const StateSample& s) { return s.x[h] >= 0.5 * p.h0; };
+  const SimulationResult half = m.Run(o);
+  ASSERT_EQ(half.status, SimulationStatus::kStopped) << half.message;
+  EXPECT_NEAR(half.samples.back().time, 1.01, 1e-12);
+  EXPECT_EQ(half.samples.back().kind, StateSample::Kind::kEnd);
+  EXPECT_NEAR(half.samples.back().x[h], p.h0 - 0.5 * p.g * 1.01 * 1.01, 1e-7 * p.h0);
+}
+
+// Fixed-point iteration (SimulationOptions::fixed_point_iteration): the ball's first 30 bounces
+// still fall within 1e-9 of the time scale of the analytic ones.
+TEST(SimulatorTest, FixedPointIterationKeepsTheAnalyticBounces) {
+  const BallParameters p;
+  const Model m(BallText(p));
+  const auto impacts = BallImpacts(p, 30);
+  SimulationOptions o = Until(impacts.back().time + 0.1);
+  o.fixed_point_iteration = true;
+  const SimulationResult r = m.Run(o);
+  ASSERT_EQ(r.status, SimulationStatus::kCompleted) << r.message;
+  ASSERT_GE(r.events.size(), impacts.size()) << Describe(m, r);
+  for (size_t k = 0; k < impacts.size(); ++k) {
+    EXPECT_EQ(r.events[k].transitions, std::vector<std::string>{"bounce"});
+    EXPECT_NEAR(r.events[k].time, impacts[k].time, 1e-9 * BallZenoTime(p)) << "bounce " << k + 1;
+  }
+}
+
 TEST(SimulatorTest, BallThatComesToRestIsNotZeno) {
   // Low restitution: the ball reaches v_rest after about ten impacts, whose times still shrink
   // geometrically up to the last one (`stop`). The run must complete at rest, not stop as Zeno.
