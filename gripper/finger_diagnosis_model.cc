@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <future>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -135,15 +136,27 @@ FingerPrediction FingerDiagnosisModel::Checked(int r, const FingerEffects& e) co
 
 RunPrediction FingerDiagnosisModel::Memoised(int r, const FingerEffects& dynamic) const {
   const std::string key = MemoKey(representative_[r], dynamic);
+  std::promise<std::shared_ptr<const RunPrediction>> promise;
+  std::shared_future<std::shared_ptr<const RunPrediction>> entry;
+  bool mine = false;
   {
     std::lock_guard<std::mutex> lock(memo_mutex_);
-    const auto it = memo_.find(key);
-    if (it != memo_.end()) return *it->second;
+    auto [it, inserted] = memo_.try_emplace(key);
+    if (inserted) it->second = promise.get_future().share();
+    entry = it->second;
+    mine = inserted;
   }
-  auto p =
-      std::make_shared<const RunPrediction>(AsRunPrediction(Checked(representative_[r], dynamic)));
-  std::lock_guard<std::mutex> lock(memo_mutex_);
-  return *memo_.emplace(key, std::move(p)).first->second;
+  // The first caller of a key simulates it; callers on other threads meanwhile wait for its
+  // result (or its error) instead of simulating it again.
+  if (mine) {
+    try {
+      promise.set_value(std::make_shared<const RunPrediction>(
+          AsRunPrediction(Checked(representative_[r], dynamic))));
+    } catch (...) {
+      promise.set_exception(std::current_exception());
+    }
+  }
+  return *entry.get();
 }
 
 RunPrediction FingerDiagnosisModel::Predict(int r, const ParameterValues& values) const {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -60,7 +61,8 @@ class FingerDiagnosisModel : public DiagnosisModel {
   std::vector<CandidateParameter> candidates_;
   std::vector<int> representative_;  // the first run with the same motor path and object
   mutable std::mutex memo_mutex_;
-  mutable std::map<std::string, std::shared_ptr<const RunPrediction>> memo_;
+  // Each key's prediction, or the error simulating it gave (rethrown to every caller).
+  mutable std::map<std::string, std::shared_future<std::shared_ptr<const RunPrediction>>> memo_;
 };
 
 }  // namespace hybrid
