@@ -2532,5 +2532,70 @@ RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
   }
 }
 
+// Differential: recording samples changes nothing (docs/simulation.md). A random automaton run
+// without samples, with dense samples (uniform and listed: each one a stop of the integration,
+// and on a constant-rate segment a state taken on the anchor's line), and with the samples read
+// off the solver's interpolant (SimulationOptions::interpolate_samples): the same status, the
+// same jumps at the same times and the same end state, within the integrator's tolerance; both
+// sampled runs record the same samples at the same times, their states within it too.
+RC_GTEST_PROP(SimulatorProperty, SamplesChangeNothing, ()) {
+  using namespace testing;  // NOLINT(build/namespaces): the random automata's generator
+  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint64_t>());
+  RandomAutomatonOptions kinds;
+  kinds.dynamics = *rc::gen::element(RandomDynamics::kMixed, RandomDynamics::kAffine);
+  PrintOptions print;
+  print.explicit_rates = true;
+  const std::string text = GenerateRandomAutomaton(rng, kinds).Text(print);
+  const System system = ParseModel(text, "random.ha");
+  std::optional<Simulator> sim;
+  try {
+    sim.emplace(system);
+  } catch (const std::invalid_argument&) {
+    RC_DISCARD("no initial state");
+  }
+  SimulationOptions plain;
+  plain.until = 3.0;
+  SimulationResult reference;
+  try {
+    reference = sim->Run(plain);
+  } catch (const std::invalid_argument&) {
+    RC_DISCARD("the start violates an invariant");
+  }
+  SimulationOptions sampled = plain;
+  sampled.sample_step = *GenReal(0.01, 0.2);
+  for (int i = *rc::gen::inRange(0, 20); i > 0; --i) sampled.sample_times.push_back(*GenReal(0, 3));
+  std::sort(sampled.sample_times.begin(), sampled.sample_times.end());
+  SimulationOptions interpolated = sampled;
+  interpolated.interpolate_samples = true;
+  const SimulationResult stops = sim->Run(sampled);
+  const SimulationResult read = sim->Run(interpolated);
+  RC_TAG(reference.events.empty() ? "no jumps" : "jumps",
+         reference.steps > 0 ? "solver steps" : "exact segments only");
+  auto close = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    if (a.size() != b.size()) return false;
+    for (int i = 0; i < a.size(); ++i) {
+      if (!(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])))) return false;
+    }
+    return true;
+  };
+  for (const SimulationResult* r : {&stops, &read}) {
+    RC_ASSERT(r->status == reference.status);
+    RC_ASSERT(r->events.size() == reference.events.size());
+    for (size_t k = 0; k < r->events.size(); ++k) {
+      RC_ASSERT(r->events[k].transitions == reference.events[k].transitions);
+      RC_ASSERT(std::abs(r->events[k].time - reference.events[k].time) <= 1e-6);
+    }
+    RC_ASSERT(r->samples.back().modes == reference.samples.back().modes);
+    RC_ASSERT(close(r->samples.back().x, reference.samples.back().x));
+  }
+  RC_ASSERT(stops.samples.size() == read.samples.size());
+  for (size_t i = 0; i < stops.samples.size(); ++i) {
+    RC_ASSERT(stops.samples[i].kind == read.samples[i].kind);
+    RC_ASSERT(std::abs(stops.samples[i].time - read.samples[i].time) <= 1e-6);
+    RC_ASSERT(stops.samples[i].modes == read.samples[i].modes);
+    RC_ASSERT(close(stops.samples[i].x, read.samples[i].x));
+  }
+}
+
 }  // namespace
 }  // namespace hybrid
