@@ -6,7 +6,7 @@ change in the machine's speed during the measurement falls on both), and prints 
 user + system CPU seconds of the child process (getrusage), the medians and the ratio
 old / new. Both must exit with the same status each time; their standard outputs are
 compared too (--same-output), except lines that contain a wall-clock figure, given by
---ignore (a regular expression, default: lines with "seconds" or "time:").
+--ignore (a regular expression, default: lines with "seconds", "time:" or a figure in s).
 
 Usage: tools/compare_cpu.py OLD NEW [--runs N] [--same-output] [--ignore REGEX] -- ARGS...
 Example (the diagnosis of the demo, a build of an earlier commit against this one):
@@ -40,7 +40,7 @@ def main():
     parser.add_argument("--runs", type=int, default=5, help="runs of each (default 5)")
     parser.add_argument("--same-output", action="store_true",
                         help="the standard outputs must be equal (but for --ignore lines)")
-    parser.add_argument("--ignore", default=r"seconds|time:",
+    parser.add_argument("--ignore", default=r"seconds|time:|[0-9] s\b",
                         help="lines of the output left out of the comparison (regex)")
     argv = sys.argv[1:]
     split = argv.index("--") if "--" in argv else len(argv)
