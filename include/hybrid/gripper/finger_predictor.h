@@ -81,8 +81,8 @@ class FingerPredictor {
     bool interpolate_samples = false;    ///< SimulationOptions::interpolate_samples
     bool fixed_point_iteration = false;  ///< SimulationOptions::fixed_point_iteration
   };
-  /// Diagnose's settings: within 1e-3 deg of the default ones (FingerPredictorProperty; 6e-4
-  /// deg the largest difference seen over 300 random runs), far below the measurement noise.
+  /// Diagnose's settings: within 1e-3 deg of the default ones (FingerPredictorProperty checks it
+  /// on random runs), far below the measurement noise.
   /// Tolerances 3e-7 / 3e-8; the phase-3 law (the only flow the solver integrates) is non-stiff,
   /// so its steps use fixed-point iteration and the samples are read off the solver's
   /// interpolant (SimulationOptions). No interior double-crossing checks: the finger's guards
