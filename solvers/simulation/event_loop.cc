@@ -619,7 +619,8 @@ bool EventLoop::RecordInsideStep(const Pass& p) {
   if (p.exact || p.short_gap || !options_.interpolate_samples) return true;
   for (double t = samples_.Next(); t < p.t_new; t = samples_.Next()) {
     HYBRID_ASSERT(t > p.t_prev, "the samples up to the pass's start are taken");
-    if (!integrator_->Interpolate(t, &x_mid_)) return true;  // left to the stops (never here)
+    const bool inside = integrator_->Interpolate(t, &x_mid_);
+    HYBRID_ASSERT(inside, "a sample inside a solver step lies on its interpolant");
     if (samples_.TakeUniform(t)) RecordAt(StateSample::Kind::kSample, t, x_mid_);
     while (samples_.TakeListed(t)) RecordAt(StateSample::Kind::kSample, t, x_mid_);
     if (stop_asked_) {
