@@ -55,6 +55,7 @@ struct Model {
   // `file_name` resolves imports (spec/hand.ha imports finger.ha).
   explicit Model(std::string_view text, const std::string& file_name = "test.ha")
       : system(ParseModel(text, file_name)), sim(system) {}
+  explicit Model(System parsed) : system(std::move(parsed)), sim(system) {}
   Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 
@@ -2476,45 +2477,54 @@ TEST(SimulatorScheduleTest, RefusesTimesOutOfOrderOrBeyondTheHorizon) {
 namespace hybrid {
 namespace {
 
-// Differential: a run of a random automaton (tests/test_utilities/random_hybrid_automata.h, affine
-// dynamics, urgent and lazy transitions, resets) continued from the state it reached at an
-// arbitrary time (SimulationOptions::start_modes, start_x) ends where the whole run ends: the same
-// modes, the same values within the integrator's tolerance.
-RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
+// A random automaton (tests/test_utilities/random_hybrid_automata.h: mixed or affine dynamics,
+// urgent and lazy transitions, resets) drawn by rapidcheck and compiled; a case without an
+// initial state is discarded (a text that does not parse fails it).
+std::unique_ptr<Model> RandomModel() {
   using namespace testing;  // NOLINT(build/namespaces): the random automata's generator
   std::mt19937_64 rng(*rc::gen::arbitrary<std::uint64_t>());
   RandomAutomatonOptions kinds;
   kinds.dynamics = *rc::gen::element(RandomDynamics::kMixed, RandomDynamics::kAffine);
   PrintOptions print;
   print.explicit_rates = true;
-  const std::string text = GenerateRandomAutomaton(rng, kinds).Text(print);
-  const System system = ParseModel(text, "random.ha");
-  std::optional<Simulator> sim;
+  System system = ParseModel(GenerateRandomAutomaton(rng, kinds).Text(print), "random.ha");
   try {
-    sim.emplace(system);
+    return std::make_unique<Model>(std::move(system));
   } catch (const std::invalid_argument&) {
     RC_DISCARD("no initial state");
   }
+}
+
+// The run of `m` under `options`; a case whose start violates an invariant is discarded.
+SimulationResult RunOrDiscard(const Model& m, const SimulationOptions& options) {
+  try {
+    return m.Run(options);
+  } catch (const std::invalid_argument&) {
+    RC_DISCARD("the start violates an invariant");
+  }
+}
+
+// Differential: a run of a random automaton (tests/test_utilities/random_hybrid_automata.h, affine
+// dynamics, urgent and lazy transitions, resets) continued from the state it reached at an
+// arbitrary time (SimulationOptions::start_modes, start_x) ends where the whole run ends: the same
+// modes, the same values within the integrator's tolerance.
+RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
+  const std::unique_ptr<Model> m = RandomModel();
   constexpr double kHorizon = 3.0;
   const double split = *GenReal(0.3, 2.7) + 0.000123;
   SimulationOptions whole_options;
   whole_options.until = kHorizon;
-  SimulationResult whole;
-  try {
-    whole = sim->Run(whole_options);
-  } catch (const std::invalid_argument&) {
-    RC_DISCARD("the start violates an invariant");
-  }
+  const SimulationResult whole = RunOrDiscard(*m, whole_options);
   RC_PRE(whole.status == SimulationStatus::kCompleted);
   SimulationOptions first_options;
   first_options.until = split;
-  const SimulationResult first = sim->Run(first_options);
+  const SimulationResult first = m->Run(first_options);
   RC_ASSERT(first.status == SimulationStatus::kCompleted);
   SimulationOptions second_options;
   second_options.until = kHorizon - split;
   second_options.start_modes = first.samples.back().modes;
   second_options.start_x = first.samples.back().x;
-  const SimulationResult second = sim->Run(second_options);
+  const SimulationResult second = m->Run(second_options);
   RC_ASSERT(second.status == SimulationStatus::kCompleted);
   RC_ASSERT(second.samples.back().modes == whole.samples.back().modes);
   const Eigen::VectorXd& a = whole.samples.back().x;
@@ -2545,36 +2555,18 @@ RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
 //   in the other);
 // - both sampled runs record the same samples when both complete, within the tolerance.
 RC_GTEST_PROP(SimulatorProperty, SamplesChangeNothing, ()) {
-  using namespace testing;  // NOLINT(build/namespaces): the random automata's generator
-  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint64_t>());
-  RandomAutomatonOptions kinds;
-  kinds.dynamics = *rc::gen::element(RandomDynamics::kMixed, RandomDynamics::kAffine);
-  PrintOptions print;
-  print.explicit_rates = true;
-  const std::string text = GenerateRandomAutomaton(rng, kinds).Text(print);
-  const System system = ParseModel(text, "random.ha");
-  std::optional<Simulator> sim;
-  try {
-    sim.emplace(system);
-  } catch (const std::invalid_argument&) {
-    RC_DISCARD("no initial state");
-  }
+  const std::unique_ptr<Model> m = RandomModel();
   SimulationOptions plain;
   plain.until = 3.0;
-  SimulationResult reference;
-  try {
-    reference = sim->Run(plain);
-  } catch (const std::invalid_argument&) {
-    RC_DISCARD("the start violates an invariant");
-  }
+  const SimulationResult reference = RunOrDiscard(*m, plain);
   SimulationOptions sampled = plain;
   sampled.sample_step = *GenReal(0.01, 0.2);
   for (int i = *rc::gen::inRange(0, 20); i > 0; --i) sampled.sample_times.push_back(*GenReal(0, 3));
   std::sort(sampled.sample_times.begin(), sampled.sample_times.end());
   SimulationOptions interpolated = sampled;
   interpolated.interpolate_samples = true;
-  const SimulationResult stops = sim->Run(sampled);
-  const SimulationResult read = sim->Run(interpolated);
+  const SimulationResult stops = m->Run(sampled);
+  const SimulationResult read = m->Run(interpolated);
   const bool solver = reference.steps > 0;
   RC_TAG(reference.events.empty() ? "no jumps" : "jumps",
          solver ? "solver steps" : "exact segments only",
