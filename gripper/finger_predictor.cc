@@ -177,15 +177,16 @@ std::vector<std::pair<std::string, double>> FingerPredictor::RunParameters(const
 std::vector<double> MotorPositions(std::span<const double> requests,
                                    std::span<const ControllerStop> stops) {
   std::vector<double> motor(requests.size());
-  double held = kNaN;  // NaN: following the requests (a stop is never NaN: FirstStall)
+  bool holding = false;  // the motor held at `held` (a bool beside it: any value may be a stop)
+  double held = 0.0;
   size_t next = 0;
   for (size_t k = 0; k < requests.size(); ++k) {
     while (next < stops.size() && stops[next].index <= k) {
-      if (stops[next].index == k) held = stops[next].motor;
+      if (stops[next].index == k) holding = true, held = stops[next].motor;
       ++next;
     }
-    if (requests[k] < held) held = kNaN;  // a more open request: follow it
-    motor[k] = std::isnan(held) ? requests[k] : held;
+    if (holding && requests[k] < held) holding = false;  // a more open request: follow it
+    motor[k] = holding ? held : requests[k];
   }
   return motor;
 }
