@@ -2525,6 +2525,22 @@ RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
   second_options.start_modes = first.samples.back().modes;
   second_options.start_x = first.samples.back().x;
   const SimulationResult second = m->Run(second_options);
+  // A guard or an invariant's boundary met exactly at the horizon (the random automata's round
+  // constants put one there now and then) is a tie that rounding decides: one run reaches it a
+  // rounding error short and ends, the other a rounding error past and jumps there or leaves
+  // the invariant. Not a difference of the split. (Still open, RC_PARAMS="seed=6
+  // max_success=300": a jump at a crossing whose guard still holds after it, a self-loop that
+  // resets nothing, fires once in one run and twice in the other, as rounding puts the state
+  // after the jump on either side of the guard's boundary.)
+  const auto at_horizon = [](const SimulationResult& r, double horizon) {
+    const bool jumps = !r.events.empty() && r.events.back().time >= horizon - 1e-9;
+    const bool stops = r.status != SimulationStatus::kCompleted && !r.samples.empty() &&
+                       r.samples.back().time >= horizon - 1e-9;
+    return jumps || stops;
+  };
+  if (at_horizon(whole, kHorizon) || at_horizon(second, kHorizon - split)) {
+    RC_DISCARD("a guard or an invariant's boundary met at the horizon (a tie within rounding)");
+  }
   RC_ASSERT(second.status == SimulationStatus::kCompleted);
   RC_ASSERT(second.samples.back().modes == whole.samples.back().modes);
   const Eigen::VectorXd& a = whole.samples.back().x;
