@@ -70,13 +70,9 @@ class InductionRound {
   // steps on which the living candidates hold before s_k and one of `goals` fails at s_k. On sat,
   // `failed` gets the goals the model breaks (all of them when it cannot tell).
   z3::check_result StepQuery(int m, const std::vector<std::size_t>& goals, unsigned limit,
-                             std::vector<std::size_t>& failed);
+                             std::vector<std::size_t>& failed, bool apart = false);
   // Logs (kDebug) that the step from mode m (any: m < 0) fails for the candidates `failed`.
   void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
-  // What the step from mode m implies of the modes (s_k-1 in m alone, s_k in m or a target of a
-  // transition from m), spelt out so that Z3's simplification drops the other modes' constraints
-  // before the solver sees them.
-  z3::expr OnlyModesOfTheStep(int m);
   // The path of the step query from mode m (any: m < 0), built on first use.
   const z3::expr& StepPath(int m);
   // The living candidates and the lemmas hold at s_0 .. s_k-1: built on first use after each

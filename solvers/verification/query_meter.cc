@@ -68,7 +68,9 @@ std::uint64_t ResourceCount(const z3::solver& s) {
 }
 
 QueryMeter::QueryMeter(z3::context& ctx, SolverBudget& budget, QueryDump dump)
-    : budget_(budget), dump_(std::move(dump)), watchdog_([&ctx] { ctx.interrupt(); }) {
+    : budget_(budget), dump_(std::move(dump)), ctx_(ctx), running_(&ctx), watchdog_([this] {
+        running_.load()->interrupt();
+      }) {
   HYBRID_ASSERT(dump_.directory.empty() || dump_.count != nullptr,
                 "a dump directory comes with its file counter");
 }
@@ -80,7 +82,7 @@ bool QueryMeter::Stopped(const z3::solver& s) const {
   return false;
 }
 
-std::uint64_t QueryMeter::Allow(z3::solver& s, unsigned cap, std::uint64_t ceiling) {
+std::uint64_t QueryMeter::Allowed(unsigned cap, std::uint64_t ceiling) const {
   HYBRID_ASSERT(budget_.used() < ceiling, "a query runs only below its ceiling");
   // What is left, rounded down to a power of two when less than `cap`: setting a solver's
   // parameters costs time on a large incremental solver, so they change only when the
@@ -91,6 +93,11 @@ std::uint64_t QueryMeter::Allow(z3::solver& s, unsigned cap, std::uint64_t ceili
     allowed = 1;
     while (allowed * 2 <= left) allowed *= 2;
   }
+  return allowed;
+}
+
+std::uint64_t QueryMeter::Allow(z3::solver& s, unsigned cap, std::uint64_t ceiling) {
+  const std::uint64_t allowed = Allowed(cap, ceiling);
   const bool same =
       last_solver_ && static_cast<Z3_solver>(*last_solver_) == static_cast<Z3_solver>(s);
   if (!same || last_allowed_ != allowed) {
@@ -111,20 +118,43 @@ void QueryMeter::DumpQuery(z3::solver& s, std::uint64_t allowed) {
   if (!out) Log(LogLevel::kWarning, "prove", "cannot write the query file " + path);
 }
 
-z3::check_result QueryMeter::Check(z3::solver& s, unsigned cap, std::uint64_t ceiling,
-                                   const std::string& what) {
-  HYBRID_ASSERT(cap > 0, "a query may use some resource units");
+bool QueryMeter::MayRun(std::uint64_t ceiling, const std::string& what) {
   if (budget_.used() >= ceiling || budget_.SafetyExpired()) {
     ++starved_;
     if (LogEnabled(LogLevel::kDebug)) {
       Log(LogLevel::kDebug, "prove", "query (" + what + ") not run: budget spent");
     }
-    return z3::unknown;
+    return false;
   }
-  if (Stopped(s)) return z3::unknown;
   if (LogEnabled(LogLevel::kDebug)) {
     Log(LogLevel::kDebug, "prove", "query start (" + what + ")");
   }
+  return true;
+}
+
+void QueryMeter::Settle(z3::check_result r, std::uint64_t spent, std::uint64_t allowed,
+                        unsigned cap, bool stopped, double seconds, const std::string& what) {
+  if (stopped) {
+    // Where the net stopped the query depends on the machine's speed; what it charges and
+    // what follows on this solver must not: the whole allowance, and no further query.
+    budget_.Charge(std::max<std::uint64_t>(spent, allowed));
+    budget_.NoteSafetyStop();
+  } else {
+    budget_.Charge(spent);
+  }
+  if (r == z3::unknown && allowed < cap) ++starved_;
+  if (LogEnabled(LogLevel::kInfo)) {
+    std::ostringstream line;
+    line << "query (" << what << "): " << r << ", " << spent << " units, " << seconds << " s";
+    if (stopped) line << ", stopped by the CPU-time safety net";
+    Log(LogLevel::kInfo, "prove", line.str());
+  }
+}
+
+z3::check_result QueryMeter::Check(z3::solver& s, unsigned cap, std::uint64_t ceiling,
+                                   const std::string& what) {
+  HYBRID_ASSERT(cap > 0, "a query may use some resource units");
+  if (!MayRun(ceiling, what) || Stopped(s)) return z3::unknown;
   // The CPU-time limit of the query comes from the units it may use (10 s per budget second, at
   // least 10 s): work Z3's count misses (a search query of the finger's modes spent 100 s on 1.8
   // million units) is cut there.
@@ -140,22 +170,70 @@ z3::check_result QueryMeter::Check(z3::solver& s, unsigned cap, std::uint64_t ce
   const std::uint64_t spent = count > seen_ ? count - seen_ : 0;
   seen_ = std::max(seen_, count);
   if (stopped) {
-    // Where the net stopped the query depends on the machine's speed; what it charges and
-    // what follows on this solver must not: the whole allowance, and no further query.
     r = z3::unknown;
-    budget_.Charge(std::max<std::uint64_t>(spent, allowed));
-    budget_.NoteSafetyStop();
     stopped_solvers_.push_back(s);
-  } else {
-    budget_.Charge(spent);
   }
-  if (r == z3::unknown && allowed < cap) ++starved_;
-  if (LogEnabled(LogLevel::kInfo)) {
-    std::ostringstream line;
-    line << "query (" << what << "): " << r << ", " << spent << " units, " << seconds << " s";
-    if (stopped) line << ", stopped by the CPU-time safety net";
-    Log(LogLevel::kInfo, "prove", line.str());
+  Settle(r, spent, allowed, cap, stopped, seconds, what);
+  return r;
+}
+
+z3::check_result QueryMeter::CheckApart(const z3::expr_vector& query, unsigned cap,
+                                        std::uint64_t ceiling, const std::string& what,
+                                        const std::vector<z3::expr>& watch,
+                                        std::vector<bool>& holds, long group) {
+  HYBRID_ASSERT(cap > 0, "a query may use some resource units");
+  holds.clear();
+  if (!MayRun(ceiling, what)) return z3::unknown;
+  const std::uint64_t allowed = Allowed(cap, ceiling);
+  if (!dump_.directory.empty()) {
+    z3::solver dumped = MakeSolver(ctx_);
+    for (const z3::expr& e : query) dumped.add(e);
+    DumpQuery(dumped, allowed);
   }
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!apart_ || apart_group_ != group) {
+    apart_ = std::make_unique<z3::context>();
+    apart_group_ = group;
+    apart_seen_ = 0;
+  }
+  bool stopped = false;
+  std::uint64_t count = 0;
+  z3::check_result r = SolveApart(query, allowed, watch, holds, stopped, count);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::uint64_t spent = count > apart_seen_ ? count - apart_seen_ : 0;
+  apart_seen_ = std::max(apart_seen_, count);
+  if (stopped) {
+    r = z3::unknown;
+    apart_.reset();  // its state depends on where the net stopped it: the next query gets another
+  }
+  Settle(r, spent, allowed, cap, stopped, seconds, what);
+  return r;
+}
+
+z3::check_result QueryMeter::SolveApart(const z3::expr_vector& query, std::uint64_t allowed,
+                                        const std::vector<z3::expr>& watch,
+                                        std::vector<bool>& holds, bool& stopped,
+                                        std::uint64_t& count) {
+  z3::context& apart = *apart_;
+  z3::solver solver = MakeSolver(apart);
+  z3::params p(apart);
+  p.set("rlimit", static_cast<unsigned>(allowed));
+  solver.set(p);
+  const auto translate = [&](const z3::expr& e) {
+    return z3::expr(apart, Z3_translate(ctx_, e, apart));
+  };
+  for (const z3::expr& e : query) solver.add(translate(e));
+  running_ = &apart;
+  watchdog_.Arm(budget_.SafetyCpuSeconds(allowed));
+  const z3::check_result r = solver.check();
+  stopped = watchdog_.Disarm();
+  running_ = &ctx_;
+  if (r == z3::sat && !stopped) {
+    const z3::model model = solver.get_model();
+    for (const z3::expr& w : watch) holds.push_back(model.eval(translate(w), true).is_true());
+  }
+  count = ResourceCount(solver);
   return r;
 }
 

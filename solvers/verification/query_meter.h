@@ -4,7 +4,9 @@
 
 #include <z3++.h>
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -99,6 +101,22 @@ class QueryMeter {
   z3::check_result Check(z3::solver& s, unsigned cap, std::uint64_t ceiling,
                          const std::string& what);
 
+  /// Check for a query asked apart from the meter's context: the formulas `query` (of the meter's
+  /// context) are copied into a context of the queries of `group` and solved there by
+  /// MakeSolver's solver. A new context is made whenever `group` differs from the previous
+  /// call's (and after the safety net stopped a query), so that what the solver does depends on
+  /// the queries of the group alone, in their order, not on what other queries left in a
+  /// context: Z3 orders terms by their creation in a context, and nlsat's effort on a nonlinear
+  /// query swings with that order by orders of magnitude (the finger's `phase3_law` step from
+  /// link 2's phase 3: decided in 0.03 to 0.07 s alone, not in 5 million units after the other
+  /// queries of the check). Limits, charges, the safety net and the
+  /// log as Check (the charge is what the group's context counted for the query). On sat,
+  /// `holds` gets, for each of `watch` (Boolean formulas of the meter's context), whether the
+  /// model makes it true; it is left empty otherwise.
+  z3::check_result CheckApart(const z3::expr_vector& query, unsigned cap, std::uint64_t ceiling,
+                              const std::string& what, const std::vector<z3::expr>& watch,
+                              std::vector<bool>& holds, long group);
+
   /// How many queries the budget refused or cut short so far.
   int starved() const { return starved_; }
 
@@ -114,8 +132,23 @@ class QueryMeter {
   // Whether the safety net stopped a query of `s` before.
   bool Stopped(const z3::solver& s) const;
   // The resource limit of the next query: `cap`, or what is left below `ceiling` rounded down to
-  // a power of two; set in `s` when it changed.
+  // a power of two.
+  std::uint64_t Allowed(unsigned cap, std::uint64_t ceiling) const;
+  // Allowed(cap, ceiling), set in `s` when it changed.
   std::uint64_t Allow(z3::solver& s, unsigned cap, std::uint64_t ceiling);
+  // The query of CheckApart in apart_ (the solver, its model and the copied formulas gone on
+  // return, so that apart_ may then be dropped): its result, whether the safety net `stopped`
+  // it, apart_'s resource `count` after it, and on sat the values of `watch` in `holds`.
+  z3::check_result SolveApart(const z3::expr_vector& query, std::uint64_t allowed,
+                              const std::vector<z3::expr>& watch, std::vector<bool>& holds,
+                              bool& stopped, std::uint64_t& count);
+  // Whether a query may run (below the ceiling, safety deadline not passed); if not, counts it
+  // in starved() and logs it.
+  bool MayRun(std::uint64_t ceiling, const std::string& what);
+  // Charges a query that used `spent` units of `allowed` (all of them if the safety net
+  // `stopped` it) and logs it.
+  void Settle(z3::check_result r, std::uint64_t spent, std::uint64_t allowed, unsigned cap,
+              bool stopped, double seconds, const std::string& what);
   // Writes the query of `s` into the dump directory, if any.
   void DumpQuery(z3::solver& s, std::uint64_t allowed);
 
@@ -128,7 +161,16 @@ class QueryMeter {
   // Solvers whose query the safety net stopped: their state depends on where it stopped, so
   // they get no further query (held, so that no other solver can take their address).
   std::vector<z3::solver> stopped_solvers_;
-  CpuWatchdog watchdog_;  // the safety net; interrupts the context
+  z3::context& ctx_;
+  // The context the safety net interrupts: ctx_, or a query's own while CheckApart runs it
+  // (changed only while the watchdog is not armed).
+  std::atomic<z3::context*> running_;
+  // The context of CheckApart's queries of group apart_group_ (null: none yet), and its count
+  // after the last of them.
+  std::unique_ptr<z3::context> apart_;
+  long apart_group_ = 0;
+  std::uint64_t apart_seen_ = 0;
+  CpuWatchdog watchdog_;  // the safety net; interrupts running_
 };
 
 }  // namespace hybrid

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "automaton/internal_assert.h"
+
 namespace hybrid {
 
 std::string FlowClassName(FlowClass c) {
@@ -690,45 +692,60 @@ int SmtEncoding::InitialIndex(const z3::model& model) {
 }
 
 z3::expr SmtEncoding::State(int k) {
-  return Reuse(states_, k, [&] {
-    StepVars& v = Vars(k);
-    const auto& env = Env(k);
-    // One flat conjunction of plain clauses (which every Z3 tactic accepts; a long chain of
-    // binary `&&` is slow for Z3 to free).
-    z3::expr_vector clauses(ctx_);
-    // Exactly one mode: at least one, and at most one by a ladder (amo[m]: some mode <= m),
-    // linear in the number of modes.
-    z3::expr_vector modes(ctx_);
-    for (const auto& b : v.mode) modes.push_back(b);
-    clauses.push_back(z3::mk_or(modes));
-    for (std::size_t m = 0; m < v.mode.size(); ++m) {
-      clauses.push_back(!v.mode[m] || v.amo[m]);
-      if (m == 0) continue;
-      clauses.push_back(!v.amo[m - 1] || v.amo[m]);
-      clauses.push_back(!v.amo[m - 1] || !v.mode[m]);
+  return Reuse(states_, k, [&] { return StateOf(k, nullptr); });
+}
+
+z3::expr SmtEncoding::StateIn(int k, const std::vector<bool>& modes) {
+  HYBRID_ASSERT(static_cast<int>(modes.size()) == automaton_.num_modes(), "a flag per mode");
+  return StateOf(k, &modes);
+}
+
+z3::expr SmtEncoding::StateOf(int k, const std::vector<bool>* allowed) {
+  StepVars& v = Vars(k);
+  const auto& env = Env(k);
+  const auto in = [allowed](std::size_t m) { return allowed == nullptr || (*allowed)[m]; };
+  // One flat conjunction of plain clauses (which every Z3 tactic accepts; a long chain of
+  // binary `&&` is slow for Z3 to free).
+  z3::expr_vector clauses(ctx_);
+  // Exactly one mode: at least one, and at most one by a ladder over the allowed modes (amo[m]:
+  // some allowed mode <= m), linear in their number; the others are out.
+  z3::expr_vector modes(ctx_);
+  std::optional<std::size_t> previous;
+  for (std::size_t m = 0; m < v.mode.size(); ++m) {
+    if (!in(m)) {
+      clauses.push_back(!v.mode[m]);
+      continue;
     }
-    for (const z3::expr& d : parameter_definitions_) clauses.push_back(d);
-    // Uncertain parameters stay in their ranges in every state (also in induction steps, which
-    // do not start from an initial state).
-    for (const auto& [slot, value] : automaton_.parameters()) {
-      if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
-        clauses.push_back(Translate(range->lo, params_) <= *params_[slot]);
-        clauses.push_back(*params_[slot] <= Translate(range->hi, params_));
-      }
+    modes.push_back(v.mode[m]);
+    clauses.push_back(!v.mode[m] || v.amo[m]);
+    if (previous) {
+      clauses.push_back(!v.amo[*previous] || v.amo[m]);
+      clauses.push_back(!v.amo[*previous] || !v.mode[m]);
     }
-    for (int m = 0; m < automaton_.num_modes(); ++m) {
-      const Constraint& inv = automaton_.modes()[m].invariant;
-      // Invariants in their closure: the boundary belongs to the mode, as in the simulator.
-      if (!inv.empty()) {
-        clauses.push_back(z3::implies(v.mode[m], Conjunction(inv, env, Boundary::kClosure)));
-      }
+    previous = m;
+  }
+  clauses.push_back(z3::mk_or(modes));
+  for (const z3::expr& d : parameter_definitions_) clauses.push_back(d);
+  // Uncertain parameters stay in their ranges in every state (also in induction steps, which
+  // do not start from an initial state).
+  for (const auto& [slot, value] : automaton_.parameters()) {
+    if (auto range = automaton_.ParameterRange(slot); range && uncertain_slot_[slot]) {
+      clauses.push_back(Translate(range->lo, params_) <= *params_[slot]);
+      clauses.push_back(*params_[slot] <= Translate(range->hi, params_));
     }
-    for (std::size_t i = 0; i < input_slots_.size(); ++i) {
-      clauses.push_back(Num(ctx_, input_lo_[i]) <= v.u[i]);
-      clauses.push_back(v.u[i] <= Num(ctx_, input_hi_[i]));
+  }
+  for (int m = 0; m < automaton_.num_modes(); ++m) {
+    const Constraint& inv = automaton_.modes()[m].invariant;
+    // Invariants in their closure: the boundary belongs to the mode, as in the simulator.
+    if (!inv.empty() && in(static_cast<std::size_t>(m))) {
+      clauses.push_back(z3::implies(v.mode[m], Conjunction(inv, env, Boundary::kClosure)));
     }
-    return z3::mk_and(clauses);
-  });
+  }
+  for (std::size_t i = 0; i < input_slots_.size(); ++i) {
+    clauses.push_back(Num(ctx_, input_lo_[i]) <= v.u[i]);
+    clauses.push_back(v.u[i] <= Num(ctx_, input_hi_[i]));
+  }
+  return z3::mk_and(clauses);
 }
 
 z3::expr SmtEncoding::InMode(int k, ModeId m) { return Vars(k).mode.at(m.value()); }

@@ -92,6 +92,11 @@ class SmtEncoding {
   int InitialIndex(const z3::model& model);
   /// Well-formedness of s_k: exactly one mode, its invariant, inputs within bounds.
   z3::expr State(int k);
+  /// State(k) with s_k in one of the modes flagged in `modes` (a flag per mode): the same as
+  /// State(k) and "not InMode(k, n)" for each mode n not flagged, but of the size of the flagged
+  /// modes (their invariants only), so that a query about a few modes of a large automaton does
+  /// not carry the others. Built anew on each call.
+  z3::expr StateIn(int k, const std::vector<bool>& modes);
   /// T(s_k, s_k+1).
   z3::expr Transition(int k);
   /// T(s_k, s_k+1) with s_k in mode `m` (smaller than Transition(k) and InMode(k, m)).
@@ -136,6 +141,9 @@ class SmtEncoding {
   static std::string ConstantName(std::string_view kind, int index, int step);
 
  private:
+  // State(k) (allowed: null) or StateIn(k, *allowed).
+  z3::expr StateOf(int k, const std::vector<bool>* allowed);
+
   struct StepVars {
     std::vector<z3::expr> mode;  // one Bool per mode
     std::vector<z3::expr> x;     // per continuous variable (index in variables())
