@@ -94,8 +94,9 @@ bool InductionRound::StepPerMode() {
       cut_ = true;  // nothing left to prove with: every candidate is dropped
       failed = goals;
     } else if (StepQuery(m, goals, resource_limit_ / 100, failed) == z3::unknown) {
-      // Split per candidate with a larger limit, then the full one (a candidate dropped for
-      // want of resources takes with it every candidate that needs it as a lemma).
+      // Split per candidate: in a context of the mode's own, then in this one with a larger
+      // limit and the full one (a candidate dropped for want of resources takes with it every
+      // candidate that needs it as a lemma).
       for (std::size_t j : goals) {
         std::vector<std::size_t> f;
         if (StepQuery(m, {j}, resource_limit_ / 25, f, true) == z3::unknown &&

@@ -21,12 +21,16 @@ namespace hybrid {
 /// caller checks), the survivors are invariants of every run.
 ///
 /// The step query is asked first from any mode in one query (Z3's default solver; cheap where
-/// the flows are simple, however many modes) while it decides, then split on the mode of
-/// s_k-1 (nlsat: one small nonlinear problem per mode is far easier than their disjunction).
-/// Per query, all living candidates at once: a model names those it breaks, which are dropped
-/// (all of them when it cannot tell), and the rest are checked again; a per-mode query that runs
-/// out is split per candidate with a larger limit (resource_limit / 5, then resource_limit), and
-/// a candidate that runs out alone is dropped. Dropping is always sound: what survives is
+/// the flows are simple, however many modes; not asked when a flow is separable, whose
+/// polynomial closed form that solver does not decide) while it decides, then split on the mode
+/// of s_k-1 (nlsat: one small nonlinear problem per mode is far easier than their disjunction),
+/// each built from the modes of the step only (SmtEncoding::StateIn). Per query, all living
+/// candidates at once (at most resource_limit / 100): a model names those it breaks, which are
+/// dropped (all of them when it cannot tell), and the rest are checked again; a per-mode query
+/// that runs out is split per candidate: first in a context of the mode's own
+/// (QueryMeter::CheckApart, resource_limit / 25), where nlsat's effort does not depend on the
+/// other modes' queries, then in the round's context with resource_limit / 5 and
+/// resource_limit; a candidate that runs out alone is dropped. Dropping is always sound: what survives is
 /// inductive whatever was dropped. Once the budget reaches `ceiling`, every living candidate is
 /// dropped (cut()).
 ///

@@ -130,5 +130,45 @@ TEST(QueryMeter, EachQueryIsLogged) {
                                              "query (refused) not run: budget spent"}));
 }
 
+// CheckApart: the query solved in a context of its own decides as Check does (linear and
+// nonlinear), reads the watched formulas off its model on sat, is charged what that context
+// counted (the same for the same query in a new group, whatever ran before) and runs nothing
+// past the ceiling.
+TEST(QueryMeter, AQueryAskedApartDecidesAndIsCharged) {
+  z3::context ctx;
+  SolverBudget budget(1.0);
+  QueryMeter meter(ctx, budget);
+  const z3::expr x = ctx.real_const("x");
+  const z3::expr y = ctx.real_const("y");
+  z3::expr_vector sat(ctx);
+  sat.push_back(x > 0 && x < 1);
+  std::vector<bool> holds;
+  EXPECT_EQ(meter.CheckApart(sat, 1'000'000, budget.total(), "test", {x<2, x> 3}, holds, 1),
+            z3::sat);
+  EXPECT_EQ(holds, (std::vector<bool>{true, false}));
+  // Nonlinear: x y = 1 with x > 0 and y < 0 has no solution (nlsat).
+  z3::expr_vector unsat(ctx);
+  unsat.push_back(x * y == 1 && x > 0 && y < 0);
+  std::uint64_t before = budget.used();
+  EXPECT_EQ(meter.CheckApart(unsat, 1'000'000, budget.total(), "test", {x > 0}, holds, 2),
+            z3::unsat);
+  EXPECT_TRUE(holds.empty());
+  const std::uint64_t alone = budget.used() - before;
+  EXPECT_GT(alone, 0u);
+  // The meter's own context is not touched: a query there is charged from its own count.
+  z3::solver s = MakeSolver(ctx);
+  s.add(x * x < 0);
+  EXPECT_EQ(meter.Check(s, 1'000'000, budget.total(), "test"), z3::unsat);
+  // The same query in a new group costs the same.
+  before = budget.used();
+  EXPECT_EQ(meter.CheckApart(unsat, 1'000'000, budget.total(), "test", {}, holds, 3), z3::unsat);
+  EXPECT_EQ(budget.used() - before, alone);
+  // Past the ceiling nothing runs.
+  before = budget.used();
+  EXPECT_EQ(meter.CheckApart(unsat, 1'000'000, 0, "test", {}, holds, 4), z3::unknown);
+  EXPECT_EQ(budget.used(), before);
+  EXPECT_EQ(meter.starved(), 1);
+}
+
 }  // namespace
 }  // namespace hybrid
