@@ -28,6 +28,7 @@ InductionRound::InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigne
   }
   alive_.assign(set_.size(), true);
   path_from_.resize(enc_.automaton().num_modes());
+  hypotheses_from_.resize(enc_.automaton().num_modes());
 }
 
 void InductionRound::Run() {
@@ -42,7 +43,7 @@ void InductionRound::Run() {
   bool changed = true;
   while (changed) {
     changed = false;
-    hypotheses_.reset();
+    ForgetHypotheses();
     if (whole && !Living().empty() && meter_.budget().used() < ceiling_ &&
         !meter_.budget().SafetyExpired()) {
       std::vector<std::size_t> failed;
@@ -81,7 +82,7 @@ bool InductionRound::Drop(const std::vector<std::size_t>& failed) {
     changed = changed || alive_[j];
     alive_[j] = false;
   }
-  if (changed) hypotheses_.reset();  // weaker now: modes already passed are checked again
+  if (changed) ForgetHypotheses();  // weaker now: modes already passed are checked again
   return changed;
 }
 
@@ -120,11 +121,12 @@ z3::check_result InductionRound::StepQuery(int m, const std::vector<std::size_t>
   if (!meter_.Afford(PathUnits(enc_.automaton(), k, m), ceiling_)) return z3::unknown;
   z3::expr_vector query(ctx_);
   query.push_back(StepPath(m));
-  query.push_back(Hypotheses());
+  query.push_back(Hypotheses(m));
   z3::expr_vector bad(ctx_);
   std::vector<z3::expr> at_k;
+  const std::vector<bool> next = m < 0 ? std::vector<bool>() : StepModes(m).second;
   for (std::size_t j : goals) {
-    at_k.push_back(enc_.Holds(set_[j]->bad, k, 0.0));
+    at_k.push_back(m < 0 ? enc_.Holds(set_[j]->bad, k, 0.0) : enc_.HoldsIn(set_[j]->bad, k, next));
     bad.push_back(at_k.back());
   }
   query.push_back(z3::mk_or(bad));
@@ -174,13 +176,7 @@ const z3::expr& InductionRound::StepPath(int m) {
     if (m >= 0) {
       // s_k-1 in m alone, s_k in m or a target of a transition from m: only those modes'
       // constraints (a large automaton's others would cost Z3 their simplification per mode).
-      const Automaton& a = enc_.automaton();
-      std::vector<bool> from(static_cast<std::size_t>(a.num_modes()), false);
-      from[static_cast<std::size_t>(m)] = true;
-      std::vector<bool> next = from;
-      for (const Transition& t : a.transitions()) {
-        if (t.source.value() == m) next[static_cast<std::size_t>(t.target.value())] = true;
-      }
+      const auto [from, next] = StepModes(m);
       e.push_back(enc_.StateIn(k - 1, from));
       e.push_back(enc_.StateIn(k, next));
     }
@@ -192,20 +188,42 @@ const z3::expr& InductionRound::StepPath(int m) {
   return *path;
 }
 
-const z3::expr& InductionRound::Hypotheses() {
-  if (!hypotheses_) {
+void InductionRound::ForgetHypotheses() {
+  hypotheses_.reset();
+  hypotheses_from_.assign(hypotheses_from_.size(), std::nullopt);
+}
+
+const z3::expr& InductionRound::Hypotheses(int m) {
+  std::optional<z3::expr>& hypotheses = m < 0 ? hypotheses_ : hypotheses_from_[m];
+  if (!hypotheses) {
+    const std::vector<bool> from = m < 0 ? std::vector<bool>() : StepModes(m).first;
+    // At s_k-1 the step from m is in m: the candidates read there as in m alone.
+    const auto holds = [&](const Predicate& bad, int i) {
+      return m >= 0 && i == k_ - 1 ? enc_.HoldsIn(bad, i, from) : enc_.Holds(bad, i, 0.0);
+    };
     z3::expr_vector e(ctx_);
     for (std::size_t j = 0; j < set_.size(); ++j) {
       if (!alive_[j]) continue;
-      for (int i = 0; i < k_; ++i) e.push_back(!enc_.Holds(set_[j]->bad, i, 0.0));
+      for (int i = 0; i < k_; ++i) e.push_back(!holds(set_[j]->bad, i));
     }
     for (const ProofCandidate* lemma : lemmas_) {
-      for (int i = 0; i < k_; ++i) e.push_back(!enc_.Holds(lemma->bad, i, 0.0));
+      for (int i = 0; i < k_; ++i) e.push_back(!holds(lemma->bad, i));
     }
     e.push_back(enc_.TakeDefinitions());
-    hypotheses_ = z3::mk_and(e);
+    hypotheses = z3::mk_and(e);
   }
-  return *hypotheses_;
+  return *hypotheses;
+}
+
+std::pair<std::vector<bool>, std::vector<bool>> InductionRound::StepModes(int m) const {
+  const Automaton& a = enc_.automaton();
+  std::vector<bool> from(static_cast<std::size_t>(a.num_modes()), false);
+  from[static_cast<std::size_t>(m)] = true;
+  std::vector<bool> next = from;
+  for (const Transition& t : a.transitions()) {
+    if (t.source.value() == m) next[static_cast<std::size_t>(t.target.value())] = true;
+  }
+  return {std::move(from), std::move(next)};
 }
 
 }  // namespace hybrid

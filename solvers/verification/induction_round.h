@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "solvers/verification/proof_candidate.h"
@@ -30,9 +31,9 @@ namespace hybrid {
 /// that runs out is split per candidate: first in a context of the mode's own
 /// (QueryMeter::CheckApart, resource_limit / 25), where nlsat's effort does not depend on the
 /// other modes' queries, then in the round's context with resource_limit / 5 and
-/// resource_limit; a candidate that runs out alone is dropped. Dropping is always sound: what survives is
-/// inductive whatever was dropped. Once the budget reaches `ceiling`, every living candidate is
-/// dropped (cut()).
+/// resource_limit; a candidate that runs out alone is dropped. Dropping is always sound: what
+/// survives is inductive whatever was dropped. Once the budget reaches `ceiling`, every living
+/// candidate is dropped (cut()).
 ///
 /// Formulas are built once per round (the path per last mode, the hypotheses after each drop).
 /// Logs (topic "prove") at kDebug each failed step: k, the mode, the candidates it breaks (not
@@ -79,9 +80,14 @@ class InductionRound {
   void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
   // The path of the step query from mode m (any: m < 0), built on first use.
   const z3::expr& StepPath(int m);
-  // The living candidates and the lemmas hold at s_0 .. s_k-1: built on first use after each
-  // drop.
-  const z3::expr& Hypotheses();
+  // The living candidates and the lemmas hold at s_0 .. s_k-1 (for the step from mode m, read
+  // at s_k-1 in m alone; any mode: m < 0): built on first use after each drop.
+  const z3::expr& Hypotheses(int m);
+  // Forgets the hypotheses built (after a drop).
+  void ForgetHypotheses();
+  // The modes of the step from m: s_k-1's (m alone) and s_k's (m and the targets of its
+  // transitions), a flag per mode.
+  std::pair<std::vector<bool>, std::vector<bool>> StepModes(int m) const;
 
   SmtEncoding& enc_;
   QueryMeter& meter_;
@@ -92,9 +98,10 @@ class InductionRound {
   std::vector<ProofCandidate*> set_;
   std::vector<const ProofCandidate*> lemmas_;
   std::vector<bool> alive_;
-  std::vector<std::optional<z3::expr>> path_from_;  // the path of k steps, per last mode
-  std::optional<z3::expr> hypotheses_;              // of the alive candidates
-  std::optional<z3::expr> path_any_;                // the path of k steps, any last mode
+  std::vector<std::optional<z3::expr>> path_from_;        // the path of k steps, per last mode
+  std::optional<z3::expr> hypotheses_;                    // of the alive candidates
+  std::vector<std::optional<z3::expr>> hypotheses_from_;  // the same, per mode of s_k-1
+  std::optional<z3::expr> path_any_;                      // the path of k steps, any last mode
   bool cut_ = false;
 };
 

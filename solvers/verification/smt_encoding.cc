@@ -516,13 +516,20 @@ z3::expr SmtEncoding::Reuse(std::deque<std::optional<Built>>& cache, int k,
   return cache[k]->formula;
 }
 
-z3::expr SmtEncoding::Discrete(int k, int slot) {
+z3::expr SmtEncoding::Discrete(int k, int slot) { return DiscreteIn(k, slot, {}); }
+
+z3::expr SmtEncoding::DiscreteIn(int k, int slot, const std::vector<bool>& modes) {
   StepVars& v = Vars(k);
-  z3::expr out = Num(ctx_, 0.0);
-  for (int m = automaton_.num_modes() - 1; m >= 0; --m) {
-    const auto value = automaton_.modes()[m].DiscreteValueOf(slot);
-    out = z3::ite(v.mode[m], Num(ctx_, value.value_or(0)), out);
+  const auto value = [&](int m) {
+    return Num(ctx_, automaton_.modes()[m].DiscreteValueOf(slot).value_or(0));
+  };
+  std::vector<int> in;
+  for (int m = 0; m < automaton_.num_modes(); ++m) {
+    if (modes.empty() || modes[static_cast<std::size_t>(m)]) in.push_back(m);
   }
+  if (!modes.empty() && in.size() == 1) return value(in[0]);  // s_k is in that mode
+  z3::expr out = Num(ctx_, 0.0);
+  for (auto m = in.rbegin(); m != in.rend(); ++m) out = z3::ite(v.mode[*m], value(*m), out);
   return out;
 }
 
@@ -751,7 +758,23 @@ z3::expr SmtEncoding::StateOf(int k, const std::vector<bool>* allowed) {
 z3::expr SmtEncoding::InMode(int k, ModeId m) { return Vars(k).mode.at(m.value()); }
 
 z3::expr SmtEncoding::Holds(const Predicate& p, int k, double tolerance) {
-  const auto& env = Env(k);
+  return HoldsOf(p, k, nullptr, tolerance);
+}
+
+z3::expr SmtEncoding::HoldsIn(const Predicate& p, int k, const std::vector<bool>& modes,
+                              double tolerance) {
+  HYBRID_ASSERT(static_cast<int>(modes.size()) == automaton_.num_modes(), "a flag per mode");
+  return HoldsOf(p, k, &modes, tolerance);
+}
+
+z3::expr SmtEncoding::HoldsOf(const Predicate& p, int k, const std::vector<bool>* modes,
+                              double tolerance) {
+  std::vector<std::optional<z3::expr>> restricted;
+  if (modes != nullptr) {
+    restricted = Env(k);
+    for (int slot : automaton_.discrete_variables()) restricted[slot] = DiscreteIn(k, slot, *modes);
+  }
+  const auto& env = modes != nullptr ? restricted : Env(k);
   std::function<z3::expr(const Predicate&, bool)> go = [&](const Predicate& q,
                                                            bool positive) -> z3::expr {
     switch (q.kind()) {
@@ -763,7 +786,10 @@ z3::expr SmtEncoding::Holds(const Predicate& p, int k, double tolerance) {
         return Compare(q.comparison(), env, positive ? tolerance : -tolerance);
       case Predicate::Kind::kInMode: {
         auto m = automaton_.FindMode(q.mode());
-        return m ? InMode(k, *m) : ctx_.bool_val(false);
+        if (!m || (modes != nullptr && !(*modes)[static_cast<std::size_t>(m->value())])) {
+          return ctx_.bool_val(false);
+        }
+        return InMode(k, *m);
       }
       case Predicate::Kind::kNot:
         return !go(q.operands()[0], !positive);

@@ -104,6 +104,12 @@ class SmtEncoding {
   /// `p` at s_k, evaluated leniently within `tolerance` (comparisons in positive position hold
   /// within it, under `not` they must hold with that margin; tolerance 0 is exact).
   z3::expr Holds(const Predicate& p, int k, double tolerance = 0.0);
+  /// Holds(p, k, tolerance) where s_k is in one of the modes flagged in `modes` (a flag per
+  /// mode; StateIn(k, modes) holds): the discrete variables are read from the flagged modes
+  /// only and "in" an unflagged mode is false, so that the formula has the size of the flagged
+  /// modes, not of the automaton.
+  z3::expr HoldsIn(const Predicate& p, int k, const std::vector<bool>& modes,
+                   double tolerance = 0.0);
   /// s_k is in mode `m`.
   z3::expr InMode(int k, ModeId m);
   /// Every uncertain parameter at its nominal value.
@@ -143,6 +149,11 @@ class SmtEncoding {
  private:
   // State(k) (allowed: null) or StateIn(k, *allowed).
   z3::expr StateOf(int k, const std::vector<bool>* allowed);
+  // Holds (modes: null) or HoldsIn(p, k, *modes, tolerance).
+  z3::expr HoldsOf(const Predicate& p, int k, const std::vector<bool>* modes, double tolerance);
+  // The value of discrete variable `slot` at s_k, where s_k is in a mode flagged in `modes`
+  // (empty: any mode): an ite over those modes' values, the value itself for one mode.
+  z3::expr DiscreteIn(int k, int slot, const std::vector<bool>& modes);
 
   struct StepVars {
     std::vector<z3::expr> mode;  // one Bool per mode

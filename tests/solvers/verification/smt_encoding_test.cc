@@ -541,6 +541,36 @@ TEST(SmtEncodingSize, StateInIsTheStateInTheFlaggedModes) {
   }
 }
 
+// HoldsIn(p, k, flags) is Holds(p, k) where s_k is in a flagged mode (StateIn(k, flags)): the
+// two differ in no model, for every property of the finger (its discrete variables c1 .. l3 and
+// its modes read) and several sets of flagged modes; and it is smaller where few are flagged.
+TEST(SmtEncodingSize, HoldsInIsHoldsInTheFlaggedModes) {
+  const System finger = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
+  const Automaton& a = finger.components()[0].automaton;
+  const int n = a.num_modes();
+  for (const std::vector<int>& flagged :
+       std::vector<std::vector<int>>{{0}, {n - 1}, {1, 4, 9}, {0, 2, n - 1}}) {
+    z3::context ctx;
+    SmtEncoding enc(ctx, a);
+    std::vector<bool> flags(static_cast<std::size_t>(n), false);
+    for (int m : flagged) flags[static_cast<std::size_t>(m)] = true;
+    z3::solver s(ctx);
+    s.add(enc.StateIn(0, flags));
+    s.add(enc.TakeDefinitions());
+    ASSERT_FALSE(finger.properties().empty());
+    for (const Property& p : finger.properties()) {
+      const z3::expr all = enc.Holds(p.predicate, 0);
+      const z3::expr in = enc.HoldsIn(p.predicate, 0, flags);
+      s.push();
+      s.add(enc.TakeDefinitions());
+      s.add(all != in);
+      EXPECT_EQ(s.check(), z3::unsat) << p.name << ", " << flagged.size() << " flagged modes";
+      s.pop();
+      if (flagged.size() == 1) EXPECT_LE(Size(in), Size(all)) << p.name;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Reading a path back: the representative input reaches the encoded endpoint.
 
