@@ -2504,6 +2504,27 @@ SimulationResult RunOrDiscard(const Model& m, const SimulationOptions& options) 
   }
 }
 
+// Whether two states agree within the integrator's tolerance (1e-6, relative to `a`).
+bool Close(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  if (a.size() != b.size()) return false;
+  for (int i = 0; i < a.size(); ++i) {
+    if (!(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])))) return false;
+  }
+  return true;
+}
+
+// Two completed runs of one model agree within the integrator's tolerance: the same jumps at
+// times within 1e-6, and the same end modes and state (Close).
+void RcAssertSameRunWithinTolerance(const SimulationResult& r, const SimulationResult& reference) {
+  RC_ASSERT(r.events.size() == reference.events.size());
+  for (size_t k = 0; k < r.events.size(); ++k) {
+    RC_ASSERT(r.events[k].transitions == reference.events[k].transitions);
+    RC_ASSERT(std::abs(r.events[k].time - reference.events[k].time) <= 1e-6);
+  }
+  RC_ASSERT(r.samples.back().modes == reference.samples.back().modes);
+  RC_ASSERT(Close(reference.samples.back().x, r.samples.back().x));
+}
+
 // Differential: a run of a random automaton (tests/test_utilities/random_hybrid_automata.h, affine
 // dynamics, urgent and lazy transitions, resets) continued from the state it reached at an
 // arbitrary time (SimulationOptions::start_modes, start_x) ends where the whole run ends: the same
@@ -2543,11 +2564,7 @@ RC_GTEST_PROP(SimulatorProperty, ARunSplitAnywhereEqualsTheWholeRun, ()) {
   }
   RC_ASSERT(second.status == SimulationStatus::kCompleted);
   RC_ASSERT(second.samples.back().modes == whole.samples.back().modes);
-  const Eigen::VectorXd& a = whole.samples.back().x;
-  const Eigen::VectorXd& b = second.samples.back().x;
-  for (int i = 0; i < a.size(); ++i) {
-    RC_ASSERT(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])));
-  }
+  RC_ASSERT(Close(whole.samples.back().x, second.samples.back().x));
   // The events: the whole run's after the split, the second part's shifted by it.
   size_t k = 0;
   while (k < whole.events.size() && whole.events[k].time <= split) ++k;
@@ -2602,29 +2619,17 @@ RC_GTEST_PROP(SimulatorProperty, SamplesChangeNothing, ()) {
   };
   same_run(read);
   if (!solver) same_run(stops);
-  auto close = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    if (a.size() != b.size()) return false;
-    for (int i = 0; i < a.size(); ++i) {
-      if (!(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])))) return false;
-    }
-    return true;
-  };
   if (reference.status != SimulationStatus::kCompleted ||
       stops.status != SimulationStatus::kCompleted) {
     return;
   }
-  RC_ASSERT(stops.events.size() == reference.events.size());
-  for (size_t k = 0; k < stops.events.size(); ++k) {
-    RC_ASSERT(stops.events[k].transitions == reference.events[k].transitions);
-    RC_ASSERT(std::abs(stops.events[k].time - reference.events[k].time) <= 1e-6);
-  }
-  RC_ASSERT(close(stops.samples.back().x, reference.samples.back().x));
+  RcAssertSameRunWithinTolerance(stops, reference);
   RC_ASSERT(stops.samples.size() == read.samples.size());
   for (size_t i = 0; i < stops.samples.size(); ++i) {
     RC_ASSERT(stops.samples[i].kind == read.samples[i].kind);
     RC_ASSERT(std::abs(stops.samples[i].time - read.samples[i].time) <= 1e-6);
     RC_ASSERT(stops.samples[i].modes == read.samples[i].modes);
-    RC_ASSERT(close(stops.samples[i].x, read.samples[i].x));
+    RC_ASSERT(Close(stops.samples[i].x, read.samples[i].x));
   }
 }
 
@@ -2650,17 +2655,7 @@ RC_GTEST_PROP(SimulatorProperty, FixedPointIterationAgreesWithNewton, ()) {
     return;
   }
   if (reference.status != SimulationStatus::kCompleted) return;
-  RC_ASSERT(r.events.size() == reference.events.size());
-  for (size_t k = 0; k < r.events.size(); ++k) {
-    RC_ASSERT(r.events[k].transitions == reference.events[k].transitions);
-    RC_ASSERT(std::abs(r.events[k].time - reference.events[k].time) <= 1e-6);
-  }
-  RC_ASSERT(r.samples.back().modes == reference.samples.back().modes);
-  const Eigen::VectorXd& a = reference.samples.back().x;
-  const Eigen::VectorXd& b = r.samples.back().x;
-  for (int i = 0; i < a.size(); ++i) {
-    RC_ASSERT(std::abs(a[i] - b[i]) <= 1e-6 * (1.0 + std::abs(a[i])));
-  }
+  RcAssertSameRunWithinTolerance(r, reference);
 }
 
 }  // namespace

@@ -507,6 +507,19 @@ TEST(SmtEncodingSize, ExactlyOneModeHolds) {
   EXPECT_EQ(s.check(), z3::unsat);
 }
 
+// Sets of flagged modes of an automaton of n modes (n >= 10) for StateIn and HoldsIn: the first
+// or the last alone, and a few together, as a flag per mode.
+std::vector<std::vector<bool>> FlagSets(int n) {
+  std::vector<std::vector<bool>> out;
+  for (const std::vector<int>& flagged :
+       std::vector<std::vector<int>>{{0}, {n - 1}, {1, 4, 9}, {0, 2, n - 1}}) {
+    std::vector<bool> flags(static_cast<std::size_t>(n), false);
+    for (int m : flagged) flags[static_cast<std::size_t>(m)] = true;
+    out.push_back(std::move(flags));
+  }
+  return out;
+}
+
 // StateIn(k, flags) is State(k) with the unflagged modes ruled out, up to the exactly-one
 // ladder's auxiliaries (amo.*): State and the unflagged modes out imply StateIn, and StateIn
 // implies that some values of the auxiliaries make State hold with the unflagged modes out;
@@ -515,12 +528,10 @@ TEST(SmtEncodingSize, ExactlyOneModeHolds) {
 TEST(SmtEncodingSize, StateInIsTheStateInTheFlaggedModes) {
   const Automaton a = FingerAutomaton();
   const int n = a.num_modes();
-  for (const std::vector<int>& flagged :
-       std::vector<std::vector<int>>{{0}, {n - 1}, {1, 4, 9}, {0, 2, n - 1}}) {
+  for (const std::vector<bool>& flags : FlagSets(n)) {
+    const auto flagged = std::count(flags.begin(), flags.end(), true);
     z3::context ctx;
     SmtEncoding enc(ctx, a);
-    std::vector<bool> flags(static_cast<std::size_t>(n), false);
-    for (int m : flagged) flags[static_cast<std::size_t>(m)] = true;
     z3::expr_vector out(ctx), ladder(ctx);
     for (int m = 0; m < n; ++m) {
       if (!flags[static_cast<std::size_t>(m)]) out.push_back(!enc.InMode(0, ModeId(m)));
@@ -533,10 +544,10 @@ TEST(SmtEncodingSize, StateInIsTheStateInTheFlaggedModes) {
     s.add(definitions);
     s.push();
     s.add(full && !in);
-    EXPECT_EQ(s.check(), z3::unsat) << flagged.size() << " flagged modes";
+    EXPECT_EQ(s.check(), z3::unsat) << flagged << " flagged modes";
     s.pop();
     s.add(in && !z3::exists(ladder, full));
-    EXPECT_EQ(s.check(), z3::unsat) << flagged.size() << " flagged modes";
+    EXPECT_EQ(s.check(), z3::unsat) << flagged << " flagged modes";
     EXPECT_LT(Size(in), Size(enc.State(0)));
   }
 }
@@ -548,12 +559,10 @@ TEST(SmtEncodingSize, HoldsInIsHoldsInTheFlaggedModes) {
   const System finger = ParseModelFile(std::string(HYBRID_SOURCE_DIR) + "/spec/finger.ha");
   const Automaton& a = finger.components()[0].automaton;
   const int n = a.num_modes();
-  for (const std::vector<int>& flagged :
-       std::vector<std::vector<int>>{{0}, {n - 1}, {1, 4, 9}, {0, 2, n - 1}}) {
+  for (const std::vector<bool>& flags : FlagSets(n)) {
+    const auto flagged = std::count(flags.begin(), flags.end(), true);
     z3::context ctx;
     SmtEncoding enc(ctx, a);
-    std::vector<bool> flags(static_cast<std::size_t>(n), false);
-    for (int m : flagged) flags[static_cast<std::size_t>(m)] = true;
     z3::solver s(ctx);
     s.add(enc.StateIn(0, flags));
     s.add(enc.TakeDefinitions());
@@ -564,9 +573,9 @@ TEST(SmtEncodingSize, HoldsInIsHoldsInTheFlaggedModes) {
       s.push();
       s.add(enc.TakeDefinitions());
       s.add(all != in);
-      EXPECT_EQ(s.check(), z3::unsat) << p.name << ", " << flagged.size() << " flagged modes";
+      EXPECT_EQ(s.check(), z3::unsat) << p.name << ", " << flagged << " flagged modes";
       s.pop();
-      if (flagged.size() == 1) EXPECT_LE(Size(in), Size(all)) << p.name;
+      if (flagged == 1) EXPECT_LE(Size(in), Size(all)) << p.name;
     }
   }
 }
