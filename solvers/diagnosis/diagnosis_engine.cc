@@ -169,14 +169,25 @@ class Engine {
   std::vector<double> HorizonLoss(int r, const RunPrediction& p) const {
     const DiagnosisRun& run = runs_[r];
     const std::vector<size_t>& ends = horizon_ends_[r];
+    const size_t n = run.input.size();
+    const int J = channels();
+    // Each sample's terms first, a channel at a time over contiguous arrays, then added up
+    // sample by sample and channel by channel: the sums of one pass over both, bit for bit (a
+    // missing sample adds +0, and every term is >= +0).
+    std::vector<double> terms(n * static_cast<size_t>(J));
+    for (int j = 0; j < J; ++j) {
+      const double* m = run.channels[j].data();
+      const double* q = p.channels[j].data();
+      double* t = terms.data() + static_cast<size_t>(j) * n;
+      const double sigma = sigma_[j], huber = o_.huber;
+      for (size_t k = 0; k < n; ++k)
+        t[k] = std::isnan(m[k]) ? 0.0 : Rho((m[k] - q[k]) / sigma, huber);
+    }
     std::vector<double> out;
     double loss = 0.0;
     size_t h = 0;
-    for (size_t k = 0; k < run.input.size() && h < ends.size(); ++k) {
-      for (int j = 0; j < channels(); ++j) {
-        const double m = run.channels[j][k];
-        if (!std::isnan(m)) loss += Rho((m - p.channels[j][k]) / sigma_[j], o_.huber);
-      }
+    for (size_t k = 0; k < n && h < ends.size(); ++k) {
+      for (int j = 0; j < J; ++j) loss += terms[static_cast<size_t>(j) * n + k];
       while (h < ends.size() && k + 1 >= ends[h]) ++h, out.push_back(loss);
     }
     while (out.size() < ends.size()) out.push_back(loss);

@@ -193,6 +193,9 @@ std::optional<std::pair<std::string, double>> RunState::OutsideInvariant(const S
     for (const CompiledComparison& cmp : components[c].modes[s.modes[c]].invariant) {
       if (cmp.may_jump) continue;
       const double residual = cmp.residual.Evaluate(env_.data());
+      // What holds exactly holds within any tolerance >= 0: the tolerance (two evaluations more)
+      // only for a residual past the boundary.
+      if (Holds(cmp.relation, residual, 0.0, true)) continue;
       if (!Holds(cmp.relation, residual, ResolutionTolerance(cmp), true)) {
         return std::make_pair(cmp.text, residual);
       }

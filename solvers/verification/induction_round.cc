@@ -1,5 +1,6 @@
 #include "solvers/verification/induction_round.h"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -94,17 +95,20 @@ bool InductionRound::StepPerMode() {
     if (meter_.budget().used() >= ceiling_ || meter_.budget().SafetyExpired()) {
       cut_ = true;  // nothing left to prove with: every candidate is dropped
       failed = goals;
-    } else if (StepQuery(m, goals, resource_limit_ / 100, failed) == z3::unknown) {
-      // Split per candidate: in a context of the mode's own, then in this one with a larger
-      // limit and the full one (a candidate dropped for want of resources takes with it every
-      // candidate that needs it as a lemma).
-      for (std::size_t j : goals) {
-        std::vector<std::size_t> f;
-        if (StepQuery(m, {j}, resource_limit_ / 25, f, true) == z3::unknown &&
-            StepQuery(m, {j}, resource_limit_ / 5, f) == z3::unknown &&
-            StepQuery(m, {j}, resource_limit_, f) == z3::unknown) {
-          f.push_back(j);
+    } else if (enc_.flow_class(ModeId(m)) != FlowClass::kSeparable) {
+      failed = FailedFrom(m, goals, std::nullopt);
+    } else {
+      // A separable flow's closed form is polynomial: nlsat decides it alone far sooner than
+      // beside the mode's jumps (the finger's phase-3 modes: each move at 1/100 of the limit,
+      // where the moves together ran out). One move at a time, each for the candidates that the
+      // moves before left standing.
+      for (const Move& move : MovesFrom(m)) {
+        std::vector<std::size_t> standing;
+        for (std::size_t j : goals) {
+          if (std::find(failed.begin(), failed.end(), j) == failed.end()) standing.push_back(j);
         }
+        if (standing.empty()) break;
+        const std::vector<std::size_t> f = FailedFrom(m, standing, move);
         failed.insert(failed.end(), f.begin(), f.end());
       }
     }
@@ -113,28 +117,49 @@ bool InductionRound::StepPerMode() {
   return changed;
 }
 
+std::vector<std::size_t> InductionRound::FailedFrom(int m, const std::vector<std::size_t>& goals,
+                                                    std::optional<Move> move) {
+  std::vector<std::size_t> failed;
+  if (StepQuery(m, goals, resource_limit_ / 100, failed, false, move) != z3::unknown) {
+    return failed;
+  }
+  // Split per candidate: in a context of the mode's own, then in this one with a larger limit
+  // and the full one (a candidate dropped for want of resources takes with it every candidate
+  // that needs it as a lemma).
+  failed.clear();
+  for (std::size_t j : goals) {
+    std::vector<std::size_t> f;
+    if (StepQuery(m, {j}, resource_limit_ / 25, f, true, move) == z3::unknown &&
+        StepQuery(m, {j}, resource_limit_ / 5, f, false, move) == z3::unknown &&
+        StepQuery(m, {j}, resource_limit_, f, false, move) == z3::unknown) {
+      f.push_back(j);
+    }
+    failed.insert(failed.end(), f.begin(), f.end());
+  }
+  return failed;
+}
+
 z3::check_result InductionRound::StepQuery(int m, const std::vector<std::size_t>& goals,
                                            unsigned limit, std::vector<std::size_t>& failed,
-                                           bool apart) {
+                                           bool apart, std::optional<Move> move) {
   const int k = k_;
   // A path of k steps (k + 1 states) asserted in a new solver.
-  if (!meter_.Afford(PathUnits(enc_.automaton(), k, m), ceiling_)) return z3::unknown;
+  if (!meter_.Afford(PathUnits(enc_.automaton(), k, m, move.has_value()), ceiling_)) {
+    return z3::unknown;
+  }
   z3::expr_vector query(ctx_);
-  query.push_back(StepPath(m));
+  query.push_back(StepPath(m, move));
   query.push_back(Hypotheses(m));
   z3::expr_vector bad(ctx_);
   std::vector<z3::expr> at_k;
-  const std::vector<bool> next = m < 0 ? std::vector<bool>() : StepModes(m).second;
+  const std::vector<bool> next = m < 0 ? std::vector<bool>() : StepModes(m, move).second;
   for (std::size_t j : goals) {
     at_k.push_back(m < 0 ? enc_.Holds(set_[j]->bad, k, 0.0) : enc_.HoldsIn(set_[j]->bad, k, next));
     bad.push_back(at_k.back());
   }
   query.push_back(z3::mk_or(bad));
   query.push_back(enc_.TakeDefinitions());
-  const std::string what = m < 0 ? std::string("induction")
-                                 : "induction from " + enc_.automaton().modes()[m].name +
-                                       (goals.size() == 1 ? ", one candidate" : "") +
-                                       (apart ? ", apart" : "");
+  const std::string what = QueryName(m, goals.size(), apart, move);
   std::vector<bool> broken;
   z3::check_result r;
   if (apart) {
@@ -158,6 +183,17 @@ z3::check_result InductionRound::StepQuery(int m, const std::vector<std::size_t>
   return r;
 }
 
+std::string InductionRound::QueryName(int m, std::size_t goals, bool apart,
+                                      std::optional<Move> move) const {
+  if (m < 0) return "induction";
+  const Automaton& a = enc_.automaton();
+  std::string what = "induction from " + a.modes()[m].name;
+  if (move) {
+    what += move->transition ? ", by " + a.transition(*move->transition).name : ", by its flow";
+  }
+  return what + (goals == 1 ? ", one candidate" : "") + (apart ? ", apart" : "");
+}
+
 void InductionRound::LogFailedStep(int m, const std::vector<std::size_t>& failed) const {
   std::string names;
   for (std::size_t j : failed) names += (names.empty() ? "" : ", ") + set_[j]->goal->property.name;
@@ -167,25 +203,38 @@ void InductionRound::LogFailedStep(int m, const std::vector<std::size_t>& failed
           " fails for " + names);
 }
 
-const z3::expr& InductionRound::StepPath(int m) {
-  const int k = k_;
-  std::optional<z3::expr>& path = m < 0 ? path_any_ : path_from_[m];
-  if (!path) {
-    z3::expr_vector e(ctx_);
-    for (int i = 0; i + 1 < k || (m < 0 && i <= k); ++i) e.push_back(enc_.State(i));
-    if (m >= 0) {
-      // s_k-1 in m alone, s_k in m or a target of a transition from m: only those modes'
-      // constraints (a large automaton's others would cost Z3 their simplification per mode).
-      const auto [from, next] = StepModes(m);
-      e.push_back(enc_.StateIn(k - 1, from));
-      e.push_back(enc_.StateIn(k, next));
-    }
-    for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
-    e.push_back(m < 0 ? enc_.Transition(k - 1) : enc_.TransitionFrom(k - 1, ModeId(m)));
-    e.push_back(enc_.TakeDefinitions());
-    path = z3::mk_and(e);
+const z3::expr& InductionRound::StepPath(int m, std::optional<Move> move) {
+  if (move) {
+    const std::pair<int, int> key(m, move->transition ? move->transition->value() : -1);
+    auto it = path_by_move_.find(key);
+    if (it == path_by_move_.end()) it = path_by_move_.emplace(key, BuildPath(m, move)).first;
+    return it->second;
   }
+  std::optional<z3::expr>& path = m < 0 ? path_any_ : path_from_[m];
+  if (!path) path = BuildPath(m, std::nullopt);
   return *path;
+}
+
+z3::expr InductionRound::BuildPath(int m, std::optional<Move> move) {
+  const int k = k_;
+  z3::expr_vector e(ctx_);
+  for (int i = 0; i + 1 < k || (m < 0 && i <= k); ++i) e.push_back(enc_.State(i));
+  if (m >= 0) {
+    // s_k-1 in m alone, s_k in the modes the step can reach: only those modes' constraints (a
+    // large automaton's others would cost Z3 their simplification per mode).
+    const auto [from, next] = StepModes(m, move);
+    e.push_back(enc_.StateIn(k - 1, from));
+    e.push_back(enc_.StateIn(k, next));
+  }
+  for (int i = 0; i + 1 < k; ++i) e.push_back(enc_.Transition(i));
+  if (m < 0) {
+    e.push_back(enc_.Transition(k - 1));
+  } else {
+    e.push_back(move ? enc_.MoveFrom(k - 1, ModeId(m), move->transition)
+                     : enc_.TransitionFrom(k - 1, ModeId(m)));
+  }
+  e.push_back(enc_.TakeDefinitions());
+  return z3::mk_and(e);
 }
 
 void InductionRound::ForgetHypotheses() {
@@ -215,15 +264,30 @@ const z3::expr& InductionRound::Hypotheses(int m) {
   return *hypotheses;
 }
 
-std::pair<std::vector<bool>, std::vector<bool>> InductionRound::StepModes(int m) const {
+std::pair<std::vector<bool>, std::vector<bool>> InductionRound::StepModes(
+    int m, std::optional<Move> move) const {
   const Automaton& a = enc_.automaton();
   std::vector<bool> from(static_cast<std::size_t>(a.num_modes()), false);
   from[static_cast<std::size_t>(m)] = true;
   std::vector<bool> next = from;
-  for (const Transition& t : a.transitions()) {
-    if (t.source.value() == m) next[static_cast<std::size_t>(t.target.value())] = true;
+  if (move && move->transition) {
+    next.assign(next.size(), false);
+    next[static_cast<std::size_t>(a.transition(*move->transition).target.value())] = true;
+  } else if (!move) {
+    for (const Transition& t : a.transitions()) {
+      if (t.source.value() == m) next[static_cast<std::size_t>(t.target.value())] = true;
+    }
   }
   return {std::move(from), std::move(next)};
+}
+
+std::vector<InductionRound::Move> InductionRound::MovesFrom(int m) const {
+  const Automaton& a = enc_.automaton();
+  std::vector<Move> moves{Move{}};
+  for (int t = 0; t < a.num_transitions(); ++t) {
+    if (a.transitions()[t].source.value() == m) moves.push_back(Move{TransitionId(t)});
+  }
+  return moves;
 }
 
 }  // namespace hybrid

@@ -5,7 +5,9 @@
 #include <z3++.h>
 
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -31,11 +33,14 @@ namespace hybrid {
 /// that runs out is split per candidate: first in a context of the mode's own
 /// (QueryMeter::CheckApart, resource_limit / 25), where nlsat's effort does not depend on the
 /// other modes' queries, then in the round's context with resource_limit / 5 and
-/// resource_limit; a candidate that runs out alone is dropped. Dropping is always sound: what
-/// survives is inductive whatever was dropped. Once the budget reaches `ceiling`, every living
-/// candidate is dropped (cut()).
+/// resource_limit; a candidate that runs out alone is dropped. From a mode with a separable
+/// flow (a polynomial closed form), all this is done one move at a time: the flow, then each
+/// transition from the mode (nlsat decides the law without the jumps' case split far sooner).
+/// Dropping is always sound: what survives is inductive whatever was dropped. Once the budget
+/// reaches `ceiling`, every living candidate is dropped (cut()).
 ///
-/// Formulas are built once per round (the path per last mode, the hypotheses after each drop).
+/// Formulas are built once per round (the path per last mode and move, the hypotheses after each
+/// drop).
 /// Logs (topic "prove") at kDebug each failed step: k, the mode, the candidates it breaks (not
 /// the path: reading it from the model would use the context, and so change what later queries
 /// are charged).
@@ -71,23 +76,41 @@ class InductionRound {
   // The step from each mode in turn for the living candidates (split per candidate where a
   // query runs out); drops those that fail and returns whether any was dropped.
   bool StepPerMode();
-  // The step query from mode m, or from any mode (m = -1, with Z3's default solver): a path of k
-  // steps on which the living candidates hold before s_k and one of `goals` fails at s_k. On sat,
-  // `failed` gets the goals the model breaks (all of them when it cannot tell).
+  // One move of the step from a mode: its flow (no transition) or the jump by `transition`.
+  struct Move {
+    std::optional<TransitionId> transition;
+  };
+  // The candidates among `goals` whose step from mode m (by `move` only, when given) fails
+  // (a query of them all, split per candidate when it runs out).
+  std::vector<std::size_t> FailedFrom(int m, const std::vector<std::size_t>& goals,
+                                      std::optional<Move> move);
+  // The step query from mode m (by `move` only, when given), or from any mode (m = -1, with
+  // Z3's default solver): a path of k steps on which the living candidates hold before s_k and
+  // one of `goals` fails at s_k. On sat, `failed` gets the goals the model breaks (all of them
+  // when it cannot tell).
   z3::check_result StepQuery(int m, const std::vector<std::size_t>& goals, unsigned limit,
-                             std::vector<std::size_t>& failed, bool apart = false);
+                             std::vector<std::size_t>& failed, bool apart = false,
+                             std::optional<Move> move = std::nullopt);
   // Logs (kDebug) that the step from mode m (any: m < 0) fails for the candidates `failed`.
   void LogFailedStep(int m, const std::vector<std::size_t>& failed) const;
-  // The path of the step query from mode m (any: m < 0), built on first use.
-  const z3::expr& StepPath(int m);
+  // The path of the step query from mode m (any: m < 0; by `move` only, when given), built on
+  // first use.
+  const z3::expr& StepPath(int m, std::optional<Move> move = std::nullopt);
+  // The path of StepPath, built.
+  z3::expr BuildPath(int m, std::optional<Move> move);
+  // The name of a step query in the log: its mode, move, number of goals and context.
+  std::string QueryName(int m, std::size_t goals, bool apart, std::optional<Move> move) const;
+  // The moves from mode m: its flow, then its transitions.
+  std::vector<Move> MovesFrom(int m) const;
   // The living candidates and the lemmas hold at s_0 .. s_k-1 (for the step from mode m, read
   // at s_k-1 in m alone; any mode: m < 0): built on first use after each drop.
   const z3::expr& Hypotheses(int m);
   // Forgets the hypotheses built (after a drop).
   void ForgetHypotheses();
   // The modes of the step from m: s_k-1's (m alone) and s_k's (m and the targets of its
-  // transitions), a flag per mode.
-  std::pair<std::vector<bool>, std::vector<bool>> StepModes(int m) const;
+  // transitions; by `move` only: m for the flow, the transition's target), a flag per mode.
+  std::pair<std::vector<bool>, std::vector<bool>> StepModes(
+      int m, std::optional<Move> move = std::nullopt) const;
 
   SmtEncoding& enc_;
   QueryMeter& meter_;
@@ -99,6 +122,7 @@ class InductionRound {
   std::vector<const ProofCandidate*> lemmas_;
   std::vector<bool> alive_;
   std::vector<std::optional<z3::expr>> path_from_;        // the path of k steps, per last mode
+  std::map<std::pair<int, int>, z3::expr> path_by_move_;  // per (last mode, transition or -1)
   std::optional<z3::expr> hypotheses_;                    // of the alive candidates
   std::vector<std::optional<z3::expr>> hypotheses_from_;  // the same, per mode of s_k-1
   std::optional<z3::expr> path_any_;                      // the path of k steps, any last mode

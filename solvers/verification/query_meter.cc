@@ -16,11 +16,14 @@ std::uint64_t StepUnits(const Automaton& automaton) {
          static_cast<std::uint64_t>(automaton.num_modes() + automaton.num_transitions() + 1);
 }
 
-std::uint64_t PathUnits(const Automaton& automaton, int k, int m) {
+std::uint64_t PathUnits(const Automaton& automaton, int k, int m, bool one_move) {
   HYBRID_ASSERT(k >= 1 && m < automaton.num_modes(), "a path of at least one step, from a mode");
+  HYBRID_ASSERT(!one_move || m >= 0, "one move is a move from a mode");
   std::uint64_t last =
       static_cast<std::uint64_t>(automaton.num_modes() + automaton.num_transitions() + 1);
-  if (m >= 0) {
+  if (one_move) {
+    last = 1;  // the flow or one transition
+  } else if (m >= 0) {
     last = 1;
     for (const Transition& t : automaton.transitions()) last += t.source.value() == m ? 1 : 0;
   }

@@ -29,8 +29,8 @@ std::uint64_t StepUnits(const Automaton& automaton);
 
 /// The charge for what a path of k steps whose last step leaves mode m (any mode: m < 0) puts in
 /// a new solver: k + 1 states (each linear in the modes), k - 1 full steps and the last step
-/// (from m: its flow and its outgoing transitions only).
-std::uint64_t PathUnits(const Automaton& automaton, int k, int m);
+/// (from m: its flow and its outgoing transitions only; with `one_move`, one of them).
+std::uint64_t PathUnits(const Automaton& automaton, int k, int m, bool one_move = false);
 
 /// The solver for the induction and unreachability queries: the formula simplified (Z3's
 /// simplify, propagate-values, solve-eqs), then Z3's simplex (qflra) if it is linear, else nlsat

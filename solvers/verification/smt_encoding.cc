@@ -1140,14 +1140,25 @@ z3::expr SmtEncoding::Jump(int k, int t) {
   return out;
 }
 
+z3::expr SmtEncoding::FlowMove(int k, int mode) {
+  return Vars(k).flow && Vars(k + 1).mode[mode] && Flow(k, mode);
+}
+
+z3::expr SmtEncoding::JumpMove(int k, int t) { return Vars(k).jump[t] && Jump(k, t); }
+
 z3::expr SmtEncoding::TransitionFrom(int k, ModeId m) {
-  StepVars& a = Vars(k);
-  StepVars& b = Vars(k + 1);
   const int mode = m.value();
   z3::expr_vector options(ctx_);
-  options.push_back(a.flow && b.mode[mode] && Flow(k, mode));
-  for (int t : outgoing_[mode]) options.push_back(a.jump[t] && Jump(k, t));
-  return a.mode[mode] && z3::mk_or(options);
+  options.push_back(FlowMove(k, mode));
+  for (int t : outgoing_[mode]) options.push_back(JumpMove(k, t));
+  return Vars(k).mode[mode] && z3::mk_or(options);
+}
+
+z3::expr SmtEncoding::MoveFrom(int k, ModeId m, std::optional<TransitionId> jump) {
+  const int mode = m.value();
+  HYBRID_ASSERT(!jump || automaton_.transition(*jump).source == m,
+                "a move from a mode is one of its transitions");
+  return Vars(k).mode[mode] && (jump ? JumpMove(k, jump->value()) : FlowMove(k, mode));
 }
 
 z3::expr SmtEncoding::Transition(int k) {

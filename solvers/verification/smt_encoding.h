@@ -101,6 +101,9 @@ class SmtEncoding {
   z3::expr Transition(int k);
   /// T(s_k, s_k+1) with s_k in mode `m` (smaller than Transition(k) and InMode(k, m)).
   z3::expr TransitionFrom(int k, ModeId m);
+  /// T(s_k, s_k+1) with s_k in mode `m`, by one move: m's flow (`jump` empty) or the jump by the
+  /// transition `jump` (one from m). TransitionFrom(k, m) is the disjunction of m's moves.
+  z3::expr MoveFrom(int k, ModeId m, std::optional<TransitionId> jump);
   /// `p` at s_k, evaluated leniently within `tolerance` (comparisons in positive position hold
   /// within it, under `not` they must hold with that margin; tolerance 0 is exact).
   z3::expr Holds(const Predicate& p, int k, double tolerance = 0.0);
@@ -284,6 +287,9 @@ class SmtEncoding {
   static void AddSigmaBound(const GuardAtom& at, std::vector<std::pair<z3::expr, bool>>& lower,
                             std::vector<std::pair<z3::expr, bool>>& upper);
   z3::expr Jump(int k, int t);
+  // The moves of TransitionFrom: the flow in `mode` (s_k+1 in it too), the jump by transition t.
+  z3::expr FlowMove(int k, int mode);
+  z3::expr JumpMove(int k, int t);
   // Whether `c` reads a continuous variable with a flow in mode `mode`.
   bool ReadsMovingVariable(const Comparison& c, int mode) const;
   z3::expr Discrete(int k, int slot);

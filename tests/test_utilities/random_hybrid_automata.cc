@@ -367,8 +367,49 @@ RandomMode DrawAffineMode(Rng& rng, const Context& ctx, const std::string& name)
   return m;
 }
 
+// A mode of RandomDynamics::kSeparable (see there): a driver w' = c u and the other variables
+// still or K phi(w) u, with positive coefficients (`-0.4*w*u` would read as a negation, not as a
+// product with u); the direction comes from c's sign and the input's bounds.
+RandomMode DrawSeparableMode(Rng& rng, const Context& ctx, const std::string& name) {
+  RandomMode m{name, {}, {}, {}};
+  const auto& vars = ctx.a->variables;
+  const auto& params = ctx.a->parameters;
+  const int nv = static_cast<int>(vars.size());
+  const std::string u = Pick(rng, ctx.a->inputs).name;
+  const int w = UniformInt(rng, 0, nv - 1);
+  const std::string& driver = vars[w].name;
+  m.flows.emplace_back(driver, Name(u, NonZeroTenths(rng, 10)));
+  for (int v = 0; v < nv; ++v) {
+    if (v == w) continue;
+    const double k = Tenths(rng, 1, 10);
+    switch (UniformInt(rng, 0, 3)) {
+      case 0:  // still
+        break;
+      case 1:
+        m.flows.emplace_back(vars[v].name, RandomSum{{{k, {driver, u}}}});
+        break;
+      case 2:
+        m.flows.emplace_back(vars[v].name, RandomSum{{{k / 2, {driver, driver, u}}}});
+        break;
+      default: {
+        std::vector<std::string> factors = {driver, u};
+        if (!params.empty()) factors.insert(factors.begin(), Pick(rng, params).name);
+        m.flows.emplace_back(vars[v].name, RandomSum{{{k, factors}}});
+        break;
+      }
+    }
+  }
+  const int atoms = Weighted(rng, {35, 45, 20});
+  for (int i = 0; i < atoms; ++i) m.invariant.push_back(DrawInvariantAtom(rng, ctx));
+  return m;
+}
+
 RandomMode DrawMode(Rng& rng, const Context& ctx, const std::string& name) {
   if (Affine(ctx)) return DrawAffineMode(rng, ctx, name);
+  if (ctx.options.dynamics == RandomDynamics::kSeparable && !ctx.a->inputs.empty() &&
+      ctx.a->variables.size() >= 2 && RandomChance(rng, 70)) {
+    return DrawSeparableMode(rng, ctx, name);
+  }
   RandomMode m{name, {}, {}, {}};
   const auto& vars = ctx.a->variables;
   for (int v = 0; v < static_cast<int>(vars.size()); ++v) {

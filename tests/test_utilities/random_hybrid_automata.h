@@ -194,6 +194,12 @@ enum class RandomDynamics {
   /// (guard `x >= 3` for an invariant `x <= 3`), and a third of the resets mix two variables
   /// (`v := -0.7*v + 0.2*w + 1.1`).
   kAffine,
+  /// Seven modes in ten (with an input and two variables or more) separable as the finger's
+  /// phase 3 is: one input u drives one variable (`w' = 0.7*u`), and each other variable stands
+  /// still or follows a polynomial of the driver times u (`x' = 0.4*w*u`, `x' = 0.2*w*w*u`,
+  /// `x' = 0.3*p*w*u` with a parameter p), whose closed form the prover encodes as a polynomial
+  /// law; the other modes, and everything else, are drawn as for kMixed.
+  kSeparable,
 };
 
 /// How to draw a RandomHybridAutomaton (GenerateRandomAutomaton).

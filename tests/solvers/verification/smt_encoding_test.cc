@@ -12,6 +12,7 @@
 #include <z3++.h>
 
 #include <algorithm>
+#include <random>
 #include <regex>
 #include <set>
 #include <stdexcept>
@@ -23,6 +24,7 @@
 #include "hybrid/automaton/parser.h"
 #include "hybrid/simulation/simulator.h"
 #include "tests/test_utilities/models.h"
+#include "tests/test_utilities/random_hybrid_automata.h"
 
 namespace hybrid {
 namespace {
@@ -173,6 +175,28 @@ TEST(SmtEncoding, ClassifiesTheFingerModes) {
   for (const char* m : {"c001_l000", "c111_l000", "c000_l111", "c001_l10n", "c000_l11n"}) {
     EXPECT_EQ(enc.flow_class(Mode(a, m)), FlowClass::kStill) << m;
   }
+}
+
+// The random models of RandomDynamics::kSeparable (the prover's differential test on separable
+// flows, soundness_test.cc) have modes the encoding classifies as separable: most of those with
+// an input and two variables or more.
+TEST(SmtEncoding, ClassifiesRandomSeparableModes) {
+  int separable = 0, eligible = 0;
+  for (int i = 0; i < 100; ++i) {
+    std::mt19937_64 rng(1000 + i);
+    const testing::RandomHybridAutomaton r =
+        testing::GenerateRandomAutomaton(rng, {testing::RandomDynamics::kSeparable});
+    if (r.inputs.empty() || r.variables.size() < 2) continue;
+    const Automaton a = ParseAutomaton(r.Text(), "random.ha");
+    z3::context ctx;
+    const SmtEncoding enc(ctx, a);
+    for (int m = 0; m < a.num_modes(); ++m) {
+      ++eligible;
+      separable += enc.flow_class(ModeId(m)) == FlowClass::kSeparable ? 1 : 0;
+    }
+  }
+  EXPECT_GT(eligible, 50);
+  EXPECT_GT(separable, eligible / 3) << separable << " of " << eligible;
 }
 
 // Soundness: the endpoint of every simulated segment (constant input, start and end clear of
@@ -576,6 +600,40 @@ TEST(SmtEncodingSize, HoldsInIsHoldsInTheFlaggedModes) {
       EXPECT_EQ(s.check(), z3::unsat) << p.name << ", " << flagged << " flagged modes";
       s.pop();
       if (flagged == 1) EXPECT_LE(Size(in), Size(all)) << p.name;
+    }
+  }
+}
+
+// TransitionFrom(k, m) is the disjunction of MoveFrom(k, m, move) over m's moves (its flow and
+// each transition from it), for every mode of the finger: Z3 finds no model where they differ.
+// And a move's s_k+1 is in one mode: m for the flow, the transition's target for a jump.
+TEST(SmtEncoding, TheStepFromAModeIsTheDisjunctionOfItsMoves) {
+  const Automaton a = FingerAutomaton();
+  z3::context ctx;
+  SmtEncoding enc(ctx, a);
+  z3::solver s(ctx);
+  s.add(enc.State(0) && enc.State(1));
+  s.add(enc.TakeDefinitions());
+  for (int m = 0; m < a.num_modes(); ++m) {
+    z3::expr_vector moves(ctx);
+    moves.push_back(enc.MoveFrom(0, ModeId(m), std::nullopt));
+    std::vector<int> targets = {m};
+    for (int t = 0; t < a.num_transitions(); ++t) {
+      if (a.transitions()[t].source.value() != m) continue;
+      moves.push_back(enc.MoveFrom(0, ModeId(m), TransitionId(t)));
+      targets.push_back(a.transitions()[t].target.value());
+    }
+    const z3::expr whole = enc.TransitionFrom(0, ModeId(m));
+    s.add(enc.TakeDefinitions());  // of the auxiliaries the moves' formulas name
+    s.push();
+    s.add(whole != z3::mk_or(moves));
+    EXPECT_EQ(s.check(), z3::unsat) << a.modes()[m].name;
+    s.pop();
+    for (unsigned i = 0; i < moves.size(); ++i) {
+      s.push();
+      s.add(moves[i] && !enc.InMode(1, ModeId(targets[i])));
+      EXPECT_EQ(s.check(), z3::unsat) << a.modes()[m].name << ", move " << i;
+      s.pop();
     }
   }
 }
