@@ -271,11 +271,7 @@ z3::expr ProofRun::Bad(const ProofCandidate& c, int n, double margin) {
 // events, which the simulator breaks by declaration order), then over their ranges. Per pass, one
 // query for the candidates not yet tried: unsat settles them all; a model names those it breaks
 // (or reaches), which are tried alone (One) and the rest asked again; a query that runs out
-// leaves every remaining candidate to One. The joint query gets 1/100 of the limit: where it runs
-// out, each candidate's own query decides as well (the finger's `--modes`: a joint query that
-// ran 25 million units, 14 s, without deciding came back sat in 0.05 s in a new context, and
-// its candidates' own queries decided in 0.04 s), and whether the depth was searched
-// completely is then theirs to say.
+// leaves every remaining candidate to One.
 void ProofRun::Search(int n, bool invariants_only, std::initializer_list<bool> passes,
                       std::uint64_t ceiling) {
   if (!Extend(n, ceiling)) {
@@ -301,8 +297,7 @@ void ProofRun::Search(int n, bool invariants_only, std::initializer_list<bool> p
       bmc_.push();
       AddWithDefinitions(bmc_, enc_, z3::mk_or(any));
       if (pinned) bmc_.add(enc_.NominalParameters());
-      const z3::check_result r =
-          meter_.Check(bmc_, options_.resource_limit / 100, ceiling, "search");
+      const z3::check_result r = meter_.Check(bmc_, options_.resource_limit, ceiling, "search");
       std::vector<std::size_t> hit;
       std::optional<z3::model> model;
       if (r == z3::sat) {
@@ -313,7 +308,10 @@ void ProofRun::Search(int n, bool invariants_only, std::initializer_list<bool> p
       }
       bmc_.pop();
       if (r == z3::unsat) break;
-      more = r == z3::sat;
+      if (r == z3::unknown) {
+        if (!pinned) bmc_complete_ = false;
+        more = false;
+      }
       if (hit.empty()) hit = asked;  // cannot tell which: each alone
       for (std::size_t i : hit) {
         tried[i] = true;
