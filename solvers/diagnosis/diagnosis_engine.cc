@@ -170,27 +170,26 @@ class Engine {
     const DiagnosisRun& run = runs_[r];
     const std::vector<size_t>& ends = horizon_ends_[r];
     const size_t n = run.input.size();
-    const int J = channels();
-    // Each sample's terms first, a channel at a time over contiguous arrays, then added up
-    // sample by sample and channel by channel: the sums of one pass over both, bit for bit (a
-    // missing sample adds +0, and every term is >= +0).
-    std::vector<double> terms(n * static_cast<size_t>(J));
-    for (int j = 0; j < J; ++j) {
+    // Each sample's terms first (sample-major), a channel at a time, then added up sample by
+    // sample and channel by channel up to each horizon's end: the sums of one pass over both,
+    // bit for bit (a missing sample adds +0, and every term is >= +0).
+    const size_t J = static_cast<size_t>(channels());
+    std::vector<double> terms(n * J);
+    for (size_t j = 0; j < J; ++j) {
       const double* m = run.channels[j].data();
       const double* q = p.channels[j].data();
-      double* t = terms.data() + static_cast<size_t>(j) * n;
       const double sigma = sigma_[j], huber = o_.huber;
       for (size_t k = 0; k < n; ++k)
-        t[k] = std::isnan(m[k]) ? 0.0 : Rho((m[k] - q[k]) / sigma, huber);
+        terms[k * J + j] = std::isnan(m[k]) ? 0.0 : Rho((m[k] - q[k]) / sigma, huber);
     }
-    std::vector<double> out;
+    std::vector<double> out(ends.size());
     double loss = 0.0;
-    size_t h = 0;
-    for (size_t k = 0; k < n && h < ends.size(); ++k) {
-      for (int j = 0; j < J; ++j) loss += terms[static_cast<size_t>(j) * n + k];
-      while (h < ends.size() && k + 1 >= ends[h]) ++h, out.push_back(loss);
+    size_t done = 0;  // terms added so far
+    for (size_t h = 0; h < ends.size(); ++h) {
+      const size_t end = std::min(ends[h], n) * J;
+      for (; done < end; ++done) loss += terms[done];
+      out[h] = loss;
     }
-    while (out.size() < ends.size()) out.push_back(loss);
     return out;
   }
 

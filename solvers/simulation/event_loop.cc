@@ -119,9 +119,10 @@ bool EventLoop::SamplesOnTheLine() {
 
 bool EventLoop::StaysOnTheLine() const {
   for (size_t i = 0; i < g_prev_.size(); ++i) {
+    if (!(run_.roots()[i].direction * slopes_[i] > 0.0)) continue;  // moving away or along
     const bool boundary =
         g_prev_[i] == 0.0 ? anchor_.t - anchor_.g[i] / slopes_[i] == t_ : OnBoundary(i);
-    if (boundary && run_.roots()[i].direction * slopes_[i] > 0.0) return false;
+    if (boundary) return false;
   }
   return true;
 }
