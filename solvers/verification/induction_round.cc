@@ -28,7 +28,6 @@ InductionRound::InductionRound(SmtEncoding& encoding, QueryMeter& meter, unsigne
     HYBRID_ASSERT(c != nullptr && c->invariant && c->proved, "lemmas are proved invariants");
   }
   alive_.assign(set_.size(), true);
-  path_from_.resize(enc_.automaton().num_modes());
   hypotheses_from_.resize(enc_.automaton().num_modes());
 }
 
@@ -204,15 +203,11 @@ void InductionRound::LogFailedStep(int m, const std::vector<std::size_t>& failed
 }
 
 const z3::expr& InductionRound::StepPath(int m, std::optional<Move> move) {
-  if (move) {
-    const std::pair<int, int> key(m, move->transition ? move->transition->value() : -1);
-    auto it = path_by_move_.find(key);
-    if (it == path_by_move_.end()) it = path_by_move_.emplace(key, BuildPath(m, move)).first;
-    return it->second;
-  }
-  std::optional<z3::expr>& path = m < 0 ? path_any_ : path_from_[m];
-  if (!path) path = BuildPath(m, std::nullopt);
-  return *path;
+  // Keyed by the last mode (any: -1) and the move (every move: -2, the flow: -1, a transition).
+  const int which = !move ? -2 : move->transition ? move->transition->value() : -1;
+  auto it = paths_.find({m, which});
+  if (it == paths_.end()) it = paths_.emplace(std::pair(m, which), BuildPath(m, move)).first;
+  return it->second;
 }
 
 z3::expr InductionRound::BuildPath(int m, std::optional<Move> move) {

@@ -121,11 +121,9 @@ class InductionRound {
   std::vector<ProofCandidate*> set_;
   std::vector<const ProofCandidate*> lemmas_;
   std::vector<bool> alive_;
-  std::vector<std::optional<z3::expr>> path_from_;        // the path of k steps, per last mode
-  std::map<std::pair<int, int>, z3::expr> path_by_move_;  // per (last mode, transition or -1)
-  std::optional<z3::expr> hypotheses_;                    // of the alive candidates
+  std::map<std::pair<int, int>, z3::expr> paths_;  // of k steps, per last mode and move (StepPath)
+  std::optional<z3::expr> hypotheses_;             // of the alive candidates
   std::vector<std::optional<z3::expr>> hypotheses_from_;  // the same, per mode of s_k-1
-  std::optional<z3::expr> path_any_;                      // the path of k steps, any last mode
   bool cut_ = false;
 };
 
