@@ -1024,6 +1024,36 @@ void System::SetScenario(Scenario scenario) {
   scenario_ = std::move(scenario);
 }
 
+std::vector<int> System::InteractionGroups() const {
+  std::vector<int> parent(components_.size());
+  for (std::size_t c = 0; c < parent.size(); ++c) parent[c] = static_cast<int>(c);
+  auto find = [&](int c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  };
+  auto join = [&](int a, int b) {  // the smaller root stays the root
+    const auto [lo, hi] = std::minmax(find(a), find(b));
+    parent[hi] = lo;
+  };
+  std::map<int, int> slot_user;           // System slot -> a component that has it
+  std::map<std::string, int> label_user;  // label -> a component that uses it
+  for (int c = 0; c < static_cast<int>(components_.size()); ++c) {
+    for (const int g : components_[c].global_slot) {
+      const SymbolKind kind = symbols_[g].kind;
+      if (kind != SymbolKind::kVariable && kind != SymbolKind::kDiscrete) continue;
+      const auto [it, added] = slot_user.emplace(g, c);
+      if (!added) join(c, it->second);
+    }
+    for (const std::string& label : Alphabet(c)) {
+      const auto [it, added] = label_user.emplace(label, c);
+      if (!added) join(c, it->second);
+    }
+  }
+  std::vector<int> group(components_.size());
+  for (std::size_t c = 0; c < group.size(); ++c) group[c] = find(static_cast<int>(c));
+  return group;
+}
+
 System System::Restricted(std::span<const int> which) const {
   System out(name_);
   out.shared_ = shared_;

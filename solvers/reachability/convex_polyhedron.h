@@ -74,6 +74,10 @@ class ConvexPolyhedron {
   void AddDimensions(int count);
   /// Keeps the first `dims` dimensions (projection).
   void KeepDimensions(int dims);
+  /// This set placed in R^dims: dimension i of this becomes dimension to[i] (distinct, each in
+  /// [0, dims); to.size() == this->dims() <= dims, else std::invalid_argument), every other
+  /// dimension unconstrained. Exact: {y in R^dims : (y[to[0]], ..., y[to[n-1]]) in this}.
+  ConvexPolyhedron Embedded(int dims, std::span<const int> to) const;
   /// The convex hull of this and other.
   void Hull(const ConvexPolyhedron& other);
   /// The H79 widening of this (which must contain `previous`) with respect to `previous`.

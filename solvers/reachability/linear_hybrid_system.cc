@@ -242,16 +242,24 @@ struct LinearHybridSystem::Forms {
   }
 };
 
-LinearHybridSystem::LinearHybridSystem(const System& system, bool clock,
-                                       const std::vector<const Property*>& observed)
-    : system_(system), forms_(new Forms{system, {}, {}, {}, {}, 0}) {
+std::vector<int> LinearHybridSystem::ReadSlots(const std::vector<const Property*>& properties) {
   std::vector<int> read;
-  for (const Property* p : observed) {
+  for (const Property* p : properties) {
     p->predicate.ForEachComparison([&read](const Comparison& c) {
       for (const int s : c.lhs.Slots()) read.push_back(s);
       for (const int s : c.rhs.Slots()) read.push_back(s);
     });
   }
+  return read;
+}
+
+LinearHybridSystem::LinearHybridSystem(const System& system, bool clock,
+                                       const std::vector<const Property*>& observed)
+    : LinearHybridSystem(system, clock, ReadSlots(observed)) {}
+
+LinearHybridSystem::LinearHybridSystem(const System& system, bool clock,
+                                       const std::vector<int>& read)
+    : system_(system), forms_(new Forms{system, {}, {}, {}, {}, 0}) {
   liveness_ = std::make_unique<VariableLiveness>(system, read);
   const SymbolTable& symbols = system.symbols();
   const int n = symbols.size();

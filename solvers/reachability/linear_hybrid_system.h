@@ -84,6 +84,11 @@ class LinearHybridSystem {
   /// to be checked (the variables they read are live in every location).
   LinearHybridSystem(const System& system, bool clock,
                      const std::vector<const Property*>& observed);
+  /// The same with the System slots the checked properties read given directly (`read`: live in
+  /// every location).
+  LinearHybridSystem(const System& system, bool clock, const std::vector<int>& read);
+  /// The System slots `properties` read (their comparisons' symbols).
+  static std::vector<int> ReadSlots(const std::vector<const Property*>& properties);
   ~LinearHybridSystem();
 
   const System& system() const { return system_; }

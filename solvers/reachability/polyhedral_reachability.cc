@@ -1,7 +1,5 @@
 #include "hybrid/reachability/polyhedral_reachability.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,7 +11,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "solvers/reachability/group_product.h"
 #include "solvers/reachability/linear_hybrid_system.h"
+#include "solvers/reachability/reach_meter.h"
 
 namespace hybrid {
 namespace {
@@ -21,58 +21,7 @@ namespace {
 using Kind = LinearConstraint::Kind;
 using Conjunction = std::vector<LinearConstraint>;
 
-double ThreadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-// The deterministic cost count of one Check, in reach units (kReachUnitsPerBudgetSecond), and its
-// CPU-time safety net, shared by its explorations: each may use units up to its share.
-class Meter {
- public:
-  Meter(std::uint64_t total, double cpu_seconds)
-      : total_(total), limit_(total), cpu_seconds_(cpu_seconds), start_(ThreadCpuSeconds()) {}
-
-  // Charges `count` operations that read a polyhedron of the size of `p` (and one of `q`'s).
-  void Op(const ConvexPolyhedron& p, std::uint64_t count = 1) {
-    used_ += count * (kReachUnitsPerOperation + p.RepresentationBytes() / kReachBytesPerUnit);
-  }
-  void Op(const ConvexPolyhedron& p, const ConvexPolyhedron& q) {
-    used_ += kReachUnitsPerOperation +
-             (p.RepresentationBytes() + q.RepresentationBytes()) / kReachBytesPerUnit;
-  }
-
-  // Charges `count` comparisons of bounding boxes.
-  void Boxes(std::uint64_t count) { used_ += count * kReachUnitsPerBoxComparison; }
-  // Charges the construction of a location.
-  void Location() { used_ += kReachUnitsPerLocation; }
-  // Charges the replay of a run along a path of `steps` symbolic states.
-  void Replay(std::size_t steps) { used_ += steps * kReachUnitsPerReplayedStep; }
-
-  // The next exploration's share: what is left split equally among the `parts` still to run.
-  void ShareAmong(int parts) {
-    share_ = (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
-    limit_ = used_ + share_;
-  }
-  // Whether the current exploration has used its share.
-  bool Exhausted() const { return used_ >= limit_; }
-  // Whether the CPU-time safety net has passed (the thread's time since the Check began).
-  bool OutOfTime() const { return ThreadCpuSeconds() - start_ > cpu_seconds_; }
-
-  std::uint64_t used() const { return used_; }
-  std::uint64_t total() const { return total_; }
-  std::uint64_t share() const { return share_; }
-  double cpu_seconds() const { return cpu_seconds_; }
-
- private:
-  std::uint64_t total_;
-  std::uint64_t share_ = total_;
-  std::uint64_t limit_;
-  std::uint64_t used_ = 0;
-  double cpu_seconds_;
-  double start_;  // thread CPU time at the start of the Check
-};
+using Meter = ReachMeter;
 
 // The bounding box of a symbolic state, each bound (ConvexPolyhedron::Bounds, within one ulp of
 // the true one) widened by one ulp either way: the true infimum of dimension i lies in
@@ -196,12 +145,6 @@ std::vector<double> Unit(int n, int i) {
   return e;
 }
 
-std::vector<const Property*> PropertiesOf(const std::vector<Goal>& goals) {
-  std::vector<const Property*> out;
-  for (const Goal& g : goals) out.push_back(g.property);
-  return out;
-}
-
 // `set` (entry states of `loc`) with the values of the variables dead at `loc` forgotten.
 ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set, Meter& meter) {
   for (const int d : loc.dead) set.Unconstrain(d);
@@ -225,10 +168,13 @@ struct BadPart {
 
 class Explorer {
  public:
+  // Explores `system` for `goals` (none: the whole reachable set); `read`: the System slots the
+  // properties checked read (live everywhere).
   Explorer(const System& system, std::vector<Goal> goals, std::optional<double> horizon,
-           const PolyhedralReachability::Options& options, Meter& meter)
+           const std::vector<int>& read, const PolyhedralReachability::Options& options,
+           Meter& meter)
       : system_(system),
-        lhs_(system, horizon.has_value(), PropertiesOf(goals)),
+        lhs_(system, horizon.has_value(), read),
         goals_(std::move(goals)),
         options_(options),
         meter_(meter),
@@ -268,6 +214,19 @@ class Explorer {
 
   // Symbolic states stored.
   long long states() const { return static_cast<long long>(nodes_.size()); }
+  // Locations built.
+  int locations() const { return lhs_.num_locations(); }
+  const LinearHybridSystem& lhs() const { return lhs_; }
+  // The states found, by location: those no later state at their location contains (after a
+  // complete Run, their union is the reachable set).
+  std::map<std::vector<int>, std::vector<const ConvexPolyhedron*>> Found() const {
+    std::map<std::vector<int>, std::vector<const ConvexPolyhedron*>> out;
+    for (const auto& [tuple, indices] : passed_) {
+      if (indices.empty()) continue;
+      for (const int i : indices) out[tuple].push_back(&nodes_[static_cast<size_t>(i)].set);
+    }
+    return out;
+  }
 
  private:
   using Stop = PolyhedralReachability::Usage::Stop;
@@ -294,8 +253,10 @@ class Explorer {
   // The horizon's states, or null without a horizon.
   const ConvexPolyhedron* Horizon() const { return horizon_.empty() ? nullptr : &horizon_set_; }
 
+  // Whether every goal is decided (never, without goals: the whole reachable set is sought).
   bool AllDecided() const {
-    return std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
+    return !goals_.empty() &&
+           std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
   }
 
   // Pushes the successors of node n through each edge of its location (locations live in a
@@ -709,6 +670,86 @@ void Explorer::Finish(Stop stop) {
   }
 }
 
+// The share of what is left of the budget that the interaction groups explored alone may use.
+constexpr int kGroupShareDivisor = 4;
+
+// The reachable states of group `comps` of `system` explored alone (System::Restricted), embedded
+// in the dimensions of `full`; nullopt if a bound stopped the exploration before its fixpoint.
+std::optional<GroupProduct::Group> ExploreGroup(const System& system, std::vector<int> comps,
+                                                const std::vector<int>& read,
+                                                const LinearHybridSystem& full,
+                                                const PolyhedralReachability::Options& options,
+                                                Meter& meter, PolyhedralReachability::Usage& used) {
+  const System alone = system.Restricted(comps);
+  std::vector<int> read_alone;  // the slots of `read` the group has, in its own numbering
+  for (const int s : read) {
+    if (const auto found = alone.symbols().Find(system.symbols()[s].name)) {
+      read_alone.push_back(*found);
+    }
+  }
+  Explorer explorer(alone, {}, std::nullopt, read_alone, options, meter);
+  const PolyhedralReachability::Usage::Stop stop = explorer.Run();
+  used.states += explorer.states();
+  if (stop != PolyhedralReachability::Usage::Stop::kNone) return std::nullopt;
+  std::vector<int> to;  // each dimension of the group's view in `full` (by name)
+  const std::vector<std::string>& names = full.names();
+  for (const std::string& name : explorer.lhs().names()) {
+    to.push_back(static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin()));
+  }
+  GroupProduct::Group group{std::move(comps), {}};
+  for (const auto& [tuple, sets] : explorer.Found()) {
+    std::vector<ConvexPolyhedron>& here = group.states[tuple];
+    for (const ConvexPolyhedron* set : sets) {
+      here.push_back(set->Embedded(full.dims(), to));
+      meter.Op(here.back());
+    }
+  }
+  return group;
+}
+
+// Proves what it can of properties `which` (none with a horizon) on the product of the
+// interaction groups of `system` explored alone (GroupProduct), within a share of the budget
+// (1 / kGroupShareDivisor of what is left); writes the verdicts of those it proves and returns
+// the others. Where the system is one group, returns `which` at once.
+std::vector<int> ProveOnGroups(const System& system, const std::vector<Property>& properties,
+                               std::vector<int> which, std::vector<CheckResult>& results,
+                               const PolyhedralReachability::Options& options, Meter& meter,
+                               PolyhedralReachability::Usage& used) {
+  std::map<int, std::vector<int>> by_group;
+  const std::vector<int> group_of = system.InteractionGroups();
+  for (int c = 0; c < static_cast<int>(group_of.size()); ++c) by_group[group_of[c]].push_back(c);
+  if (by_group.size() < 2 || which.empty()) return which;
+  std::vector<const Property*> observed;
+  for (const int i : which) observed.push_back(&properties[i]);
+  const std::vector<int> read = LinearHybridSystem::ReadSlots(observed);
+  LinearHybridSystem full(system, false, read);
+  meter.ShareAmong(kGroupShareDivisor);
+  const long long states_before = used.states;
+  std::vector<GroupProduct::Group> groups;
+  for (auto& [representative, comps] : by_group) {
+    std::optional<GroupProduct::Group> g =
+        ExploreGroup(system, comps, read, full, options, meter, used);
+    if (!g) return which;
+    groups.push_back(std::move(*g));
+  }
+  std::ostringstream reason;
+  reason << "fixpoint of exact polyhedral reachability of each of its " << groups.size()
+         << " interaction groups alone (" << used.states - states_before
+         << " symbolic states in all), whose product misses the property's states";
+  GroupProduct product(full, std::move(groups), meter);
+  std::vector<int> open;
+  for (const int i : which) {
+    if (product.Meets(properties[i]) != false) {
+      open.push_back(i);
+      continue;
+    }
+    results[i].verdict =
+        properties[i].kind == Property::Kind::kReach ? Verdict::kUnreachable : Verdict::kProved;
+    results[i].reason = reason.str();
+  }
+  return open;
+}
+
 }  // namespace
 
 bool PolyhedralReachability::Handles(const System& system, const std::vector<Property>& properties,
@@ -757,13 +798,25 @@ std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
           std::llround(options_.budget * static_cast<double>(kReachUnitsPerBudgetSecond))),
       options_.cpu_seconds > 0 ? options_.cpu_seconds : std::max(60.0, 10.0 * options_.budget));
   Usage used;
+  if (auto unbounded = by_horizon.find(std::nullopt); unbounded != by_horizon.end()) {
+    try {
+      unbounded->second =
+          ProveOnGroups(system, properties, unbounded->second, results, options_, meter, used);
+    } catch (const std::invalid_argument&) {
+      // Not linear: the exploration below says why.
+    }
+    if (unbounded->second.empty()) by_horizon.erase(unbounded);
+  }
   int parts = static_cast<int>(by_horizon.size());
   for (const auto& [horizon, which] : by_horizon) {
+    std::vector<const Property*> observed;
+    for (const int i : which) observed.push_back(&properties[i]);
     std::vector<Goal> goals;
     for (const int i : which) goals.push_back({&properties[i], &results[i], false, false, ""});
     meter.ShareAmong(parts--);
     try {
-      Explorer explorer(system, std::move(goals), horizon, options_, meter);
+      Explorer explorer(system, std::move(goals), horizon, LinearHybridSystem::ReadSlots(observed),
+                        options_, meter);
       const Usage::Stop stop = explorer.Run();
       used.states += explorer.states();
       used.stop = std::max(used.stop, stop);  // the enumerators are in that order

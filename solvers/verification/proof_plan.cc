@@ -165,37 +165,6 @@ void AddGoal(int c, const Property& q, int i, const Property& p,
   jobs[c].goals.push_back({q, i, p, {}});
 }
 
-// For each component, a representative of its interaction group: the least set of components
-// closed under sharing a variable (continuous or discrete) or a synchronisation label. Groups
-// meet only through inputs (free in a check) and parameters (constants), so a property that
-// reads some groups is decided by the product of those groups alone.
-std::vector<int> InteractionGroups(const System& system) {
-  const auto components = system.components();
-  std::vector<int> parent(components.size());
-  for (std::size_t c = 0; c < parent.size(); ++c) parent[c] = static_cast<int>(c);
-  auto find = [&](int c) {
-    while (parent[c] != c) c = parent[c] = parent[parent[c]];
-    return c;
-  };
-  std::map<int, int> slot_user;           // System slot -> a component that has it
-  std::map<std::string, int> label_user;  // label -> a component that uses it
-  for (int c = 0; c < static_cast<int>(components.size()); ++c) {
-    for (const int g : components[c].global_slot) {
-      const SymbolKind kind = system.symbols()[g].kind;
-      if (kind != SymbolKind::kVariable && kind != SymbolKind::kDiscrete) continue;
-      const auto [it, added] = slot_user.emplace(g, c);
-      if (!added) parent[find(c)] = find(it->second);
-    }
-    for (const std::string& label : system.Alphabet(c)) {
-      const auto [it, added] = label_user.emplace(label, c);
-      if (!added) parent[find(c)] = find(it->second);
-    }
-  }
-  std::vector<int> group(components.size());
-  for (std::size_t c = 0; c < group.size(); ++c) group[c] = find(static_cast<int>(c));
-  return group;
-}
-
 // The components of the interaction groups of `comps`, ascending.
 std::vector<int> GroupsOf(const std::vector<int>& group, const std::set<int>& comps) {
   std::set<int> representatives;
@@ -296,7 +265,7 @@ void PlanJobs(const System& system, std::span<const Property> properties, int ma
               std::vector<CheckResult>& results, std::vector<ProofJob>& jobs,
               ProductJobs& products) {
   const std::vector<std::vector<int>> owners = SlotOwners(system);
-  const std::vector<int> group = InteractionGroups(system);
+  const std::vector<int> group = system.InteractionGroups();
   std::map<std::string, std::vector<int>> asked;  // goals by their text (see AddGoal)
   for (std::size_t i = 0; i < properties.size(); ++i) {
     const Property& p = properties[i];

@@ -1366,12 +1366,13 @@ void ConnectByBind(Rng& rng, RandomSystem& s, int i, int j, Sym kind) {
   in.binds.emplace_back(w, target);
 }
 
-void DrawConnections(Rng& rng, RandomSystem& s) {
+void DrawConnections(Rng& rng, RandomSystem& s, bool independent) {
   const Sym kinds[] = {Sym::kVariable, Sym::kInput, Sym::kLabel, Sym::kParameter, Sym::kDiscrete};
   for (int j = 1; j < static_cast<int>(s.instances.size()); ++j) {
     for (int links = Weighted(rng, {15, 35, 30, 20}); links > 0; --links) {
       const int i = UniformInt(rng, 0, j - 1);
-      const Sym kind = kinds[Weighted(rng, {40, 20, 30, 6, 4})];
+      const Sym kind = independent ? kinds[1 + 2 * Weighted(rng, {60, 40})]  // input, parameter
+                                   : kinds[Weighted(rng, {40, 20, 30, 6, 4})];
       if (RandomChance(rng, 45)) {
         ConnectByShare(rng, s, i, j, kind);
       } else {
@@ -1837,8 +1838,10 @@ void DrawSystemProperties(Rng& rng, RandomSystem& s) {
 
 // Draws 1 to 3 instances (sometimes two of one automaton, sometimes one unqualified) and their
 // automata.
-void DrawInstances(Rng& rng, RandomSystem& s, const RandomAutomatonOptions& options) {
-  const int n = Weighted(rng, {25, 45, 30}) + 1;
+void DrawInstances(Rng& rng, RandomSystem& s, const RandomSystemOptions& system_options) {
+  const RandomAutomatonOptions& options = system_options.automata;
+  const int drawn = Weighted(rng, {25, 45, 30}) + 1;
+  const int n = system_options.independent_instances ? std::max(drawn, 2) : drawn;
   const std::vector<std::string> names = DistinctNames(rng, n);
   const int unqualified = RandomChance(rng, 15) ? UniformInt(rng, 0, n - 1) : -1;
   for (int k = 0; k < n; ++k) {
@@ -1860,8 +1863,8 @@ void DrawInstances(Rng& rng, RandomSystem& s, const RandomAutomatonOptions& opti
 RandomSystem GenerateRandomSystem(std::mt19937_64& rng, const RandomSystemOptions& options) {
   RandomSystem s;
   s.name = Pick(rng, ShortNamePool());
-  DrawInstances(rng, s, options.automata);
-  DrawConnections(rng, s);
+  DrawInstances(rng, s, options);
+  DrawConnections(rng, s, options.independent_instances);
   MakeConsistent(rng, s);
   DrawSystemProperties(rng, s);
   if (RandomChance(rng, options.conflict_percent)) InjectConflict(rng, s);

@@ -304,6 +304,11 @@ struct RandomSystemOptions {
   int conflict_percent = 0;
   /// How the instances' automata are drawn (the default keeps every seed's systems).
   RandomAutomatonOptions automata = {};
+  /// Instances that interact only through shared or bound inputs and parameters (no shared or
+  /// bound variable, label or discrete variable): 2 or 3 of them, most each its own interaction
+  /// group (System::InteractionGroups; a shared name still joins two instances that both
+  /// declare it as a variable). false keeps every seed's systems.
+  bool independent_instances = false;
 };
 
 /// A random system: 1 to 3 instances (sometimes two of one automaton, sometimes one unqualified:

@@ -168,6 +168,13 @@ class System {
   /// The product mode of `tuple` as Product makes it (flows and invariants over System slots).
   Mode ProductModeOf(std::span<const int> tuple) const;
 
+  /// For each component, the smallest index of its interaction group: the least set of
+  /// components closed under sharing a variable (continuous or discrete) or a synchronisation
+  /// label. Groups meet only through inputs (free) and parameters (constant along runs): a step
+  /// of the system is a step of one group's components, and every run projects onto a run of
+  /// each group alone (Restricted), so the reachable states of the system lie in the product of
+  /// those of its groups.
+  std::vector<int> InteractionGroups() const;
   /// The system of components `which` (indices into components()) alone, with their names,
   /// shared names and binds, and no properties or scenario; its slots are numbered afresh in the
   /// order the components first use them (look a name up in symbols() to map them back). Throws
