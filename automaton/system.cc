@@ -1032,8 +1032,9 @@ std::vector<int> System::InteractionGroups() const {
     return c;
   };
   auto join = [&](int a, int b) {  // the smaller root stays the root
-    const auto [lo, hi] = std::minmax(find(a), find(b));
-    parent[hi] = lo;
+    const int ra = find(a);
+    const int rb = find(b);
+    parent[std::max(ra, rb)] = std::min(ra, rb);
   };
   std::map<int, int> slot_user;           // System slot -> a component that has it
   std::map<std::string, int> label_user;  // label -> a component that uses it

@@ -168,6 +168,8 @@ struct BadPart {
 
 class Explorer {
  public:
+  using Stop = PolyhedralReachability::Usage::Stop;
+
   // Explores `system` for `goals` (none: the whole reachable set); `read`: the System slots the
   // properties checked read (live everywhere).
   Explorer(const System& system, std::vector<Goal> goals, std::optional<double> horizon,
@@ -186,10 +188,17 @@ class Explorer {
     }
   }
 
-  // Explores until every goal is decided, the reachable set is complete or a bound is hit
-  // (checked before each expansion: the deterministic budget's share, the state bound, the
-  // CPU-time safety net); then writes every goal's result and returns why it stopped early.
+  // Explores until every goal is decided, the reachable set is complete or a bound is hit; then
+  // writes every goal's result and returns why it stopped early.
   PolyhedralReachability::Usage::Stop Run() {
+    Start();
+    const Stop stop = Resume();
+    Finish(stop);
+    return stop;
+  }
+
+  // Pushes the initial states (call once, before Resume).
+  void Start() {
     for (int i = 0; i < static_cast<int>(initial_.size()); ++i) {
       const LinearLocation& loc = Enter(initial_[i].tuple);
       ConvexPolyhedron set = Forgetting(loc, initial_[i].set, meter_);
@@ -197,10 +206,16 @@ class Explorer {
       meter_.Op(set);
       Push({initial_[i].tuple, Flow(loc, std::move(set), Horizon(), meter_), -1, i});
     }
-    Stop stop = Stop::kNone;
+  }
+
+  // Explores until every goal is decided, the reachable set is complete or a bound is hit
+  // (checked before each expansion: the deterministic budget's share or slice, the state bound,
+  // the CPU-time safety net), and returns that bound (kNone if none). After a slice's end, a
+  // later Resume goes on where this one stopped.
+  Stop Resume() {
     while (!queue_.empty() && !AllDecided()) {
-      stop = Bound();
-      if (stop != Stop::kNone) break;
+      const Stop stop = Bound(true);
+      if (stop != Stop::kNone) return stop;
       const int n = queue_.front();
       queue_.pop_front();
       if (!nodes_[n].subsumed) Expand(n);
@@ -208,9 +223,41 @@ class Explorer {
         options_.progress(static_cast<int>(nodes_.size()), static_cast<int>(queue_.size()));
       }
     }
-    Finish(stop);
-    return stop;
+    return Stop::kNone;
   }
+
+  // Whether the reachable set is complete (nothing left to expand).
+  bool complete() const { return queue_.empty(); }
+
+  // Whether every goal is decided (never, without goals: the whole reachable set is sought).
+  bool AllDecided() const {
+    return !goals_.empty() &&
+           std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
+  }
+  // Goal g's property, as decided elsewhere to hold (`proved`; `unreachable` for `reach`), for
+  // `reason`.
+  void Holds(int g, const std::string& reason) {
+    Goal& goal = goals_[static_cast<size_t>(g)];
+    CheckResult r = *goal.result;
+    r.verdict =
+        goal.property->kind == Property::Kind::kReach ? Verdict::kUnreachable : Verdict::kProved;
+    r.trace.reset();
+    r.reason = reason;
+    Decide(g, std::move(r));
+  }
+  // Goal g's result, decided elsewhere (by another engine, or by the product of the interaction
+  // groups): the exploration no longer seeks it.
+  void Decide(int g, CheckResult result) {
+    Goal& goal = goals_[static_cast<size_t>(g)];
+    *goal.result = std::move(result);
+    goal.decided = true;
+  }
+  bool decided(int g) const { return goals_[static_cast<size_t>(g)].decided; }
+  const Property& property(int g) const { return *goals_[static_cast<size_t>(g)].property; }
+  int num_goals() const { return static_cast<int>(goals_.size()); }
+
+  // Writes every undecided goal's result after the exploration stopped (at `stop`, or kNone).
+  void Finish(Stop stop);
 
   // Symbolic states stored.
   long long states() const { return static_cast<long long>(nodes_.size()); }
@@ -229,12 +276,11 @@ class Explorer {
   }
 
  private:
-  using Stop = PolyhedralReachability::Usage::Stop;
-
   // The bound the exploration has reached, if any (deterministic ones first, so that the safety
-  // net is named only when it alone stops the exploration).
-  Stop Bound() const {
-    if (meter_.Exhausted()) return Stop::kBudget;
+  // net is named only when it alone stops the exploration); with `slice`, the end of the
+  // meter's slice counts (kBudget) too.
+  Stop Bound(bool slice = false) const {
+    if (slice ? meter_.Exhausted() : meter_.ShareExhausted()) return Stop::kBudget;
     if (options_.max_states > 0 && static_cast<int>(nodes_.size()) > options_.max_states) {
       return Stop::kStateBound;
     }
@@ -252,12 +298,6 @@ class Explorer {
 
   // The horizon's states, or null without a horizon.
   const ConvexPolyhedron* Horizon() const { return horizon_.empty() ? nullptr : &horizon_set_; }
-
-  // Whether every goal is decided (never, without goals: the whole reachable set is sought).
-  bool AllDecided() const {
-    return !goals_.empty() &&
-           std::all_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.decided; });
-  }
 
   // Pushes the successors of node n through each edge of its location (locations live in a
   // std::map, so references to them stay valid while others are added; nodes_ does not).
@@ -404,7 +444,6 @@ class Explorer {
   Trace TraceOf(const PathRun& run, const std::vector<int>& path,
                 const LinearHybridSystem::Initial& init);
   std::string StopText(Stop stop) const;
-  void Finish(Stop stop);
 
   const System& system_;
   LinearHybridSystem lhs_;
@@ -670,84 +709,230 @@ void Explorer::Finish(Stop stop) {
   }
 }
 
-// The share of what is left of the budget that the interaction groups explored alone may use.
-constexpr int kGroupShareDivisor = 4;
+// The interaction groups' turns beside the exact exploration: the exact exploration first
+// explores Options::group_turn_units reach units, then the groups explore alone
+// 1/kGroupTurnDivisor of that, then each slice doubles; so where the groups do not help, they
+// cost at most that fraction of the exact exploration's work, and where they do (NAV4: two 9-cell
+// maps, whose product the exact exploration does not exhaust), they are done after about
+// kGroupTurnDivisor times their own work.
+constexpr std::uint64_t kGroupTurnDivisor = 32;
 
-// The reachable states of group `comps` of `system` explored alone (System::Restricted), embedded
-// in the dimensions of `full`; nullopt if a bound stopped the exploration before its fixpoint.
-std::optional<GroupProduct::Group> ExploreGroup(const System& system, std::vector<int> comps,
-                                                const std::vector<int>& read,
-                                                const LinearHybridSystem& full,
-                                                const PolyhedralReachability::Options& options,
-                                                Meter& meter, PolyhedralReachability::Usage& used) {
-  const System alone = system.Restricted(comps);
-  std::vector<int> read_alone;  // the slots of `read` the group has, in its own numbering
-  for (const int s : read) {
-    if (const auto found = alone.symbols().Find(system.symbols()[s].name)) {
-      read_alone.push_back(*found);
+// The interaction groups of a System (System::InteractionGroups) explored alone, a slice at a
+// time, and what the product of their reachable sets (GroupProduct) proves. Inactive for a System
+// of one group.
+class GroupTurns {
+ public:
+  // `read`: the System slots the properties read (live in every group).
+  GroupTurns(const System& system, const std::vector<int>& read,
+             const PolyhedralReachability::Options& options, Meter& meter)
+      : system_(system), full_(system, false, read), meter_(meter) {
+    std::map<int, std::vector<int>> by_group;
+    const std::vector<int> group_of = system.InteractionGroups();
+    for (int c = 0; c < static_cast<int>(group_of.size()); ++c) by_group[group_of[c]].push_back(c);
+    if (by_group.size() < 2) return;
+    for (auto& [representative, comps] : by_group) {
+      auto alone = std::make_unique<System>(system.Restricted(comps));
+      std::vector<int> read_alone;  // the slots of `read` the group has, in its own numbering
+      for (const int s : read) {
+        if (const auto found = alone->symbols().Find(system.symbols()[s].name)) {
+          read_alone.push_back(*found);
+        }
+      }
+      PolyhedralReachability::Options quiet = options;  // no progress report, no pause
+      quiet.progress = nullptr;
+      quiet.pause = nullptr;
+      explorers_.push_back(std::make_unique<Explorer>(*alone, std::vector<Goal>{}, std::nullopt,
+                                                      read_alone, quiet, meter));
+      alone_.push_back(std::move(alone));
+      components_.push_back(std::move(comps));
     }
   }
-  Explorer explorer(alone, {}, std::nullopt, read_alone, options, meter);
+
+  bool active() const { return !explorers_.empty() && !done_; }
+  void Stop() { done_ = true; }
+  long long states() const {
+    long long n = 0;
+    for (const auto& e : explorers_) n += e->states();
+    return n;
+  }
+
+  // Explores the groups on within the meter's slice; then, once every group is complete, asks
+  // the product about each goal of `exact` still open and decides those it proves. Returns once
+  // the slice is used (to be called again) or every goal has its answer from the product.
+  void Turn(Explorer& exact, const std::vector<Property>& properties,
+            const std::vector<int>& which) {
+    started_.resize(explorers_.size(), false);
+    for (std::size_t k = 0; k < explorers_.size(); ++k) {
+      if (!started_[k]) explorers_[k]->Start();
+      started_[k] = true;
+      if (explorers_[k]->complete()) continue;
+      if (explorers_[k]->Resume() != PolyhedralReachability::Usage::Stop::kNone) {
+        return;  // a bound: the next turn goes on
+      }
+    }
+    if (!product_) product_ = std::make_unique<GroupProduct>(full_, Groups(), meter_);
+    settled_.resize(which.size(), false);
+    for (std::size_t g = 0; g < which.size(); ++g) {
+      if (settled_[g] || exact.decided(static_cast<int>(g))) continue;
+      const std::optional<bool> meets = product_->Meets(properties[which[g]]);
+      if (!meets) return;  // past the slice: asked again next turn
+      settled_[g] = true;
+      if (*meets) continue;
+      std::ostringstream reason;
+      reason << "fixpoint of exact polyhedral reachability of each of its " << explorers_.size()
+             << " interaction groups alone (" << states()
+             << " symbolic states in all), whose product misses the property's states";
+      exact.Holds(static_cast<int>(g), reason.str());
+    }
+    done_ = true;
+  }
+
+ private:
+  // Each group's reachable states, in the dimensions of the whole system.
+  std::vector<GroupProduct::Group> Groups() {
+    std::vector<GroupProduct::Group> out;
+    const std::vector<std::string>& names = full_.names();
+    for (std::size_t k = 0; k < explorers_.size(); ++k) {
+      std::vector<int> to;  // each dimension of the group's view in the whole system's (by name)
+      for (const std::string& name : explorers_[k]->lhs().names()) {
+        to.push_back(static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin()));
+      }
+      GroupProduct::Group group{components_[k], {}};
+      for (const auto& [tuple, sets] : explorers_[k]->Found()) {
+        std::vector<ConvexPolyhedron>& here = group.states[tuple];
+        for (const ConvexPolyhedron* set : sets) {
+          here.push_back(set->Embedded(full_.dims(), to));
+          meter_.Op(here.back());
+        }
+      }
+      out.push_back(std::move(group));
+    }
+    return out;
+  }
+
+  const System& system_;
+  LinearHybridSystem full_;
+  Meter& meter_;
+  std::vector<std::unique_ptr<System>> alone_;
+  std::vector<std::vector<int>> components_;
+  std::vector<std::unique_ptr<Explorer>> explorers_;
+  std::unique_ptr<GroupProduct> product_;
+  std::vector<bool> settled_;  // per goal: the product has answered
+  std::vector<bool> started_;  // per group: its initial states pushed
+  bool done_ = false;
+};
+
+// Explores `system` for properties `which` (all with `horizon`); writes their results and returns
+// why the exploration stopped early (kNone if it did not).
+PolyhedralReachability::Usage::Stop ExploreBounded(const System& system,
+                                                   const std::vector<Property>& properties,
+                                                   const std::vector<int>& which, double horizon,
+                                                   std::vector<CheckResult>& results,
+                                                   const PolyhedralReachability::Options& options,
+                                                   Meter& meter,
+                                                   PolyhedralReachability::Usage& used) {
+  std::vector<const Property*> observed;
+  std::vector<Goal> goals;
+  for (const int i : which) {
+    observed.push_back(&properties[i]);
+    goals.push_back({&properties[i], &results[i], false, false, ""});
+  }
+  Explorer explorer(system, std::move(goals), horizon, LinearHybridSystem::ReadSlots(observed),
+                    options, meter);
   const PolyhedralReachability::Usage::Stop stop = explorer.Run();
   used.states += explorer.states();
-  if (stop != PolyhedralReachability::Usage::Stop::kNone) return std::nullopt;
-  std::vector<int> to;  // each dimension of the group's view in `full` (by name)
-  const std::vector<std::string>& names = full.names();
-  for (const std::string& name : explorer.lhs().names()) {
-    to.push_back(static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin()));
-  }
-  GroupProduct::Group group{std::move(comps), {}};
-  for (const auto& [tuple, sets] : explorer.Found()) {
-    std::vector<ConvexPolyhedron>& here = group.states[tuple];
-    for (const ConvexPolyhedron* set : sets) {
-      here.push_back(set->Embedded(full.dims(), to));
-      meter.Op(here.back());
-    }
-  }
-  return group;
+  return stop;
 }
 
-// Proves what it can of properties `which` (none with a horizon) on the product of the
-// interaction groups of `system` explored alone (GroupProduct), within a share of the budget
-// (1 / kGroupShareDivisor of what is left); writes the verdicts of those it proves and returns
-// the others. Where the system is one group, returns `which` at once.
-std::vector<int> ProveOnGroups(const System& system, const std::vector<Property>& properties,
-                               std::vector<int> which, std::vector<CheckResult>& results,
-                               const PolyhedralReachability::Options& options, Meter& meter,
-                               PolyhedralReachability::Usage& used) {
-  std::map<int, std::vector<int>> by_group;
-  const std::vector<int> group_of = system.InteractionGroups();
-  for (int c = 0; c < static_cast<int>(group_of.size()); ++c) by_group[group_of[c]].push_back(c);
-  if (by_group.size() < 2 || which.empty()) return which;
-  std::vector<const Property*> observed;
-  for (const int i : which) observed.push_back(&properties[i]);
-  const std::vector<int> read = LinearHybridSystem::ReadSlots(observed);
-  LinearHybridSystem full(system, false, read);
-  meter.ShareAmong(kGroupShareDivisor);
-  const long long states_before = used.states;
-  std::vector<GroupProduct::Group> groups;
-  for (auto& [representative, comps] : by_group) {
-    std::optional<GroupProduct::Group> g =
-        ExploreGroup(system, comps, read, full, options, meter, used);
-    if (!g) return which;
-    groups.push_back(std::move(*g));
-  }
-  std::ostringstream reason;
-  reason << "fixpoint of exact polyhedral reachability of each of its " << groups.size()
-         << " interaction groups alone (" << used.states - states_before
-         << " symbolic states in all), whose product misses the property's states";
-  GroupProduct product(full, std::move(groups), meter);
+// The pause of Options::pause: the goals of `exact` still open go to `options.pause`, and each
+// definite result it returns decides its goal.
+void Pause(const System& system, Explorer& exact, const PolyhedralReachability::Options& options) {
   std::vector<int> open;
-  for (const int i : which) {
-    if (product.Meets(properties[i]) != false) {
-      open.push_back(i);
-      continue;
-    }
-    results[i].verdict =
-        properties[i].kind == Property::Kind::kReach ? Verdict::kUnreachable : Verdict::kProved;
-    results[i].reason = reason.str();
+  std::vector<Property> asked;
+  for (int g = 0; g < exact.num_goals(); ++g) {
+    if (exact.decided(g)) continue;
+    open.push_back(g);
+    asked.push_back(exact.property(g));
   }
-  return open;
+  if (open.empty()) return;
+  std::vector<CheckResult> answers = options.pause(system, asked);
+  for (std::size_t k = 0; k < open.size() && k < answers.size(); ++k) {
+    if (answers[k].verdict != Verdict::kUnknown) exact.Decide(open[k], std::move(answers[k]));
+  }
+}
+
+// Explores `system` for properties `which` (none with a horizon), taking turns with the
+// interaction groups explored alone (GroupTurns) where it has several; writes their results and
+// returns why the exploration stopped early (kNone if it did not).
+PolyhedralReachability::Usage::Stop ExploreUnbounded(
+    const System& system, const std::vector<Property>& properties, const std::vector<int>& which,
+    std::vector<CheckResult>& results, const PolyhedralReachability::Options& options, Meter& meter,
+    PolyhedralReachability::Usage& used) {
+  using Stop = PolyhedralReachability::Usage::Stop;
+  std::vector<const Property*> observed;
+  std::vector<Goal> goals;
+  for (const int i : which) {
+    observed.push_back(&properties[i]);
+    goals.push_back({&properties[i], &results[i], false, false, ""});
+  }
+  const std::vector<int> read = LinearHybridSystem::ReadSlots(observed);
+  Explorer exact(system, std::move(goals), std::nullopt, read, options, meter);
+  std::optional<GroupTurns> groups;
+  try {
+    groups.emplace(system, read, options, meter);
+  } catch (const std::invalid_argument&) {
+    // A group outside the class: the exact exploration alone says why.
+  }
+  exact.Start();
+  const std::uint64_t pause_at = meter.used() + options.pause_units;
+  bool paused = !options.pause;
+  if (options.group_turn_units == 0 && groups && groups->active()) {  // the groups first
+    meter.ClearSlice();
+    try {
+      groups->Turn(exact, properties, which);
+    } catch (const std::invalid_argument&) {
+      groups->Stop();
+    }
+  }
+  std::uint64_t slice = std::max<std::uint64_t>(options.group_turn_units, 1);
+  std::uint64_t next_turn = meter.used() + slice;
+  Stop stop = Stop::kNone;
+  while (true) {
+    // Explore up to the next group turn or the pause, whichever comes first.
+    const bool turns = groups && groups->active();
+    std::uint64_t until = turns ? next_turn : UINT64_MAX;
+    if (!paused) until = std::min(until, pause_at);
+    if (until == UINT64_MAX) {
+      meter.ClearSlice();
+    } else {
+      meter.SetSlice(until - std::min(until, meter.used()));
+    }
+    stop = exact.Resume();
+    if (stop != Stop::kBudget || meter.ShareExhausted() || until == UINT64_MAX) break;
+    if (!paused && meter.used() >= pause_at) {
+      paused = true;
+      meter.ClearSlice();
+      Pause(system, exact, options);
+    }
+    if (turns && meter.used() >= next_turn) {
+      meter.SetSlice(std::max<std::uint64_t>(slice / kGroupTurnDivisor, 1));
+      try {
+        groups->Turn(exact, properties, which);
+      } catch (const std::invalid_argument&) {
+        groups->Stop();
+      }
+      slice *= 2;
+      next_turn = meter.used() + slice;
+    }
+    if (exact.AllDecided()) {
+      stop = Stop::kNone;
+      break;
+    }
+  }
+  meter.ClearSlice();
+  exact.Finish(stop);
+  used.states += exact.states() + (groups ? groups->states() : 0);
+  return stop;
 }
 
 }  // namespace
@@ -798,27 +983,14 @@ std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
           std::llround(options_.budget * static_cast<double>(kReachUnitsPerBudgetSecond))),
       options_.cpu_seconds > 0 ? options_.cpu_seconds : std::max(60.0, 10.0 * options_.budget));
   Usage used;
-  if (auto unbounded = by_horizon.find(std::nullopt); unbounded != by_horizon.end()) {
-    try {
-      unbounded->second =
-          ProveOnGroups(system, properties, unbounded->second, results, options_, meter, used);
-    } catch (const std::invalid_argument&) {
-      // Not linear: the exploration below says why.
-    }
-    if (unbounded->second.empty()) by_horizon.erase(unbounded);
-  }
   int parts = static_cast<int>(by_horizon.size());
   for (const auto& [horizon, which] : by_horizon) {
-    std::vector<const Property*> observed;
-    for (const int i : which) observed.push_back(&properties[i]);
-    std::vector<Goal> goals;
-    for (const int i : which) goals.push_back({&properties[i], &results[i], false, false, ""});
     meter.ShareAmong(parts--);
     try {
-      Explorer explorer(system, std::move(goals), horizon, LinearHybridSystem::ReadSlots(observed),
-                        options_, meter);
-      const Usage::Stop stop = explorer.Run();
-      used.states += explorer.states();
+      const Usage::Stop stop =
+          horizon
+              ? ExploreBounded(system, properties, which, *horizon, results, options_, meter, used)
+              : ExploreUnbounded(system, properties, which, results, options_, meter, used);
       used.stop = std::max(used.stop, stop);  // the enumerators are in that order
     } catch (const std::invalid_argument& e) {
       for (const int i : which) {

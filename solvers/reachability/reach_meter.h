@@ -46,8 +46,18 @@ class ReachMeter {
     share_ = (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
     limit_ = used_ + share_;
   }
-  /// Whether the current exploration has used its share.
-  bool Exhausted() const { return used_ >= limit_; }
+  /// Whether the current exploration has used its share (or its slice, if one is set).
+  bool Exhausted() const { return used_ >= std::min(limit_, slice_limit_); }
+  /// Whether the current exploration has used its share, whatever the slice.
+  bool ShareExhausted() const { return used_ >= limit_; }
+  /// Lets the work that follows use at most `units` more (within the share): explorations that
+  /// take turns (PolyhedralReachability's exact exploration and the interaction groups') stop at
+  /// the end of their slice and resume later.
+  void SetSlice(std::uint64_t units) {
+    slice_limit_ = units > limit_ - std::min(used_, limit_) ? limit_ : used_ + units;
+  }
+  /// Removes the slice: the share alone bounds the work.
+  void ClearSlice() { slice_limit_ = UINT64_MAX; }
   /// Whether the CPU-time safety net has passed (the thread's time since the Check began).
   bool OutOfTime() const { return ThreadCpuSeconds() - start_ > cpu_seconds_; }
 
@@ -60,6 +70,7 @@ class ReachMeter {
   std::uint64_t total_;
   std::uint64_t share_ = total_;
   std::uint64_t limit_;
+  std::uint64_t slice_limit_ = UINT64_MAX;
   std::uint64_t used_ = 0;
   double cpu_seconds_;
   double start_;  // thread CPU time at the start of the Check

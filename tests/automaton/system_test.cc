@@ -928,5 +928,23 @@ TEST(System, ADeclaredLabelIsInTheAlphabetAndBlocksPartners) {
   EXPECT_EQ(s.Product().num_transitions(), 0);
 }
 
+TEST(System, InteractionGroupsJoinSharedVariablesAndLabelsNotInputsOrParameters) {
+  const Automaton clock = Parse(
+      "automaton clock { var x; input u in [0, 1]; param p = 1; mode a { x' = u + p; } "
+      "mode b { } transition a -> b { guard x >= 1; label go; } init a { x = 0; } }");
+  const Automaton reader = Parse(
+      "automaton reader { var y; mode r { } transition r -> r { guard y >= 2; } "
+      "init r { y = 0; } }");
+  System s("s");
+  s.Share("u");
+  s.Share("p");
+  s.AddComponent("A", clock);
+  s.AddComponent("B", clock, {{"go", "A.go"}});  // synchronised with A
+  s.AddComponent("C", clock);                    // meets them only through u and p
+  s.AddComponent("D", reader, {{"y", "C.x"}});   // reads C's variable
+  s.AddComponent("E", clock);
+  EXPECT_EQ(s.InteractionGroups(), (std::vector<int>{0, 0, 2, 2, 4}));
+}
+
 }  // namespace
 }  // namespace hybrid

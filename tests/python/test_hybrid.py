@@ -331,10 +331,10 @@ OSCILLATOR = """automaton osc {
 }
 """
 
-# Long calls: each runs for tens of seconds when not interrupted (nav4's exact reachability about
+# Long calls: each runs for tens of seconds when not interrupted (disc_3's exact reachability about
 # a minute, docs/benchmarks_lha.md).
 LONG_CALLS = {
-    "check": ("nav4", "model.check(method='reach')"),
+    "check": ("disc_3", "model.check(method='reach')"),
     "simulate": ("oscillator", "model.simulate(until=1000.0, sample=1.0)"),
 }
 
@@ -348,7 +348,7 @@ def test_ctrl_c_stops_a_long_call_at_once(tmp_path, call):
         path = tmp_path / "osc.ha"
         path.write_text(OSCILLATOR)
     else:
-        path = os.path.join(SOURCE, "spec", "benchmarks", "nav4.ha")
+        path = os.path.join(SOURCE, "spec", "benchmarks", which + ".ha")
     script = (
         "import sys, time, hybrid\n"
         "model = hybrid.load(sys.argv[1])\n"

@@ -79,6 +79,25 @@ class PolyhedralReachability {
     /// If set, called every 64 expanded states with the symbolic states found so far and those
     /// still queued (for a progress report; it must not throw).
     std::function<void(int states, int queued)> progress;
+    /// For properties without a horizon on a System of several interaction groups
+    /// (System::InteractionGroups): the reach units the exact exploration uses before the
+    /// groups, each explored alone, take their first turn (1/32 of that); each later turn of
+    /// both doubles. Once every group is complete, a property whose bad states the product of
+    /// their reachable sets misses holds (GroupProduct: solvers/reachability/group_product.h).
+    /// So the groups cost at most 1/32 of the exact exploration's work. 0: the groups take
+    /// their turn first, to their fixpoint (or the budget).
+    std::uint64_t group_turn_units = 1'000'000;
+    /// Another engine's turn (say, a cheap proof by induction), taken once the exploration of
+    /// the properties without a horizon has used `pause_units` reach units without deciding all
+    /// of them: `pause` is called once with the system and the properties still open (over its
+    /// slots) and returns one result
+    /// each (same order); a definite one (which must keep the PropertyChecker contract: a
+    /// `violated` or `reachable` verdict with its replayed trace) becomes that property's result
+    /// and the exploration stops seeking it; then it goes on where it was. An exploration that
+    /// ends first never pauses. Not set: no pause.
+    std::function<std::vector<CheckResult>(const System& system, const std::vector<Property>& open)>
+        pause;
+    std::uint64_t pause_units = 0;
   };
 
   /// What one Check spent, and why its explorations ended (for reports such as `check --json`).

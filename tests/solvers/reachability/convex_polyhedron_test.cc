@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -227,6 +228,34 @@ TEST(ConvexPolyhedron, RepresentationBytesGrowWithTheRepresentation) {
   const ConvexPolyhedron copy = a;
   EXPECT_LE(copy.RepresentationBytes(), a.RepresentationBytes());
   EXPECT_GT(copy.RepresentationBytes(), square.RepresentationBytes());
+}
+
+TEST(ConvexPolyhedron, EmbeddedPlacesEachDimensionAndLeavesTheOthersFree) {
+  // {(a, b) : a = 1, 0 <= b <= 2} placed as dimensions 3 and 1 of R^4.
+  ConvexPolyhedron p = ConvexPolyhedron::Universe(2);
+  p.AddConstraint({{1, 0}, -1, LinearConstraint::Kind::kEqual});
+  p.AddConstraint({{0, -1}, 0, LinearConstraint::Kind::kLessEqual});
+  p.AddConstraint({{0, 1}, -2, LinearConstraint::Kind::kLessEqual});
+  const std::vector<int> to = {3, 1};
+  const ConvexPolyhedron e = p.Embedded(4, to);
+  EXPECT_EQ(e.dims(), 4);
+  const double inside[] = {5, 1.5, -7, 1};
+  const double wrong_b[] = {0, 3, 0, 1};
+  const double wrong_a[] = {0, 1.5, 0, 2};
+  EXPECT_TRUE(e.Contains(ConvexPolyhedron::Point(inside)));
+  EXPECT_FALSE(e.Contains(ConvexPolyhedron::Point(wrong_b)));
+  EXPECT_FALSE(e.Contains(ConvexPolyhedron::Point(wrong_a)));
+  const auto bounds = e.Bounds();
+  EXPECT_EQ(bounds[0].first, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(bounds[1], std::make_pair(0.0, 2.0));
+  EXPECT_EQ(bounds[3], std::make_pair(1.0, 1.0));
+  const std::vector<int> twice = {1, 1};
+  const std::vector<int> short_map = {1};
+  const std::vector<int> outside = {0, 4};
+  EXPECT_THROW(p.Embedded(4, twice), std::invalid_argument);
+  EXPECT_THROW(p.Embedded(4, short_map), std::invalid_argument);
+  EXPECT_THROW(p.Embedded(4, outside), std::invalid_argument);
+  EXPECT_THROW(p.Embedded(1, to), std::invalid_argument);
 }
 
 }  // namespace

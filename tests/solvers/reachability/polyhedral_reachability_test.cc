@@ -362,6 +362,53 @@ TEST(PolyhedralReachability, NonConvergingOneModeModelsStopAtTheDeterministicBud
   }
 }
 
+// Options::pause: one turn of another engine once the exploration has used pause_units, whose
+// definite answers decide their properties; an exploration that ends first never pauses.
+TEST(PolyhedralReachability, PausesOnceForAnotherEnginesTurnAndTakesItsDefiniteAnswers) {
+  const System ramp = Parse(kRampModel);  // never converges: the pause comes
+  for (const Verdict answer : {Verdict::kProved, Verdict::kUnknown}) {
+    PolyhedralReachability::Options options = Budget(0.02);
+    options.pause_units = 100'000;
+    int calls = 0;
+    options.pause = [&](const System& system, const std::vector<Property>& open) {
+      ++calls;
+      EXPECT_EQ(&system, &ramp);
+      EXPECT_EQ(open.size(), 1u);
+      CheckResult r;
+      r.property = open.at(0).name;
+      r.kind = open.at(0).kind;
+      r.method = "other";
+      r.verdict = answer;
+      r.reason = "the other engine's answer";
+      return std::vector<CheckResult>{r};
+    };
+    const Outcome out = CheckWithin(ramp, "y_nonnegative", options);
+    EXPECT_EQ(calls, 1);
+    EXPECT_EQ(out.result.verdict, answer) << out.result.reason;
+    if (answer == Verdict::kProved) {  // decided: the exploration stops there
+      EXPECT_EQ(out.result.method, "other");
+      EXPECT_EQ(out.result.reason, "the other engine's answer");
+      EXPECT_LT(out.usage.units_used, out.usage.units_total);
+      EXPECT_GE(out.usage.units_used, options.pause_units);
+    } else {  // not decided: it goes on to its budget
+      EXPECT_EQ(out.result.method, "reach");
+      EXPECT_NE(out.result.reason.find("stopped by its deterministic budget"), std::string::npos)
+          << out.result.reason;
+      EXPECT_GE(out.usage.units_used, out.usage.units_total);
+    }
+  }
+  const System limited = Parse(kLimitedModel);  // a fixpoint long before the pause
+  PolyhedralReachability::Options options;
+  options.pause_units = 100'000'000;
+  int calls = 0;
+  options.pause = [&](const System&, const std::vector<Property>&) {
+    ++calls;
+    return std::vector<CheckResult>{};
+  };
+  EXPECT_EQ(CheckWithin(limited, "below_5", options).result.verdict, Verdict::kProved);
+  EXPECT_EQ(calls, 0);
+}
+
 // Runs `check` while `threads` other threads burn CPU (none: unloaded).
 template <typename F>
 auto UnderLoad(int threads, F check) {

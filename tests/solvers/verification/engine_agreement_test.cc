@@ -227,18 +227,18 @@ struct Summary {
   std::map<std::string, std::map<std::string, int>> verdicts;  // engine -> verdict -> count
   std::map<std::string, double> seconds;                       // engine -> seconds
   int reach_outside_class = 0;  // properties reach left unknown as not linear
-  int group_product = 0;  // reach's verdicts on the product of interaction groups (GroupProduct)
-  int sample_refused = 0;       // properties of models whose every sampled run was rejected
-  int claims = 0;               // proved / unreachable verdicts (per property) attacked
-  long attacks = 0;             // simulations run against claims
-  long rejected = 0;            // attacks the model refused (initial state outside its invariant)
-  long states = 0;              // recorded states checked against claims
-  long outside = 0;             // attacks cut at a state outside its modes' invariants
-  int replays = 0;              // traces confirmed by ReplayTrace
-  int text_replays = 0;         // traces confirmed from model text by the test's evaluator
-  int boundary_witnesses = 0;   // of which `reach` witnesses only within the tolerance
-  int off_tie = 0;              // prove's traces replayed with parameters moved off a tie
-  int joint_unreachable = 0;    // prove's `unreachable` together with other targets only
+  int group_product = 0;   // reach's verdicts on the product of interaction groups (GroupProduct)
+  int sample_refused = 0;  // properties of models whose every sampled run was rejected
+  int claims = 0;          // proved / unreachable verdicts (per property) attacked
+  long attacks = 0;        // simulations run against claims
+  long rejected = 0;       // attacks the model refused (initial state outside its invariant)
+  long states = 0;         // recorded states checked against claims
+  long outside = 0;        // attacks cut at a state outside its modes' invariants
+  int replays = 0;         // traces confirmed by ReplayTrace
+  int text_replays = 0;    // traces confirmed from model text by the test's evaluator
+  int boundary_witnesses = 0;      // of which `reach` witnesses only within the tolerance
+  int off_tie = 0;                 // prove's traces replayed with parameters moved off a tie
+  int joint_unreachable = 0;       // prove's `unreachable` together with other targets only
   int boundary_disagreements = 0;  // disagreements whose witnesses are all such
   int agreements = 0;              // properties with definite verdicts of two engines that agree
   std::vector<std::string> contradictions;
