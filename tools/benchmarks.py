@@ -58,13 +58,13 @@ EXPECTED = os.path.join(BENCHMARKS, "expected.tsv")
 # The quick subset (--quick): models whose every verdict is decided and as expected today
 # (docs/benchmarks_lha.md), about 10 s together on this 2-core machine under load (fischer_5.ha
 # and tte_5.ha take most of it). The test BenchmarksTest.QuickSubsetIsDecidedAsExpected runs
-# `--quick --require-all`, so only fully decided models belong here. Left out: the models with
-# an unknown verdict (nav4, fischer_6) and the decided but slow ones (fiscs05, tte_7, disc_3:
-# 13 to 100 s each).
+# `--quick --require-all`, so only fully decided models belong here. Left out: the model with
+# an unknown verdict (fischer_6) and the decided but slow ones (fiscs05, tte_7: 9 to 30 s each).
 QUICK = [
     "water_tank.ha",
     "nav2.ha",
     "nav3.ha",
+    "nav4.ha",
     "fischer_2.ha",
     "fischer_2_unsafe.ha",
     "fischer_3.ha",
@@ -76,6 +76,7 @@ QUICK = [
     "fiscu04.ha",
     "tte_5.ha",
     "disc_2.ha",
+    "disc_3.ha",
 ]
 
 DECIDED = {"proved", "violated", "reachable", "unreachable"}
