@@ -261,8 +261,6 @@ class Explorer {
 
   // Symbolic states stored.
   long long states() const { return static_cast<long long>(nodes_.size()); }
-  // Locations built.
-  int locations() const { return lhs_.num_locations(); }
   const LinearHybridSystem& lhs() const { return lhs_; }
   // The states found, by location: those no later state at their location contains (after a
   // complete Run, their union is the reachable set).
@@ -725,11 +723,12 @@ class GroupTurns {
   // `read`: the System slots the properties read (live in every group).
   GroupTurns(const System& system, const std::vector<int>& read,
              const PolyhedralReachability::Options& options, Meter& meter)
-      : system_(system), full_(system, false, read), meter_(meter) {
+      : meter_(meter) {
     std::map<int, std::vector<int>> by_group;
     const std::vector<int> group_of = system.InteractionGroups();
     for (int c = 0; c < static_cast<int>(group_of.size()); ++c) by_group[group_of[c]].push_back(c);
     if (by_group.size() < 2) return;
+    full_ = std::make_unique<LinearHybridSystem>(system, false, read);
     for (auto& [representative, comps] : by_group) {
       auto alone = std::make_unique<System>(system.Restricted(comps));
       std::vector<int> read_alone;  // the slots of `read` the group has, in its own numbering
@@ -770,7 +769,7 @@ class GroupTurns {
         return;  // a bound: the next turn goes on
       }
     }
-    if (!product_) product_ = std::make_unique<GroupProduct>(full_, Groups(), meter_);
+    if (!product_) product_ = std::make_unique<GroupProduct>(*full_, Groups(), meter_);
     settled_.resize(which.size(), false);
     for (std::size_t g = 0; g < which.size(); ++g) {
       if (settled_[g] || exact.decided(static_cast<int>(g))) continue;
@@ -791,7 +790,7 @@ class GroupTurns {
   // Each group's reachable states, in the dimensions of the whole system.
   std::vector<GroupProduct::Group> Groups() {
     std::vector<GroupProduct::Group> out;
-    const std::vector<std::string>& names = full_.names();
+    const std::vector<std::string>& names = full_->names();
     for (std::size_t k = 0; k < explorers_.size(); ++k) {
       std::vector<int> to;  // each dimension of the group's view in the whole system's (by name)
       for (const std::string& name : explorers_[k]->lhs().names()) {
@@ -801,7 +800,7 @@ class GroupTurns {
       for (const auto& [tuple, sets] : explorers_[k]->Found()) {
         std::vector<ConvexPolyhedron>& here = group.states[tuple];
         for (const ConvexPolyhedron* set : sets) {
-          here.push_back(set->Embedded(full_.dims(), to));
+          here.push_back(set->Embedded(full_->dims(), to));
           meter_.Op(here.back());
         }
       }
@@ -810,8 +809,7 @@ class GroupTurns {
     return out;
   }
 
-  const System& system_;
-  LinearHybridSystem full_;
+  std::unique_ptr<LinearHybridSystem> full_;  // the whole system's view (several groups only)
   Meter& meter_;
   std::vector<std::unique_ptr<System>> alone_;
   std::vector<std::vector<int>> components_;
