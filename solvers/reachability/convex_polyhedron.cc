@@ -303,26 +303,6 @@ void ConvexPolyhedron::KeepDimensions(int dims) {
   impl_->p.remove_higher_space_dimensions(static_cast<ppl::dimension_type>(dims));
 }
 
-namespace {
-
-// A permutation of the dimensions as PPL's map_space_dimensions reads it.
-class DimensionPermutation {
- public:
-  explicit DimensionPermutation(std::vector<ppl::dimension_type> to) : to_(std::move(to)) {}
-  bool has_empty_codomain() const { return to_.empty(); }
-  ppl::dimension_type max_in_codomain() const { return to_.size() - 1; }
-  bool maps(ppl::dimension_type i, ppl::dimension_type& j) const {
-    if (i >= to_.size()) return false;
-    j = to_[i];
-    return true;
-  }
-
- private:
-  std::vector<ppl::dimension_type> to_;
-};
-
-}  // namespace
-
 ConvexPolyhedron ConvexPolyhedron::Embedded(int dims, std::span<const int> to) const {
   const auto n = static_cast<std::size_t>(this->dims());
   if (to.size() != n || dims < this->dims()) {
@@ -330,7 +310,8 @@ ConvexPolyhedron ConvexPolyhedron::Embedded(int dims, std::span<const int> to) c
   }
   // Dimensions n .. dims-1 (added unconstrained) take the targets `to` leaves free, in order.
   std::vector<bool> taken(static_cast<std::size_t>(dims), false);
-  std::vector<ppl::dimension_type> perm;
+  Permutation permutation;
+  std::vector<ppl::dimension_type>& perm = permutation.to;
   for (const int t : to) {
     if (t < 0 || t >= dims || taken[static_cast<std::size_t>(t)]) {
       throw std::invalid_argument("an embedding needs distinct targets within the space");
@@ -343,7 +324,7 @@ ConvexPolyhedron ConvexPolyhedron::Embedded(int dims, std::span<const int> to) c
   }
   auto impl = std::make_unique<Impl>(*impl_);
   impl->p.add_space_dimensions_and_embed(static_cast<ppl::dimension_type>(dims) - n);
-  impl->p.map_space_dimensions(DimensionPermutation(std::move(perm)));
+  impl->p.map_space_dimensions(permutation);
   return ConvexPolyhedron(std::move(impl));
 }
 
