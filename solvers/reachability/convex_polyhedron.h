@@ -27,9 +27,12 @@ struct AffineMap {
 };
 
 /// A convex polyhedron of R^n with exact rational arithmetic, closed or not (strict
-/// inequalities are kept strict): the Parma Polyhedra Library's NNC_Polyhedron behind a value
-/// type (its handles never leave convex_polyhedron.cc). Operations are the exact set operations
-/// named; none approximates except Widen.
+/// inequalities are kept strict): the Parma Polyhedra Library's C_Polyhedron while every
+/// constraint it was given is non-strict, its NNC_Polyhedron from the first strict one (or from
+/// an operation with a polyhedron that is one; the conversion is exact), behind a value type (its
+/// handles never leave convex_polyhedron.cc). The kind changes the cost only (a closed polyhedron
+/// has no epsilon dimension), never the set. Operations are the exact set operations named; none
+/// approximates except Widen.
 class ConvexPolyhedron {
  public:
   /// R^dims (dims >= 0).

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -256,6 +257,85 @@ TEST(ConvexPolyhedron, EmbeddedPlacesEachDimensionAndLeavesTheOthersFree) {
   EXPECT_THROW(p.Embedded(4, short_map), std::invalid_argument);
   EXPECT_THROW(p.Embedded(4, outside), std::invalid_argument);
   EXPECT_THROW(p.Embedded(1, to), std::invalid_argument);
+}
+
+// The same set made a closed polyhedron (non-strict constraints only) and a not necessarily
+// closed one (the same constraints and a strict one that cuts nothing: x < 100, all sets here lie
+// in [-10, 10]^2) gives the same results under every operation, in either order of operands:
+// the kind (convex_polyhedron.h) changes the cost only. Random sets of a box and a diagonal cut,
+// rates and resets; results compared as sets, by their bounds and on a grid of points.
+TEST(ConvexPolyhedron, ClosedAndNotNecessarilyClosedGiveTheSameSets) {
+  std::mt19937_64 rng(20261129);
+  const auto number = [&rng](int lo, int hi) {  // an integer in [lo, hi], halved
+    return static_cast<double>(lo + static_cast<int>(rng() % static_cast<unsigned>(hi - lo + 1))) /
+           2.0;
+  };
+  const auto random_set = [&]() {
+    const double x0 = number(-8, 4), y0 = number(-8, 4);
+    ConvexPolyhedron p = Box(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
+    p.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), Kind::kLessEqual});
+    return p;
+  };
+  const auto as_nnc = [](ConvexPolyhedron p) {
+    p.AddConstraint({{1, 0}, -100, Kind::kLess});  // x < 100: cuts nothing here
+    return p;
+  };
+  const auto same = [](const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
+    if (!SameSet(a, b) || a.Bounds() != b.Bounds() || a.IsEmpty() != b.IsEmpty()) return false;
+    for (double x = -10; x <= 10; x += 0.75) {
+      for (double y = -10; y <= 10; y += 0.75) {
+        if (Holds(a, x, y) != Holds(b, x, y)) return false;
+      }
+    }
+    return true;
+  };
+  const std::vector<std::pair<int, AffineMap>> swap = {{0, {{0, 1}, 0.5}}, {1, {{1, 0}, 0}}};
+  const std::vector<std::pair<int, AffineMap>> shift = {{0, {{1, 0}, 1.5}}};
+  for (int round = 0; round < 60; ++round) {
+    const ConvexPolyhedron p = random_set(), q = random_set();
+    ConvexPolyhedron rates = random_set();
+    const ConvexPolyhedron pn = as_nnc(p), qn = as_nnc(q);
+    ASSERT_TRUE(same(p, pn)) << round;
+    for (const ConvexPolyhedron* a : {&p, &pn}) {
+      for (const ConvexPolyhedron* b : {&q, &qn}) {
+        EXPECT_EQ(a->Contains(*b), p.Contains(q)) << round;
+        EXPECT_EQ(a->Intersects(*b), p.Intersects(q)) << round;
+        ConvexPolyhedron meet = *a, hull = *a, elapse = *a, back = *a;
+        meet.Intersect(*b);
+        ConvexPolyhedron expected_meet = p;
+        expected_meet.Intersect(q);
+        EXPECT_TRUE(same(meet, expected_meet)) << round;
+        hull.Hull(*b);
+        ConvexPolyhedron expected_hull = p;
+        expected_hull.Hull(q);
+        EXPECT_TRUE(same(hull, expected_hull)) << round;
+        elapse.TimeElapse(*b);
+        back.TimeElapseBackward(*b);
+        ConvexPolyhedron expected_elapse = p, expected_back = p;
+        expected_elapse.TimeElapse(q);
+        expected_back.TimeElapseBackward(q);
+        EXPECT_TRUE(SameSet(elapse, expected_elapse)) << round;
+        EXPECT_TRUE(SameSet(back, expected_back)) << round;
+      }
+    }
+    ConvexPolyhedron a = p, b = pn;
+    a.Assign(swap);
+    b.Assign(swap);
+    EXPECT_TRUE(same(a, b)) << round;
+    a.AssignPreimage(shift);
+    b.AssignPreimage(shift);
+    EXPECT_TRUE(same(a, b)) << round;
+    a.Unconstrain(1);
+    b.Unconstrain(1);
+    EXPECT_TRUE(SameSet(a, b)) << round;
+    const std::vector<double> objective = {1, -2};
+    bool attained_a = false, attained_b = false;
+    EXPECT_EQ(p.Supremum(objective, &attained_a), pn.Supremum(objective, &attained_b)) << round;
+    EXPECT_EQ(attained_a, attained_b) << round;
+    const std::vector<int> to = {2, 0};
+    EXPECT_TRUE(SameSet(p.Embedded(3, to), pn.Embedded(3, to))) << round;
+    if (!p.IsEmpty()) EXPECT_TRUE(p.Contains(pn.CentralPoint())) << round;
+  }
 }
 
 }  // namespace
