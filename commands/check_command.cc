@@ -343,15 +343,14 @@ constexpr double kQuickProveBudget = 1.0;
 class QuickProveChecker : public PropertyChecker {
  public:
   QuickProveChecker(PropertyProver::Options options, SolverBudget& command_budget)
-      : budget_(std::min(kQuickProveBudget, command_budget.seconds())),
-        command_budget_(command_budget),
-        prove_(Quick(options), budget_) {}
+      : options_(Quick(options)), command_budget_(command_budget) {}
   std::string_view name() const override { return "prove"; }
+  // A budget of its own per call (its CPU-time safety net counted from there).
   std::vector<CheckResult> Check(const System& system,
                                  std::span<const Property> properties) override {
-    const std::uint64_t before = budget_.used();
-    std::vector<CheckResult> results = prove_.Check(system, properties);
-    command_budget_.Charge(budget_.used() - before);
+    SolverBudget budget(std::min(kQuickProveBudget, command_budget_.seconds()));
+    std::vector<CheckResult> results = ProveChecker(options_, budget).Check(system, properties);
+    command_budget_.Charge(budget.used());
     return results;
   }
 
@@ -361,9 +360,8 @@ class QuickProveChecker : public PropertyChecker {
     options.max_induction = 1;
     return options;
   }
-  SolverBudget budget_;
+  PropertyProver::Options options_;
   SolverBudget& command_budget_;
-  ProveChecker prove_;
 };
 
 // auto: reachability (pausing for the quick proof, see kAutoPauseBudget), then the flowpipe, the
@@ -373,7 +371,11 @@ std::unique_ptr<PropertyChecker> MakeAuto(MethodContext& c) {
   auto quick = std::make_shared<QuickProveChecker>(c.prove, *c.budget);
   reach.pause_units = static_cast<std::uint64_t>(kAutoPauseBudget * kReachUnitsPerBudgetSecond);
   reach.pause = [quick](const System& system, const std::vector<Property>& open) {
-    return quick->Check(system, open);
+    try {
+      return quick->Check(system, open);
+    } catch (const std::exception&) {  // no answer: the exploration goes on, and so does auto
+      return std::vector<CheckResult>{};
+    }
   };
   std::vector<std::unique_ptr<PropertyChecker>> checkers;
   checkers.push_back(std::make_unique<ReachChecker>(reach, c.usage));

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <ppl.hh>
 #include <stdexcept>
-#include <optional>
 #include <string>
 #include <variant>
 
@@ -283,7 +283,7 @@ bool ConvexPolyhedron::Contains(const ConvexPolyhedron& other) const {
 bool ConvexPolyhedron::Intersects(const ConvexPolyhedron& other) const {
   const Impl& self = *impl_;
   return Impl::Both(self, *other.impl_,
-              [](const auto& x, const auto& y) { return !x.is_disjoint_from(y); });
+                    [](const auto& x, const auto& y) { return !x.is_disjoint_from(y); });
 }
 
 void ConvexPolyhedron::TimeElapse(const ConvexPolyhedron& rates) {
@@ -374,15 +374,13 @@ void ConvexPolyhedron::Unconstrain(int d) {
 }
 
 void ConvexPolyhedron::AddDimensions(int count) {
-  impl_->Visit([&](auto& q) {
-    q.add_space_dimensions_and_embed(static_cast<ppl::dimension_type>(count));
-  });
+  impl_->Visit(
+      [&](auto& q) { q.add_space_dimensions_and_embed(static_cast<ppl::dimension_type>(count)); });
 }
 
 void ConvexPolyhedron::KeepDimensions(int dims) {
-  impl_->Visit([&](auto& q) {
-    q.remove_higher_space_dimensions(static_cast<ppl::dimension_type>(dims));
-  });
+  impl_->Visit(
+      [&](auto& q) { q.remove_higher_space_dimensions(static_cast<ppl::dimension_type>(dims)); });
 }
 
 ConvexPolyhedron ConvexPolyhedron::Embedded(int dims, std::span<const int> to) const {

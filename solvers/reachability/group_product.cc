@@ -77,6 +77,7 @@ std::optional<bool> GroupProduct::Meets(const Property& property) {
       }
       at.push_back(&it[j]->second);
     }
+    if (OverBound()) return std::nullopt;  // also where no tuple has bad states
     const int before = full_.num_locations();
     const LinearLocation& loc = full_.At(tuple);
     if (full_.num_locations() != before) meter_.Location();

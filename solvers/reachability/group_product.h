@@ -46,6 +46,9 @@ class GroupProduct {
   /// the meter; nullopt once its share is used or its safety net has passed. Throws
   /// LinearHybridSystem::NotLinearError if the property is not linear.
   std::optional<bool> Meets(const Property& property);
+  /// Whether some group has no state at all (no run: Meets answers nullopt, leaving the
+  /// properties to the exact exploration).
+  bool empty() const { return start_.empty(); }
 
  private:
   // Whether some combination of the states of groups `read[k..]` at `locations[k..]`, with `set`

@@ -770,6 +770,10 @@ class GroupTurns {
       }
     }
     if (!product_) product_ = std::make_unique<GroupProduct>(*full_, Groups(), meter_);
+    if (product_->empty()) {  // a group without runs: nothing to prove here
+      done_ = true;
+      return;
+    }
     settled_.resize(which.size(), false);
     for (std::size_t g = 0; g < which.size(); ++g) {
       if (settled_[g] || exact.decided(static_cast<int>(g))) continue;
@@ -882,7 +886,8 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
     // A group outside the class: the exact exploration alone says why.
   }
   exact.Start();
-  const std::uint64_t pause_at = meter.used() + options.pause_units;
+  const std::uint64_t pause_at =
+      meter.used() + std::min(options.pause_units, UINT64_MAX / 2 - meter.used());
   bool paused = !options.pause;
   if (options.group_turn_units == 0 && groups && groups->active()) {  // the groups first
     meter.ClearSlice();
@@ -919,7 +924,7 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
       } catch (const std::invalid_argument&) {
         groups->Stop();
       }
-      slice *= 2;
+      slice = std::min(slice, UINT64_MAX / 8) * 2;
       next_turn = meter.used() + slice;
     }
     if (exact.AllDecided()) {
@@ -992,6 +997,8 @@ std::vector<CheckResult> PolyhedralReachability::Check(const System& system,
       used.stop = std::max(used.stop, stop);  // the enumerators are in that order
     } catch (const std::invalid_argument& e) {
       for (const int i : which) {
+        // A verdict decided before (a replayed run, the groups' product, the pause) stands.
+        if (results[i].verdict != Verdict::kUnknown) continue;
         results[i].verdict = Verdict::kUnknown;
         results[i].trace.reset();
         results[i].reason = std::string("not a linear hybrid automaton: ") + e.what();

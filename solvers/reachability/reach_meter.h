@@ -45,6 +45,7 @@ class ReachMeter {
   void ShareAmong(int parts) {
     share_ = (total_ - std::min(used_, total_)) / static_cast<std::uint64_t>(parts);
     limit_ = used_ + share_;
+    ClearSlice();  // a slice left by an exploration that ended early does not carry over
   }
   /// Whether the current exploration has used its share (or its slice, if one is set).
   bool Exhausted() const { return used_ >= std::min(limit_, slice_limit_); }
