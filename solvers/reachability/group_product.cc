@@ -77,7 +77,9 @@ std::optional<bool> GroupProduct::Meets(const Property& property) {
       }
       at.push_back(&it[j]->second);
     }
-    if (OverBound()) return std::nullopt;  // also where no tuple has bad states
+    // The share bounds the combinations even where none has bad states (building a location is
+    // charged); the slice is checked where there are states to combine.
+    if (meter_.ShareExhausted() || meter_.OutOfTime()) return std::nullopt;
     const int before = full_.num_locations();
     const LinearLocation& loc = full_.At(tuple);
     if (full_.num_locations() != before) meter_.Location();

@@ -43,7 +43,8 @@ class GroupProduct {
   /// property holds on the System (proved; unreachable for `reach`). Only the groups the
   /// property reads (a mode of one of their components, one of their variables) are combined:
   /// leaving a group's constraints out only enlarges the product. Every operation is charged to
-  /// the meter; nullopt once its share is used or its safety net has passed. Throws
+  /// the meter; nullopt once its share is used or its safety net has passed, or its slice where
+  /// states are combined (ReachMeter::Exhausted). Throws
   /// LinearHybridSystem::NotLinearError if the property is not linear.
   std::optional<bool> Meets(const Property& property);
   /// Whether some group has no state at all (no run: Meets answers nullopt, leaving the

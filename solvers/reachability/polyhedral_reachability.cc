@@ -755,11 +755,20 @@ class GroupTurns {
     return n;
   }
 
-  // Explores the groups on within the meter's slice; then, once every group is complete, asks
-  // the product about each goal of `exact` still open and decides those it proves. Returns once
-  // the slice is used (to be called again) or every goal has its answer from the product.
-  void Turn(Explorer& exact, const std::vector<Property>& properties,
-            const std::vector<int>& which) {
+  // Explores the groups on for at most `units` reach units (none: within the share); then, once
+  // every group is complete, asks the product about each goal of `exact` still open, within
+  // `units` more, and decides those it proves. Returns once the units are used (to be called
+  // again) or every goal has its answer from the product.
+  void Turn(Explorer& exact, const std::vector<Property>& properties, const std::vector<int>& which,
+            std::optional<std::uint64_t> units) {
+    const auto slice = [&] {
+      if (units) {
+        meter_.SetSlice(*units);
+      } else {
+        meter_.ClearSlice();
+      }
+    };
+    slice();
     started_.resize(explorers_.size(), false);
     for (std::size_t k = 0; k < explorers_.size(); ++k) {
       if (!started_[k]) explorers_[k]->Start();
@@ -769,6 +778,7 @@ class GroupTurns {
         return;  // a bound: the next turn goes on
       }
     }
+    slice();  // the product's own turn
     if (!product_) product_ = std::make_unique<GroupProduct>(*full_, Groups(), meter_);
     if (product_->empty()) {  // a group without runs: nothing to prove here
       done_ = true;
@@ -890,9 +900,8 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
       meter.used() + std::min(options.pause_units, UINT64_MAX / 2 - meter.used());
   bool paused = !options.pause;
   if (options.group_turn_units == 0 && groups && groups->active()) {  // the groups first
-    meter.ClearSlice();
     try {
-      groups->Turn(exact, properties, which);
+      groups->Turn(exact, properties, which, std::nullopt);
     } catch (const std::invalid_argument&) {
       groups->Stop();
     }
@@ -918,9 +927,9 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
       Pause(system, exact, options);
     }
     if (turns && meter.used() >= next_turn) {
-      meter.SetSlice(std::max<std::uint64_t>(slice / kGroupTurnDivisor, 1));
       try {
-        groups->Turn(exact, properties, which);
+        groups->Turn(exact, properties, which,
+                     std::max<std::uint64_t>(slice / kGroupTurnDivisor, 1));
       } catch (const std::invalid_argument&) {
         groups->Stop();
       }
