@@ -41,6 +41,13 @@ bool Says(const CheckResult& r, std::string_view what) {
   return r.reason.find(what) != std::string::npos;
 }
 
+// Expects `property` of model `text` to be `verdict`, decided by the groups' product.
+void ExpectByGroups(std::string_view text, const std::string& property, Verdict verdict) {
+  const CheckResult r = CheckOne(text, property);
+  EXPECT_EQ(r.verdict, verdict) << property << ": " << r.reason;
+  EXPECT_TRUE(Says(r, kByGroups)) << property << ": " << r.reason;
+}
+
 // Two copies of a three-cell corridor: x' = 1 from cell c0 to c1 (at x = 1); c1 turns x back
 // (x' = -1) and returns to c0 at x = 1/2, so c2 (past x = 2) is never reached. Two instances
 // share nothing: the product of their reachable sets lies in {c0, c1} x {c0, c1}.
@@ -65,12 +72,8 @@ system corridors {
 )";
 
 TEST(GroupProduct, ProvesWhatNoGroupReaches) {
-  const CheckResult r = CheckOne(kCorridors, "both_out");
-  EXPECT_EQ(r.verdict, Verdict::kUnreachable) << r.reason;
-  EXPECT_TRUE(Says(r, kByGroups)) << r.reason;
-  const CheckResult range = CheckOne(kCorridors, "in_range");
-  EXPECT_EQ(range.verdict, Verdict::kProved) << range.reason;
-  EXPECT_TRUE(Says(range, kByGroups)) << range.reason;
+  ExpectByGroups(kCorridors, "both_out", Verdict::kUnreachable);
+  ExpectByGroups(kCorridors, "in_range", Verdict::kProved);
 }
 
 TEST(GroupProduct, LeavesWhatItsProductMeetsToTheExactExploration) {
@@ -131,9 +134,7 @@ system stills {
 )";
 
 TEST(GroupProduct, AParameterBothGroupsReadIsOneDimensionOfTheProduct) {
-  const CheckResult r = CheckOne(kSharedParameter, "equal");
-  EXPECT_EQ(r.verdict, Verdict::kProved) << r.reason;
-  EXPECT_TRUE(Says(r, kByGroups)) << r.reason;
+  ExpectByGroups(kSharedParameter, "equal", Verdict::kProved);
   const CheckResult apart = CheckOne(kSharedParameter, "apart");
   EXPECT_EQ(apart.verdict, Verdict::kUnreachable) << apart.reason;
 }
