@@ -11,6 +11,7 @@
 #include <ppl.hh>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <variant>
 
 namespace hybrid {
@@ -414,6 +415,28 @@ void ConvexPolyhedron::Hull(const ConvexPolyhedron& other) {
   Impl::Both(*impl_, *other.impl_, [](auto& x, const auto& y) { x.poly_hull_assign(y); });
 }
 
+void ConvexPolyhedron::ConstraintHull(const ConvexPolyhedron& other) {
+  Impl::Both(*impl_, *other.impl_, [](auto& x, const auto& y) {
+    using Poly = std::remove_cvref_t<decltype(x)>;
+    if (y.is_empty()) return;
+    if (x.is_empty()) {
+      x = y;
+      return;
+    }
+    ppl::Constraint_System kept;
+    const auto keep_valid = [&kept](const Poly& from, const Poly& on) {
+      for (const ppl::Constraint& c : from.minimized_constraints()) {
+        if (on.relation_with(c).implies(ppl::Poly_Con_Relation::is_included())) kept.insert(c);
+      }
+    };
+    keep_valid(x, y);
+    keep_valid(y, x);
+    Poly hull(x.space_dimension(), ppl::UNIVERSE);
+    hull.add_constraints(kept);
+    x = std::move(hull);
+  });
+}
+
 void ConvexPolyhedron::Widen(const ConvexPolyhedron& previous) {
   Impl::Both(*impl_, *previous.impl_, [](auto& x, const auto& y) { x.H79_widening_assign(y); });
 }
@@ -550,6 +573,21 @@ int ConvexPolyhedron::NumConstraints() const {
   const ppl::Constraint_System& constraints = impl_->Constraints();
   for (auto it = constraints.begin(); it != constraints.end(); ++it) ++count;
   return count;
+}
+
+std::size_t ConvexPolyhedron::LargestCoefficientBits() const {
+  std::size_t bits = 0;
+  const auto size = [](const ppl::Coefficient& c) {
+    return mpz_sizeinbase(ppl::raw_value(c).get_mpz_t(), 2);
+  };
+  for (const ppl::Constraint& c : impl_->Constraints()) {
+    for (int i = 0; i < dims(); ++i) {
+      bits =
+          std::max(bits, size(c.coefficient(ppl::Variable(static_cast<ppl::dimension_type>(i)))));
+    }
+    bits = std::max(bits, size(c.inhomogeneous_term()));
+  }
+  return bits;
 }
 
 std::size_t ConvexPolyhedron::RepresentationBytes() const {

@@ -83,6 +83,11 @@ class ConvexPolyhedron {
   ConvexPolyhedron Embedded(int dims, std::span<const int> to) const;
   /// The convex hull of this and other.
   void Hull(const ConvexPolyhedron& other);
+  /// The constraint hull of this and other (PHAVer's): the constraints of each (minimised) that
+  /// the other satisfies. It contains both (so their convex hull: an over-approximation of it,
+  /// exact where one contains the other) and is made without the generators' conversion a convex
+  /// hull needs; its constraints are among theirs, so their coefficients do not grow.
+  void ConstraintHull(const ConvexPolyhedron& other);
   /// The H79 widening of this (which must contain `previous`) with respect to `previous`.
   void Widen(const ConvexPolyhedron& previous);
   /// The supremum of sum_i objective[i] x_i over this (objective has dims() entries), rounded to
@@ -113,6 +118,10 @@ class ConvexPolyhedron {
   std::vector<LinearConstraint> Constraints() const;
   /// Number of minimised constraints (a size measure).
   int NumConstraints() const;
+  /// The bit length of the largest magnitude among the integer coefficients of its minimised
+  /// constraints (each scaled to coprime integers, as PPL keeps them): a measure of how far its
+  /// facets' coefficients have grown (hulls may lengthen them without end).
+  std::size_t LargestCoefficientBits() const;
   /// The bytes its representation in PPL holds beyond the object itself, as it stands
   /// (constraints and generators as far as computed, their coefficients' digits, saturation
   /// matrices): what operations on it read, so a measure of their cost that grows with the

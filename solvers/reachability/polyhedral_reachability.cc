@@ -11,7 +11,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "solvers/reachability/exploration_steps.h"
 #include "solvers/reachability/group_product.h"
+#include "solvers/reachability/hull_exploration.h"
 #include "solvers/reachability/linear_hybrid_system.h"
 #include "solvers/reachability/reach_meter.h"
 
@@ -22,33 +24,6 @@ using Kind = LinearConstraint::Kind;
 using Conjunction = std::vector<LinearConstraint>;
 
 using Meter = ReachMeter;
-
-// The bounding box of a symbolic state, each bound (ConvexPolyhedron::Bounds, within one ulp of
-// the true one) widened by one ulp either way: the true infimum of dimension i lies in
-// [lo_down[i], lo_up[i]], the true supremum in [hi_down[i], hi_up[i]].
-struct Box {
-  std::vector<double> lo_down, lo_up, hi_down, hi_up;
-};
-
-Box BoxOf(const ConvexPolyhedron& set) {
-  Box box;
-  for (const auto& [lo, hi] : set.Bounds()) {
-    box.lo_down.push_back(std::nextafter(lo, -INFINITY));
-    box.lo_up.push_back(std::nextafter(lo, INFINITY));
-    box.hi_down.push_back(std::nextafter(hi, -INFINITY));
-    box.hi_up.push_back(std::nextafter(hi, INFINITY));
-  }
-  return box;
-}
-
-// Whether `outer` may contain `inner` as far as their boxes tell: false only when it certainly
-// does not (a bound of `inner` beyond the same bound of `outer`).
-bool MayContain(const Box& outer, const Box& inner) {
-  for (size_t i = 0; i < outer.lo_down.size(); ++i) {
-    if (outer.lo_down[i] > inner.lo_up[i] || outer.hi_up[i] < inner.hi_down[i]) return false;
-  }
-  return true;
-}
 
 // A symbolic state: a location, a convex set of states there, and how it was reached.
 struct Node {
@@ -74,64 +49,6 @@ struct Goal {
 // symbolic states whose runs do not replay would otherwise cost a pre-image walk per state.
 constexpr int kMaxConcretizations = 32;
 
-// The time-elapse successor of `set` in `loc`, kept inside its elapse invariant and `extra` (none
-// if null). `set` (entry states, inside the invariant) is reachable at once; time elapses only
-// from its states inside the elapse invariant (an urgent guard that holds on entry fires at
-// once). The result is the convex hull of both parts (exact when the entry states all lie inside
-// the elapse invariant, as usual; an over-approximation otherwise). Where the elapse invariant is
-// the invariant (no urgent guard stops time), `set` lies inside it and inside its own time
-// elapse, so neither is tested.
-ConvexPolyhedron Flow(const LinearLocation& loc, ConvexPolyhedron set,
-                      const ConvexPolyhedron* extra, Meter& meter) {
-  if (extra) {
-    set.Intersect(*extra);
-    meter.Op(set, 2);
-    if (set.IsEmpty()) return set;
-  }
-  if (loc.elapse_invariant.size() == loc.invariant.size()) {
-    set.TimeElapse(loc.rates);
-    if (!loc.invariant.empty()) set.Intersect(loc.invariant_set);
-    if (extra) set.Intersect(*extra);
-    meter.Op(set, 3);
-    return set;
-  }
-  ConvexPolyhedron flowing = set;
-  flowing.Intersect(loc.elapse_set);
-  meter.Op(flowing, 3);
-  if (flowing.IsEmpty()) return set;
-  flowing.TimeElapse(loc.rates);
-  flowing.Intersect(loc.elapse_set);
-  if (extra) flowing.Intersect(*extra);
-  meter.Op(flowing, 3);
-  if (!flowing.Contains(set)) flowing.Hull(set);
-  meter.Op(flowing, set);
-  meter.Op(flowing);
-  return flowing;
-}
-
-// Whether no point of `box` satisfies `guard`, as far as interval arithmetic on the box tells
-// with a relative margin of 1e-9 (false whenever in doubt): lets Expand skip an edge without a
-// polyhedron operation.
-bool CertainlyMisses(const Box& box, const Conjunction& guard) {
-  for (const LinearConstraint& c : guard) {
-    double lo = c.b, hi = c.b, scale = std::abs(c.b);
-    for (size_t i = 0; i < c.a.size(); ++i) {
-      const double a = c.a[i];
-      if (a == 0.0) continue;
-      const double from = a > 0 ? box.lo_down[i] : box.hi_up[i];
-      const double to = a > 0 ? box.hi_up[i] : box.lo_down[i];
-      lo += a * from;
-      hi += a * to;
-      scale += std::abs(a) * std::max(std::abs(from), std::abs(to));
-    }
-    if (!std::isfinite(scale)) continue;
-    const double margin = 1e-9 * (1.0 + scale);
-    if (lo > margin) return true;  // c.a x + c.b > 0 on the whole box
-    if (c.kind == Kind::kEqual && hi < -margin) return true;
-  }
-  return false;
-}
-
 // `p` with `count` unconstrained dimensions added after its own.
 ConvexPolyhedron Lifted(ConvexPolyhedron p, int count) {
   p.AddDimensions(count);
@@ -143,13 +60,6 @@ std::vector<double> Unit(int n, int i) {
   std::vector<double> e(static_cast<size_t>(n), 0.0);
   e[static_cast<size_t>(i)] = 1.0;
   return e;
-}
-
-// `set` (entry states of `loc`) with the values of the variables dead at `loc` forgotten.
-ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set, Meter& meter) {
-  for (const int d : loc.dead) set.Unconstrain(d);
-  if (!loc.dead.empty()) meter.Op(set, loc.dead.size());
-  return set;
 }
 
 // A concrete run along a path, as Explorer::Concretize picks it: the values of the dimensions at
@@ -834,6 +744,54 @@ class GroupTurns {
   bool done_ = false;
 };
 
+// Reachability on convex hulls (HullExploration) beside the exact exploration: its first turn
+// before the exact exploration (Options::hull_units, at most 1/kHullTurnDivisor of the share),
+// then 1/kHullTurnDivisor of each of the exact exploration's turns, until its fixpoint proves
+// what its hulls miss or it is abandoned.
+constexpr std::uint64_t kHullTurnDivisor = 4;
+
+class HullTurns {
+ public:
+  HullTurns(const System& system, const std::vector<const Property*>& observed,
+            const std::vector<int>& read, const PolyhedralReachability::Options& options,
+            Meter& meter)
+      : meter_(meter), hull_(system, observed, read, meter, options.progress) {}
+
+  bool active() const { return !done_; }
+
+  // Explores on for at most `units` reach units; at the fixpoint, every goal of `exact` still
+  // open whose bad states the hulls miss holds.
+  void Turn(Explorer& exact, std::uint64_t units) {
+    meter_.SetSlice(units);
+    std::vector<bool> settled;
+    for (int g = 0; g < exact.num_goals(); ++g) settled.push_back(exact.decided(g));
+    HullExploration::Status status = HullExploration::Status::kAbandoned;
+    try {
+      status = hull_.Resume(settled);
+    } catch (const std::invalid_argument&) {
+      // Outside the class: the exact exploration alone says why.
+    }
+    meter_.ClearSlice();
+    if (status == HullExploration::Status::kOpen) return;
+    done_ = true;
+    if (status != HullExploration::Status::kFixpoint) return;
+    for (int g = 0; g < exact.num_goals(); ++g) {
+      if (exact.decided(g) || !hull_.Misses(g)) continue;
+      std::ostringstream reason;
+      reason << "fixpoint of polyhedral reachability on convex hulls (" << hull_.classes()
+             << " hulls in " << hull_.locations()
+             << " locations, an over-approximation), which misses the property's states";
+      exact.Holds(g, reason.str());
+    }
+  }
+  long long states() const { return hull_.classes(); }
+
+ private:
+  Meter& meter_;
+  HullExploration hull_;
+  bool done_ = false;
+};
+
 // Explores `system` for properties `which` (all with `horizon`); writes their results and returns
 // why the exploration stopped early (kNone if it did not).
 PolyhedralReachability::Usage::Stop ExploreBounded(const System& system,
@@ -873,9 +831,65 @@ void Pause(const System& system, Explorer& exact, const PolyhedralReachability::
   }
 }
 
+// The explorations beside the exact one for properties without a horizon: the interaction
+// groups' (GroupTurns) and the hulls' (HullTurns), each when it applies.
+struct SideTurns {
+  std::optional<GroupTurns> groups;
+  std::optional<HullTurns> hull;
+
+  bool active() const { return (groups && groups->active()) || (hull && hull->active()); }
+  long long states() const { return (groups ? groups->states() : 0) + (hull ? hull->states() : 0); }
+  // One turn each, after the exact exploration's turn of `slice` units.
+  void Turn(Explorer& exact, const std::vector<Property>& properties, const std::vector<int>& which,
+            std::uint64_t slice) {
+    if (hull && hull->active() && !exact.AllDecided()) {
+      hull->Turn(exact, std::max<std::uint64_t>(slice / kHullTurnDivisor, 1));
+    }
+    if (groups && groups->active() && !exact.AllDecided()) {
+      try {
+        groups->Turn(exact, properties, which,
+                     std::max<std::uint64_t>(slice / kGroupTurnDivisor, 1));
+      } catch (const std::invalid_argument&) {
+        groups->Stop();
+      }
+    }
+  }
+};
+
+// Sets up the side explorations for `system` in `side` (each left out where it does not apply)
+// and takes their first turns: the hulls' of Options::hull_units, the groups' to their fixpoint
+// where Options::group_turn_units is 0.
+void FirstTurns(const System& system, const std::vector<Property>& properties,
+                const std::vector<int>& which, const std::vector<const Property*>& observed,
+                const std::vector<int>& read, const PolyhedralReachability::Options& options,
+                Meter& meter, Explorer& exact, SideTurns& side) {
+  try {
+    side.groups.emplace(system, read, options, meter);
+  } catch (const std::invalid_argument&) {
+    // A group outside the class: the exact exploration alone says why.
+  }
+  if (options.hull_units > 0) {
+    try {
+      side.hull.emplace(system, observed, read, options, meter);
+      side.hull->Turn(exact, std::min(options.hull_units, meter.share() / kHullTurnDivisor));
+    } catch (const std::invalid_argument&) {
+      side.hull.reset();
+    }
+  }
+  if (options.group_turn_units == 0 && side.groups && side.groups->active() &&
+      !exact.AllDecided()) {
+    try {
+      side.groups->Turn(exact, properties, which, std::nullopt);
+    } catch (const std::invalid_argument&) {
+      side.groups->Stop();
+    }
+  }
+}
+
 // Explores `system` for properties `which` (none with a horizon), taking turns with the
-// interaction groups explored alone (GroupTurns) where it has several; writes their results and
-// returns why the exploration stopped early (kNone if it did not).
+// interaction groups explored alone (GroupTurns) where it has several and with the hulls
+// (HullTurns); writes their results and returns why the exploration stopped early (kNone if it
+// did not).
 PolyhedralReachability::Usage::Stop ExploreUnbounded(
     const System& system, const std::vector<Property>& properties, const std::vector<int>& which,
     std::vector<CheckResult>& results, const PolyhedralReachability::Options& options, Meter& meter,
@@ -889,29 +903,18 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
   }
   const std::vector<int> read = LinearHybridSystem::ReadSlots(observed);
   Explorer exact(system, std::move(goals), std::nullopt, read, options, meter);
-  std::optional<GroupTurns> groups;
-  try {
-    groups.emplace(system, read, options, meter);
-  } catch (const std::invalid_argument&) {
-    // A group outside the class: the exact exploration alone says why.
-  }
   exact.Start();
+  SideTurns side;
+  FirstTurns(system, properties, which, observed, read, options, meter, exact, side);
   const std::uint64_t pause_at =
       meter.used() + std::min(options.pause_units, UINT64_MAX / 2 - meter.used());
   bool paused = !options.pause;
-  if (options.group_turn_units == 0 && groups && groups->active()) {  // the groups first
-    try {
-      groups->Turn(exact, properties, which, std::nullopt);
-    } catch (const std::invalid_argument&) {
-      groups->Stop();
-    }
-  }
   std::uint64_t slice = std::max<std::uint64_t>(options.group_turn_units, 1);
   std::uint64_t next_turn = meter.used() + slice;
   Stop stop = Stop::kNone;
-  while (true) {
-    // Explore up to the next group turn or the pause, whichever comes first.
-    const bool turns = groups && groups->active();
+  while (!exact.AllDecided()) {
+    // Explore up to the next side turn or the pause, whichever comes first.
+    const bool turns = side.active();
     std::uint64_t until = turns ? next_turn : UINT64_MAX;
     if (!paused) until = std::min(until, pause_at);
     if (until == UINT64_MAX) {
@@ -927,23 +930,15 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
       Pause(system, exact, options);
     }
     if (turns && meter.used() >= next_turn) {
-      try {
-        groups->Turn(exact, properties, which,
-                     std::max<std::uint64_t>(slice / kGroupTurnDivisor, 1));
-      } catch (const std::invalid_argument&) {
-        groups->Stop();
-      }
+      side.Turn(exact, properties, which, slice);
       slice = std::min(slice, UINT64_MAX / 8) * 2;
       next_turn = meter.used() + slice;
     }
-    if (exact.AllDecided()) {
-      stop = Stop::kNone;
-      break;
-    }
   }
+  if (exact.AllDecided()) stop = Stop::kNone;
   meter.ClearSlice();
   exact.Finish(stop);
-  used.states += exact.states() + (groups ? groups->states() : 0);
+  used.states += exact.states() + side.states();
   return stop;
 }
 

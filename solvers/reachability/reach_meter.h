@@ -38,6 +38,8 @@ class ReachMeter {
   void Boxes(std::uint64_t count) { used_ += count * kReachUnitsPerBoxComparison; }
   /// Charges the construction of a location.
   void Location() { used_ += kReachUnitsPerLocation; }
+  /// Charges `units` reach units.
+  void Charge(std::uint64_t units) { used_ += units; }
   /// Charges the replay of a run along a path of `steps` symbolic states.
   void Replay(std::size_t steps) { used_ += steps * kReachUnitsPerReplayedStep; }
 

@@ -53,7 +53,9 @@ inline constexpr std::uint64_t kReachUnitsPerReplayedStep = 2'000;
 /// picked forward flow by flow inside those sets (a central point each: dwell time and one input
 /// value per flow), so its cost grows linearly with the path's length. The run is replayed by the
 /// simulator with its jump schedule (ConfirmTrace): `violated` (`reachable`) if it replays,
-/// `unknown` otherwise. The exploration is exact (no widening, no hull).
+/// `unknown` otherwise. The exploration is exact (no widening, no hull); beside it, for
+/// properties without a horizon, an exploration on convex hulls (Options::hull_units) may prove
+/// properties (never refute them) at its own fixpoint.
 ///
 /// The budget is deterministic: the exploration charges reach units for its work (see
 /// kReachUnitsPerBudgetSecond: per polyhedron operation, by the size of the polyhedra it reads;
@@ -87,6 +89,16 @@ class PolyhedralReachability {
     /// So the groups cost at most 1/32 of the exact exploration's work. 0: the groups take
     /// their turn first, to their fixpoint (or the budget).
     std::uint64_t group_turn_units = 1'000'000;
+    /// For properties without a horizon: the reach units of the first turn of reachability on
+    /// convex hulls (HullExploration: one polyhedron per location and per value of the
+    /// variables constant there, an over-approximation: solvers/reachability/hull_exploration.h),
+    /// taken before the exact exploration (at most a quarter of the exploration's share of the
+    /// budget); later turns get 1/4 of each of the exact exploration's turns. At its fixpoint a
+    /// property whose bad states the hulls miss holds; the hull proves nothing else (a bad state
+    /// met is left to the exact exploration), and it is abandoned once every property left is met
+    /// or its coefficients grow too long. 0: no hull. The default, 2 budget seconds, lets the hull
+    /// of FISCS05 (163 million units) end in its first turn.
+    std::uint64_t hull_units = 200'000'000;
     /// Another engine's turn (say, a cheap proof by induction), taken once the exploration of
     /// the properties without a horizon has used `pause_units` reach units without deciding all
     /// of them: `pause` is called once with the system and the properties still open (over its

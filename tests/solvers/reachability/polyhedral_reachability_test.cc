@@ -329,9 +329,12 @@ Outcome CheckWithin(const System& system, const std::string& property,
   return out;
 }
 
+// The exact exploration alone (no hulls: those prove both non-converging models' properties
+// through their widening, HullExploration's tests) within `budget_seconds`.
 PolyhedralReachability::Options Budget(double budget_seconds) {
   PolyhedralReachability::Options options;
   options.budget = budget_seconds;
+  options.hull_units = 0;
   return options;
 }
 

@@ -136,6 +136,7 @@ TEST(VariableLiveness, ForgettingAnUnreadClockGivesReachabilityAFixpoint) {
   const System system = Parse(kDrift);
   PolyhedralReachability::Options options;
   options.max_states = 200;
+  options.hull_units = 0;  // the exact exploration alone
   const PolyhedralReachability engine(options);
   const auto proved = engine.Check(system, {Named(system, "y_bounded")});
   EXPECT_EQ(proved[0].verdict, Verdict::kProved) << proved[0].reason;
@@ -145,6 +146,12 @@ TEST(VariableLiveness, ForgettingAnUnreadClockGivesReachabilityAFixpoint) {
   const auto kept = engine.Check(system, {Named(system, "x_nonnegative")});
   EXPECT_EQ(kept[0].verdict, Verdict::kUnknown) << kept[0].reason;
   EXPECT_NE(kept[0].reason.find("200 symbolic states"), std::string::npos) << kept[0].reason;
+  // The hulls (x's states merged, x >= 0 kept) prove it.
+  options.hull_units = 1'000'000;
+  const auto by_hull =
+      PolyhedralReachability(options).Check(system, {Named(system, "x_nonnegative")});
+  EXPECT_EQ(by_hull[0].verdict, Verdict::kProved) << by_hull[0].reason;
+  EXPECT_NE(by_hull[0].reason.find("convex hulls"), std::string::npos) << by_hull[0].reason;
 }
 
 }  // namespace

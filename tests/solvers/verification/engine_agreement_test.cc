@@ -133,6 +133,18 @@ std::vector<CheckResult> Reach(const System& system, const std::vector<Property>
   o.budget = 0.02;  // 1.5 million reach units
   o.max_states = 400;
   o.cpu_seconds = 30;
+  o.hull_units = 0;  // the exact exploration alone (the hulls are "reach-hull")
+  return PolyhedralReachability(o).Check(system, properties);
+}
+
+/// Reachability with its hulls' first turn (Options::hull_units; at most a quarter of the
+/// budget), so that what the hulls prove (HullExploration) is attacked and compared like every
+/// other engine's verdicts.
+std::vector<CheckResult> ReachHull(const System& system, const std::vector<Property>& properties) {
+  PolyhedralReachability::Options o;
+  o.budget = 0.02;
+  o.max_states = 400;
+  o.cpu_seconds = 30;
   return PolyhedralReachability(o).Check(system, properties);
 }
 
@@ -147,6 +159,7 @@ std::vector<CheckResult> ReachGroupsFirst(const System& system,
   o.max_states = 400;
   o.cpu_seconds = 30;
   o.group_turn_units = 0;
+  o.hull_units = 0;
   return PolyhedralReachability(o).Check(system, properties);
 }
 
@@ -161,6 +174,7 @@ std::vector<CheckResult> ReachPaused(const System& system,
   o.max_states = 400;
   o.cpu_seconds = 30;
   o.pause_units = 1;
+  o.hull_units = 0;
   o.pause = [](const System& s, const std::vector<Property>& open) {
     PropertyProver::Options quick;
     quick.max_depth = 1;
@@ -223,6 +237,7 @@ std::vector<CheckResult> Flowpipe(const System& system, const std::vector<Proper
 const std::vector<std::pair<std::string, Engine>>& Engines() {
   static const std::vector<std::pair<std::string, Engine>> engines = {
       {"reach", Reach},
+      {"reach-hull", ReachHull},
       {"reach-groups-first", ReachGroupsFirst},
       {"reach-paused", ReachPaused},
       {"flowpipe", Flowpipe},
@@ -270,6 +285,7 @@ struct Summary {
   int reach_outside_class = 0;  // properties reach left unknown as not linear
   int group_product = 0;   // reach's verdicts on the product of interaction groups (GroupProduct)
   int paused = 0;          // definite verdicts of reach-paused that its pause (the prover) gave
+  int hull = 0;            // verdicts of reach-hull from its hulls (HullExploration)
   int sample_refused = 0;  // properties of models whose every sampled run was rejected
   int claims = 0;          // proved / unreachable verdicts (per property) attacked
   long attacks = 0;        // simulations run against claims
@@ -314,7 +330,8 @@ std::string SummaryText(const Settings& settings, const Summary& s) {
   out << "  reach outside its class (not linear): " << s.reach_outside_class
       << "; sample refused models without runs: " << s.sample_refused
       << "; reach verdicts on the product of interaction groups: " << s.group_product
-      << "; reach-paused verdicts from its pause: " << s.paused << "\n"
+      << "; reach-paused verdicts from its pause: " << s.paused
+      << "; reach-hull verdicts from its hulls: " << s.hull << "\n"
       << "  claims attacked " << s.claims << ", attacks " << s.attacks << " (" << s.rejected
       << " refused by the model, " << s.outside
       << " cut at a state outside the invariants), states checked " << s.states << "\n"
@@ -693,6 +710,9 @@ void CompareVerdicts(const Verdicts& v, const std::set<std::pair<std::string, in
       }
       if (run.engine == "reach-paused" && r.method == "prove" && r.verdict != Verdict::kUnknown) {
         ++s.paused;
+      }
+      if (run.engine == "reach-hull" && r.reason.find("on convex hulls") != std::string::npos) {
+        ++s.hull;
       }
       if (run.engine.starts_with("reach") &&
           r.reason.find("interaction groups alone") != std::string::npos) {
@@ -1199,6 +1219,7 @@ Summary RunAgreement(const std::string& what, int default_systems, ht::RandomDyn
 TEST(EngineAgreementTest, EnginesAgreeOnRandomSystems) {
   const Summary s = RunAgreement("engine agreement", kDefaultSystems, ht::RandomDynamics::kMixed);
   EXPECT_GT(s.paused, 0) << "no verdict came from reachability's pause";
+  EXPECT_GT(s.hull, 0) << "no verdict came from reachability's hulls";
 }
 
 // The same on systems whose modes are mostly separable (RandomDynamics::kSeparable, the
