@@ -424,9 +424,23 @@ void ConvexPolyhedron::ConstraintHull(const ConvexPolyhedron& other) {
       return;
     }
     ppl::Constraint_System kept;
-    const auto keep_valid = [&kept](const Poly& from, const Poly& on) {
+    const auto keep = [&kept](const Poly& on, const ppl::Constraint& c) {
+      if (on.relation_with(c).implies(ppl::Poly_Con_Relation::is_included())) kept.insert(c);
+    };
+    // Each equality e == 0 as its two halves e >= 0 and e <= 0, either of which may hold on
+    // the other set alone.
+    const auto keep_valid = [&](const Poly& from, const Poly& on) {
       for (const ppl::Constraint& c : from.minimized_constraints()) {
-        if (on.relation_with(c).implies(ppl::Poly_Con_Relation::is_included())) kept.insert(c);
+        if (!c.is_equality()) {
+          keep(on, c);
+          continue;
+        }
+        ppl::Linear_Expression e(c.inhomogeneous_term());
+        for (ppl::dimension_type i = 0; i < c.space_dimension(); ++i) {
+          e += c.coefficient(ppl::Variable(i)) * ppl::Variable(i);
+        }
+        keep(on, e >= 0);
+        keep(on, e <= 0);
       }
     };
     keep_valid(x, y);

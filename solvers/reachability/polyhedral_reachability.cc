@@ -904,10 +904,12 @@ PolyhedralReachability::Usage::Stop ExploreUnbounded(
   const std::vector<int> read = LinearHybridSystem::ReadSlots(observed);
   Explorer exact(system, std::move(goals), std::nullopt, read, options, meter);
   exact.Start();
-  SideTurns side;
-  FirstTurns(system, properties, which, observed, read, options, meter, exact, side);
+  // The pause counts the side explorations' first turns too: where the hulls' first turn ends
+  // without a proof, the other engine answers before the exact exploration goes on.
   const std::uint64_t pause_at =
       meter.used() + std::min(options.pause_units, UINT64_MAX / 2 - meter.used());
+  SideTurns side;
+  FirstTurns(system, properties, which, observed, read, options, meter, exact, side);
   bool paused = !options.pause;
   std::uint64_t slice = std::max<std::uint64_t>(options.group_turn_units, 1);
   std::uint64_t next_turn = meter.used() + slice;

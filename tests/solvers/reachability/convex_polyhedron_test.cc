@@ -259,6 +259,50 @@ TEST(ConvexPolyhedron, EmbeddedPlacesEachDimensionAndLeavesTheOthersFree) {
   EXPECT_THROW(p.Embedded(1, to), std::invalid_argument);
 }
 
+TEST(ConvexPolyhedron, ConstraintHullKeepsTheConstraintsEachSetSatisfies) {
+  // Two boxes side by side: every constraint that survives is a side of their hull.
+  ConvexPolyhedron boxes = Box(0, 1, 0, 1);
+  boxes.ConstraintHull(Box(2, 3, 0, 1));
+  EXPECT_TRUE(SameSet(boxes, Box(0, 3, 0, 1)));
+  // The triangle {x, y >= 0, x + y <= 1} and the segment y = 0, 2 <= x <= 3: x >= 0 and y >= 0
+  // hold on both (y >= 0 also as half of the segment's equality), x <= 3 holds on the triangle;
+  // x + y <= 1, x >= 2 and y <= 0 each fail on one. So {x >= 0, y >= 0, x <= 3}: it contains
+  // (0, 5), which their convex hull does not.
+  ConvexPolyhedron t = Plane({{{-1, 0}, 0, Kind::kLessEqual},
+                              {{0, -1}, 0, Kind::kLessEqual},
+                              {{1, 1}, -1, Kind::kLessEqual}});
+  const ConvexPolyhedron segment = Plane(
+      {{{0, 1}, 0, Kind::kEqual}, {{-1, 0}, 2, Kind::kLessEqual}, {{1, 0}, -3, Kind::kLessEqual}});
+  ConvexPolyhedron convex = t;
+  convex.Hull(segment);
+  t.ConstraintHull(segment);
+  EXPECT_TRUE(SameSet(t, Plane({{{-1, 0}, 0, Kind::kLessEqual},
+                                {{0, -1}, 0, Kind::kLessEqual},
+                                {{1, 0}, -3, Kind::kLessEqual}})));
+  EXPECT_TRUE(t.Contains(convex));
+  EXPECT_TRUE(Holds(t, 0, 5));
+  EXPECT_FALSE(Holds(convex, 0, 5));
+  // The empty set changes nothing; from the empty set, the other set.
+  ConvexPolyhedron box = Box(0, 1, 0, 1);
+  box.ConstraintHull(ConvexPolyhedron::Empty(2));
+  EXPECT_TRUE(SameSet(box, Box(0, 1, 0, 1)));
+  ConvexPolyhedron empty = ConvexPolyhedron::Empty(2);
+  empty.ConstraintHull(Box(0, 1, 0, 1));
+  EXPECT_TRUE(SameSet(empty, Box(0, 1, 0, 1)));
+}
+
+TEST(ConvexPolyhedron, LargestCoefficientBitsMeasuresTheIntegerConstraints) {
+  // x <= 1/3 is kept as -3x + 1 >= 0 (2 bits); x <= 1/1024 as -1024x + 1 >= 0 (11 bits); x = 5
+  // as x - 5 == 0 (3 bits).
+  ConvexPolyhedron third = ConvexPolyhedron::Universe(1);
+  third.AddConstraint({{3}, -1, Kind::kLessEqual});
+  EXPECT_EQ(third.LargestCoefficientBits(), 2u);
+  ConvexPolyhedron small = ConvexPolyhedron::Universe(1);
+  small.AddConstraint({{1}, -1.0 / 1024, Kind::kLessEqual});
+  EXPECT_EQ(small.LargestCoefficientBits(), 11u);
+  EXPECT_EQ(ConvexPolyhedron::Point(std::vector<double>{5}).LargestCoefficientBits(), 3u);
+}
+
 // The same set made a closed polyhedron (non-strict constraints only) and a not necessarily
 // closed one (the same constraints and a strict one that cuts nothing: x < 100, all sets here lie
 // in [-10, 10]^2) gives the same results under every operation, in either order of operands:
