@@ -87,23 +87,24 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
       if (lo == hi && std::isfinite(lo)) key.second.emplace_back(d, lo);
     }
   }
-  auto [it, added] = classes_.try_emplace(key, Class{set});
-  Class& c = it->second;
-  if (!added) {
+  auto it = classes_.find(key);
+  if (it == classes_.end()) {
+    it = classes_.emplace(std::move(key), Class{std::move(set)}).first;
+  } else {
+    Class& c = it->second;
     meter_.Op(c.entry, set);
     if (c.entry.Contains(set)) return;
-    ConvexPolyhedron previous = c.entry;
+    const ConvexPolyhedron previous = c.entry;
     c.entry.Hull(set);
     meter_.Op(c.entry, set);
     if (c.entry.NumConstraints() > kMaxFacetsPerDimension * lhs_.dims()) {
       // Too many facets for its dimension: the constraint hull instead (its constraints are
       // among those of the two sets).
-      c.entry = std::move(previous);
+      c.entry = previous;
       c.entry.ConstraintHull(set);
       meter_.Op(c.entry, set);
-      previous = c.entry;  // no widening of this step
     }
-    if (++c.growths > kGrowthsBeforeWidening) {
+    if (++c.growths > kGrowthsBeforeWidening) {  // each hull contains `previous`
       c.entry.Widen(previous);
       c.entry.Intersect(loc.invariant_set);
       meter_.Op(c.entry, 2);
@@ -114,6 +115,7 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
       return;
     }
   }
+  Class& c = it->second;
   c.flowed = Flow(loc, c.entry, nullptr, meter_);
   CheckProperties(loc, c.flowed);
   if (!c.queued) {
