@@ -282,8 +282,28 @@ bool ConvexPolyhedron::Contains(const ConvexPolyhedron& other) const {
 }
 
 bool ConvexPolyhedron::Intersects(const ConvexPolyhedron& other) const {
-  const Impl& self = *impl_;
-  return Impl::Both(self, *other.impl_,
+  if (other.dims() != dims()) throw std::invalid_argument("polyhedra of different dimensions");
+  // With a closed one, x: each constraint of the other against the generators of x (PPL's
+  // relation test, exact, with no intersection to convert and no not-necessarily-closed copy
+  // of x). One that x lies outside of settles it (disjoint); those that x lies inside of drop
+  // out; if at most one is left, x meets the other (x meets that constraint's set, and lies in
+  // the others'). A property's bad part is usually one half-space, its other bounds kept by the
+  // state, so the intersection is seldom built.
+  const Impl* closed = impl_.get();
+  const Impl* rest = other.impl_.get();
+  if (!closed->closed()) std::swap(closed, rest);
+  if (closed->closed()) {
+    const ppl::C_Polyhedron& x = closed->c();
+    if (x.is_empty()) return false;
+    int left = 0;
+    for (const ppl::Constraint& c : rest->Constraints()) {
+      const ppl::Poly_Con_Relation r = x.relation_with(c);
+      if (r.implies(ppl::Poly_Con_Relation::is_disjoint())) return false;
+      if (!r.implies(ppl::Poly_Con_Relation::is_included())) ++left;
+    }
+    if (left <= 1) return true;
+  }
+  return Impl::Both(*impl_, *other.impl_,
                     [](const auto& x, const auto& y) { return !x.is_disjoint_from(y); });
 }
 

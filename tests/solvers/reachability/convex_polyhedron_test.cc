@@ -259,6 +259,64 @@ TEST(ConvexPolyhedron, EmbeddedPlacesEachDimensionAndLeavesTheOthersFree) {
   EXPECT_THROW(p.Embedded(1, to), std::invalid_argument);
 }
 
+TEST(ConvexPolyhedron, IntersectsAHalfSpaceExactlyAtTheBoundary) {
+  // The box [0, 1]^2 against x + y REL 2, which touches it at its corner (1, 1) only.
+  const ConvexPolyhedron box = Box(0, 1, 0, 1);
+  const auto half = [](Kind kind, double b) { return Plane({{{-1, -1}, b, kind}}); };
+  EXPECT_TRUE(box.Intersects(half(Kind::kLessEqual, 2)));               // x + y >= 2: the corner
+  EXPECT_FALSE(box.Intersects(half(Kind::kLess, 2)));                   // x + y > 2
+  EXPECT_TRUE(box.Intersects(half(Kind::kLess, 1.5)));                  // x + y > 1.5
+  EXPECT_FALSE(box.Intersects(half(Kind::kLessEqual, 2.5)));            // x + y >= 2.5
+  EXPECT_TRUE(box.Intersects(Plane({{{1, 1}, -2, Kind::kEqual}})));     // x + y == 2
+  EXPECT_FALSE(box.Intersects(Plane({{{1, 1}, -2.5, Kind::kEqual}})));  // x + y == 2.5
+  EXPECT_FALSE(box.Intersects(Plane({{{1, 1}, 0.5, Kind::kEqual}})));   // x + y == -0.5
+  // Either order; an unbounded set; the empty set.
+  EXPECT_FALSE(half(Kind::kLess, 2).Intersects(box));
+  const ConvexPolyhedron quadrant = Plane({{{-1, 0}, 5, Kind::kLessEqual}});  // x >= 5
+  EXPECT_TRUE(quadrant.Intersects(half(Kind::kLess, 2)));
+  EXPECT_FALSE(quadrant.Intersects(Plane({{{1, 0}, -4, Kind::kLess}})));  // x < 4
+  EXPECT_FALSE(ConvexPolyhedron::Empty(2).Intersects(half(Kind::kLessEqual, 0)));
+  EXPECT_FALSE(box.Intersects(ConvexPolyhedron::Empty(2)));
+  EXPECT_THROW((void)box.Intersects(ConvexPolyhedron::Universe(3)), std::invalid_argument);
+}
+
+// Intersects (which, with a closed set, tests the other's constraints against its generators
+// and the one left by the range of its expression) against the intersection made and tested
+// for emptiness, and against grid points in both, on random closed sets and random bad parts:
+// one half-space (strict, non-strict or an equality), alone or within a box, closed or not.
+TEST(ConvexPolyhedron, IntersectsAgreesWithTheIntersectionAndWithPoints) {
+  std::mt19937_64 rng(20261130);
+  const auto number = [&rng](int lo, int hi) {  // an integer in [lo, hi], halved
+    return static_cast<double>(lo + static_cast<int>(rng() % static_cast<unsigned>(hi - lo + 1))) /
+           2.0;
+  };
+  const Kind kinds[] = {Kind::kLess, Kind::kLessEqual, Kind::kEqual};
+  int met = 0, missed = 0;
+  for (int round = 0; round < 300; ++round) {
+    const double x0 = number(-8, 4), y0 = number(-8, 4);
+    ConvexPolyhedron state = Box(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
+    state.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), Kind::kLessEqual});
+    ConvexPolyhedron bad = ConvexPolyhedron::Universe(2);
+    if (rng() % 2 == 0) bad = Box(number(-12, 0), number(0, 12), number(-12, 0), number(0, 12));
+    bad.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), kinds[rng() % 3]});
+    ConvexPolyhedron meet = state;
+    meet.Intersect(bad);
+    const bool expected = !meet.IsEmpty();
+    EXPECT_EQ(state.Intersects(bad), expected) << round;
+    EXPECT_EQ(bad.Intersects(state), expected) << round;
+    for (double x = -10; x <= 10; x += 0.5) {
+      for (double y = -10; y <= 10; y += 0.5) {
+        if (Holds(state, x, y) && Holds(bad, x, y)) {
+          EXPECT_TRUE(expected) << round << ": (" << x << ", " << y << ") lies in both";
+        }
+      }
+    }
+    (expected ? met : missed) += 1;
+  }
+  EXPECT_GT(met, 50);
+  EXPECT_GT(missed, 50);
+}
+
 TEST(ConvexPolyhedron, ConstraintHullKeepsTheConstraintsEachSetSatisfies) {
   // Two boxes side by side: every constraint that survives is a side of their hull.
   ConvexPolyhedron boxes = Box(0, 1, 0, 1);
