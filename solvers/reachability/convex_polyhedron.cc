@@ -333,6 +333,25 @@ void ConvexPolyhedron::Assign(std::span<const std::pair<int, AffineMap>> maps) {
     });
     return;
   }
+  // Where no f_j reads a dimension another map writes (resets to constants, a clock shifted by
+  // a parameter), the simultaneous assignment is the maps one after another: PPL's affine
+  // images, without the fresh dimensions below.
+  const auto reads_another = [&](std::size_t j) {
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+      const int written = maps[i].first;
+      if (i != j && written >= 0 && written < static_cast<int>(maps[j].second.a.size()) &&
+          maps[j].second.a[static_cast<std::size_t>(written)] != 0.0) {
+        return true;
+      }
+    }
+    return false;
+  };
+  bool independent = true;
+  for (std::size_t j = 0; j < maps.size() && independent; ++j) independent = !reads_another(j);
+  if (independent) {
+    for (const auto& map : maps) Assign(std::span<const std::pair<int, AffineMap>>(&map, 1));
+    return;
+  }
   // Simultaneous: y_j = f_j(x) in fresh dimensions, then x_{d_j} := y_j, then drop the y_j.
   const int n = dims();
   const int k = static_cast<int>(maps.size());

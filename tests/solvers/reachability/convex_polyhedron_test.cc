@@ -85,6 +85,21 @@ TEST(ConvexPolyhedron, BoundsPerDimension) {
   EXPECT_EQ(ConvexPolyhedron::Empty(1).Bounds(), (Bounds{{INFINITY, -INFINITY}}));
 }
 
+TEST(ConvexPolyhedron, SimultaneousResetsThatReadNoOtherWrittenDimension) {
+  // x := x / 2 + 1, y := 7 on [0, 1] x [2, 3]: [1, 1.5] x {7}, each map reading the values before.
+  ConvexPolyhedron p = Box(0, 1, 2, 3);
+  const std::vector<std::pair<int, AffineMap>> maps = {{0, AffineMap{{0.5, 0}, 1}},
+                                                       {1, AffineMap{{0, 0}, 7}}};
+  p.Assign(maps);
+  EXPECT_TRUE(SameSet(p, Box(1, 1.5, 7, 7)));
+  // y := x + y, x := 0 reads x, which the other writes: x + y of the values before.
+  ConvexPolyhedron q = Box(0, 1, 2, 3);
+  const std::vector<std::pair<int, AffineMap>> reading = {{1, AffineMap{{1, 1}, 0}},
+                                                          {0, AffineMap{{0, 0}, 0}}};
+  q.Assign(reading);
+  EXPECT_TRUE(SameSet(q, Box(0, 0, 2, 4)));
+}
+
 TEST(ConvexPolyhedron, SimultaneousResetsSwap) {
   // x := y, y := x on [0, 1] x [2, 3] gives [2, 3] x [0, 1] (one after the other would give a
   // part of the diagonal).
