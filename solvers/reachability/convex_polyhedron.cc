@@ -564,14 +564,33 @@ std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
   const size_t n = static_cast<size_t>(dims());
   std::vector<std::pair<double, double>> out(n, {INFINITY, -INFINITY});
   if (IsEmpty()) return out;
-  std::vector<std::optional<mpq_class>> lo(n), hi(n);
+  // Each extreme as the coefficient and divisor of the point that has it (c / d, d > 0),
+  // compared by cross-multiplication: no rational made canonical (a gcd) per coordinate.
+  struct Extreme {
+    mpz_class c, d;
+    bool set = false;
+  };
+  std::vector<Extreme> lo(n), hi(n);
   std::vector<bool> below(n, false), above(n, false);  // unbounded that way
+  mpz_class left, right;
+  // Whether c / d lies beyond `e` (below it for lo, above for hi), so replaces it.
+  const auto beyond = [&](const Extreme& e, mpz_srcptr c, mpz_srcptr d, int side) {
+    if (!e.set) return true;
+    mpz_mul(left.get_mpz_t(), c, e.d.get_mpz_t());
+    mpz_mul(right.get_mpz_t(), e.c.get_mpz_t(), d);
+    return side * mpz_cmp(left.get_mpz_t(), right.get_mpz_t()) > 0;
+  };
   for (const ppl::Generator& g : impl_->Generators()) {
     if (g.is_point() || g.is_closure_point()) {
-      const std::vector<mpq_class> x = Coordinates(g);
+      mpz_srcptr d = ppl::raw_value(g.divisor()).get_mpz_t();
       for (size_t i = 0; i < n; ++i) {
-        if (!lo[i] || x[i] < *lo[i]) lo[i] = x[i];
-        if (!hi[i] || x[i] > *hi[i]) hi[i] = x[i];
+        mpz_srcptr c = ppl::raw_value(g.coefficient(ppl::Variable(i))).get_mpz_t();
+        for (auto [e, side] : {std::pair{&lo[i], -1}, std::pair{&hi[i], 1}}) {
+          if (!beyond(*e, c, d, side)) continue;
+          mpz_set(e->c.get_mpz_t(), c);
+          mpz_set(e->d.get_mpz_t(), d);
+          e->set = true;
+        }
       }
       continue;
     }
@@ -581,9 +600,14 @@ std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
       above[i] = above[i] || sign > 0 || (sign != 0 && g.is_line());
     }
   }
+  const auto value = [](const Extreme& e) {
+    mpq_class q(e.c, e.d);
+    q.canonicalize();
+    return NearestDouble(q);
+  };
   for (size_t i = 0; i < n; ++i) {
-    out[i].first = below[i] ? -INFINITY : NearestDouble(*lo[i]);
-    out[i].second = above[i] ? INFINITY : NearestDouble(*hi[i]);
+    out[i].first = below[i] ? -INFINITY : value(lo[i]);
+    out[i].second = above[i] ? INFINITY : value(hi[i]);
   }
   return out;
 }

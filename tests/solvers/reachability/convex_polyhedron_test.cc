@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <utility>
@@ -330,6 +331,40 @@ TEST(ConvexPolyhedron, IntersectsAgreesWithTheIntersectionAndWithPoints) {
   }
   EXPECT_GT(met, 50);
   EXPECT_GT(missed, 50);
+}
+
+// Bounds (one pass over the generators) against the supremum of x and of -x and of y and -y
+// (PPL's optimisation), on random sets: bounded or not, closed or with a strict constraint.
+TEST(ConvexPolyhedron, BoundsAgreeWithTheSupremaPerDimension) {
+  std::mt19937_64 rng(20261131);
+  const auto number = [&rng](int lo, int hi) {  // an integer in [lo, hi], divided by 3
+    return static_cast<double>(lo + static_cast<int>(rng() % static_cast<unsigned>(hi - lo + 1))) /
+           3.0;
+  };
+  const Kind kinds[] = {Kind::kLess, Kind::kLessEqual};
+  int unbounded = 0;
+  for (int round = 0; round < 200; ++round) {
+    ConvexPolyhedron p = ConvexPolyhedron::Universe(2);
+    for (int k = 0; k < 3; ++k) {
+      p.AddConstraint({{number(-6, 6), number(-6, 6)}, number(-12, 12), kinds[rng() % 2]});
+    }
+    if (rng() % 2 == 0) p.Intersect(Box(-5, 5, -5, 5));
+    const auto bounds = p.Bounds();
+    if (p.IsEmpty()) {
+      EXPECT_EQ(bounds[0], std::make_pair(double{INFINITY}, double{-INFINITY})) << round;
+      continue;
+    }
+    for (int i = 0; i < 2; ++i) {
+      std::vector<double> up(2, 0.0), down(2, 0.0);
+      up[static_cast<size_t>(i)] = 1.0;
+      down[static_cast<size_t>(i)] = -1.0;
+      const std::optional<double> sup = p.Supremum(up), neg_inf = p.Supremum(down);
+      EXPECT_EQ(bounds[static_cast<size_t>(i)].second, sup ? *sup : INFINITY) << round;
+      EXPECT_EQ(bounds[static_cast<size_t>(i)].first, neg_inf ? -*neg_inf : -INFINITY) << round;
+      unbounded += sup ? 0 : 1;
+    }
+  }
+  EXPECT_GT(unbounded, 10);
 }
 
 TEST(ConvexPolyhedron, ConstraintHullKeepsTheConstraintsEachSetSatisfies) {
