@@ -84,9 +84,10 @@ class ConvexPolyhedron {
   /// The convex hull of this and other.
   void Hull(const ConvexPolyhedron& other);
   /// The constraint hull of this and other (PHAVer's): the constraints of each (minimised; an
-  /// equality as its two inequalities) that the other satisfies. It contains both (so their convex hull: an over-approximation of it,
-  /// exact where one contains the other) and is made without the generators' conversion a convex
-  /// hull needs; its constraints are among theirs, so their coefficients do not grow.
+  /// equality as its two inequalities) that the other satisfies. It contains both (so their convex
+  /// hull: an over-approximation of it, exact where one contains the other) and is made without the
+  /// generators' conversion a convex hull needs; its constraints are among theirs, so their
+  /// coefficients do not grow.
   void ConstraintHull(const ConvexPolyhedron& other);
   /// The H79 widening of this (which must contain `previous`) with respect to `previous`.
   void Widen(const ConvexPolyhedron& previous);

@@ -102,7 +102,9 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
       // among those of the two sets).
       c.entry = previous;
       c.entry.ConstraintHull(set);
+      c.entry.Intersect(loc.invariant_set);  // it may leave the invariant, which both lie in
       meter_.Op(c.entry, set);
+      meter_.Op(c.entry);
     }
     if (++c.growths > kGrowthsBeforeWidening) {  // each hull contains `previous`
       c.entry.Widen(previous);

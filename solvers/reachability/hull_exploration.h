@@ -32,8 +32,10 @@ namespace hybrid {
 ///
 /// Soundness: every reachable state lies in some F. By induction on runs: an initial state lies
 /// in the E of its class, and its time successors in F; a state reached by a jump from a state of
-/// some F lies in the entry set that expansion of F computed, so in the E of its class (E only
-/// grows), and its time successors in that class's F. Hull and widening only enlarge E. So at
+/// some F lies in the entry set that expansion of F computed, so in the E of its class, and its
+/// time successors in that class's F. E keeps containing every entry set added to it: a hull,
+/// a constraint hull and a widening contain both sets, and the intersection with the invariant
+/// that follows the last two removes only states outside it, where no entry set lies. So at
 /// the fixpoint (nothing left to expand), a property whose bad states no F meets holds. The
 /// polyhedra are PPL's, with exact rational coefficients; only the choice of classes reads
 /// doubles (ConvexPolyhedron::Bounds), and any choice of classes is sound. A bad state met

@@ -868,7 +868,7 @@ void FirstTurns(const System& system, const std::vector<Property>& properties,
   } catch (const std::invalid_argument&) {
     // A group outside the class: the exact exploration alone says why.
   }
-  if (options.hull_units > 0) {
+  if (options.hull_units > 0 && !exact.AllDecided()) {
     try {
       side.hull.emplace(system, observed, read, options, meter);
       side.hull->Turn(exact, std::min(options.hull_units, meter.share() / kHullTurnDivisor));
