@@ -77,4 +77,28 @@ ConvexPolyhedron Forgetting(const LinearLocation& loc, ConvexPolyhedron set, Rea
   return set;
 }
 
+std::optional<ConvexPolyhedron> Jump(const LinearEdge& edge, ConvexPolyhedron set,
+                                     ReachMeter& meter) {
+  meter.Op(set);
+  if (!edge.guard.empty()) {
+    set.Intersect(edge.guard_set);
+    meter.Op(set, 2);
+    if (set.IsEmpty()) return std::nullopt;
+  }
+  set.Assign(edge.resets);
+  if (!edge.resets.empty()) meter.Op(set);
+  return set;
+}
+
+std::optional<ConvexPolyhedron> Entering(const LinearLocation& target, ConvexPolyhedron set,
+                                         ReachMeter& meter) {
+  set = Forgetting(target, std::move(set), meter);
+  if (!target.invariant.empty()) {  // else every state (and `set` is not empty)
+    set.Intersect(target.invariant_set);
+    meter.Op(set, 2);
+    if (set.IsEmpty()) return std::nullopt;
+  }
+  return set;
+}
+
 }  // namespace hybrid

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "solvers/reachability/convex_polyhedron.h"
@@ -37,6 +38,16 @@ bool CertainlyMisses(const Box& box, const std::vector<LinearConstraint>& guard)
 /// letting time pass in `loc` lies in the result.
 ConvexPolyhedron Flow(const LinearLocation& loc, ConvexPolyhedron set,
                       const ConvexPolyhedron* extra, ReachMeter& meter);
+
+/// The states `set` (a copy, charged) reaches through `edge`: those inside its guard, after its
+/// resets; nullopt if none is inside the guard.
+std::optional<ConvexPolyhedron> Jump(const LinearEdge& edge, ConvexPolyhedron set,
+                                     ReachMeter& meter);
+
+/// The entry states of `target` that `set` (reached by a jump into it) gives: the dead
+/// variables forgotten (Forgetting), inside the invariant; nullopt if none is.
+std::optional<ConvexPolyhedron> Entering(const LinearLocation& target, ConvexPolyhedron set,
+                                         ReachMeter& meter);
 
 /// `set` (entry states of `loc`) with the values of the variables dead at `loc`
 /// (LinearLocation::dead) forgotten.

@@ -134,23 +134,12 @@ void HullExploration::Expand(const Key& key, const Class& c) {
   for (const LinearEdge& edge : loc.edges) {
     meter_.Boxes(1);
     if (CertainlyMisses(box, edge.guard)) continue;
-    ConvexPolyhedron set = c.flowed;
-    meter_.Op(set);
-    if (!edge.guard.empty()) {
-      set.Intersect(edge.guard_set);
-      meter_.Op(set, 2);
-      if (set.IsEmpty()) continue;
-    }
-    set.Assign(edge.resets);
-    if (!edge.resets.empty()) meter_.Op(set);
+    std::optional<ConvexPolyhedron> jumped = Jump(edge, c.flowed, meter_);
+    if (!jumped) continue;
     const LinearLocation& target = Enter(edge.target);
-    set = Forgetting(target, std::move(set), meter_);
-    if (!target.invariant.empty()) {
-      set.Intersect(target.invariant_set);
-      meter_.Op(set, 2);
-      if (set.IsEmpty()) continue;
-    }
-    Add(edge.target, std::move(set));
+    std::optional<ConvexPolyhedron> entered = Entering(target, std::move(*jumped), meter_);
+    if (!entered) continue;
+    Add(edge.target, std::move(*entered));
     if (abandoned_) return;
   }
 }

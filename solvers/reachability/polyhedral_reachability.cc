@@ -215,22 +215,12 @@ class Explorer {
       const LinearEdge& edge = loc.edges[static_cast<size_t>(e)];
       meter_.Boxes(1);
       if (CertainlyMisses(nodes_[n].box, edge.guard)) continue;
-      ConvexPolyhedron set = nodes_[n].set;
-      meter_.Op(set);
-      if (!edge.guard.empty()) {
-        set.Intersect(edge.guard_set);
-        meter_.Op(set, 2);
-        if (set.IsEmpty()) continue;
-      }
-      set.Assign(edge.resets);
-      if (!edge.resets.empty()) meter_.Op(set);
+      std::optional<ConvexPolyhedron> jumped = Jump(edge, nodes_[n].set, meter_);
+      if (!jumped) continue;
       const LinearLocation& target = Enter(edge.target);
-      set = Forgetting(target, std::move(set), meter_);
-      if (!target.invariant.empty()) {  // else every state (and `set` is not empty)
-        set.Intersect(target.invariant_set);
-        meter_.Op(set, 2);
-        if (set.IsEmpty()) continue;
-      }
+      std::optional<ConvexPolyhedron> entered = Entering(target, std::move(*jumped), meter_);
+      if (!entered) continue;
+      ConvexPolyhedron& set = *entered;
       // Where time elapse is exact (Flow), a state found before contains the flow of every set
       // of entry states it contains: such an entry set is dropped before its flow is computed.
       if (target.elapse_invariant.size() == target.invariant.size() &&

@@ -16,39 +16,25 @@
 #include <utility>
 #include <vector>
 
+#include "tests/test_utilities/polyhedra.h"
+
 namespace hybrid {
 namespace {
 
 using Kind = LinearConstraint::Kind;
 
-// The polyhedron of R^2 where every constraint a0 x + a1 y + b REL 0 holds.
-ConvexPolyhedron Plane(const std::vector<LinearConstraint>& constraints) {
-  ConvexPolyhedron p = ConvexPolyhedron::Universe(2);
-  for (const LinearConstraint& c : constraints) p.AddConstraint(c);
-  return p;
-}
-
-// Whether a and b are the same set.
-bool SameSet(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
-  return a.Contains(b) && b.Contains(a);
-}
+using testing::Plane;
+using testing::Rectangle;
+using testing::SameSet;
 
 bool Holds(const ConvexPolyhedron& p, double x, double y) {
   return p.Contains(ConvexPolyhedron::Point(std::vector<double>{x, y}));
 }
 
-// The box [x0, x1] x [y0, y1].
-ConvexPolyhedron Box(double x0, double x1, double y0, double y1) {
-  return Plane({{{-1, 0}, x0, Kind::kLessEqual},
-                {{1, 0}, -x1, Kind::kLessEqual},
-                {{0, -1}, y0, Kind::kLessEqual},
-                {{0, 1}, -y1, Kind::kLessEqual}});
-}
-
 TEST(ConvexPolyhedron, TimeElapseOfAPointWithARateBox) {
   // From (0, 0) at x' in [1, 2], y' = 1: {y >= 0, y <= x <= 2 y}.
   ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{0, 0});
-  const ConvexPolyhedron rates = Box(1, 2, 1, 1);
+  const ConvexPolyhedron rates = Rectangle(1, 2, 1, 1);
   p.TimeElapse(rates);
   const ConvexPolyhedron expected = Plane({{{0, -1}, 0, Kind::kLessEqual},
                                            {{-1, 1}, 0, Kind::kLessEqual},
@@ -64,7 +50,7 @@ TEST(ConvexPolyhedron, TimeElapseBackwardReversesTheRates) {
   // The states from which (2, 1) is reached at x' in [1, 2], y' = 1: (2 - t r, 1 - t), so
   // y <= 1 and 1 - y <= 2 - x <= 2 (1 - y): {y <= 1, x <= 1 + y, x >= 2 y}.
   ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{2, 1});
-  p.TimeElapseBackward(Box(1, 2, 1, 1));
+  p.TimeElapseBackward(Rectangle(1, 2, 1, 1));
   const ConvexPolyhedron expected = Plane({{{0, 1}, -1, Kind::kLessEqual},
                                            {{1, -1}, -1, Kind::kLessEqual},
                                            {{-1, 2}, 0, Kind::kLessEqual}});
@@ -75,10 +61,10 @@ TEST(ConvexPolyhedron, TimeElapseBackwardReversesTheRates) {
 
 TEST(ConvexPolyhedron, BoundsPerDimension) {
   using Bounds = std::vector<std::pair<double, double>>;
-  EXPECT_EQ(Box(0, 1, 2, 3).Bounds(), (Bounds{{0, 1}, {2, 3}}));
+  EXPECT_EQ(Rectangle(0, 1, 2, 3).Bounds(), (Bounds{{0, 1}, {2, 3}}));
   // A cone from the origin: unbounded above in both dimensions.
   ConvexPolyhedron cone = ConvexPolyhedron::Point(std::vector<double>{0, 0});
-  cone.TimeElapse(Box(1, 2, 1, 1));
+  cone.TimeElapse(Rectangle(1, 2, 1, 1));
   EXPECT_EQ(cone.Bounds(), (Bounds{{0, INFINITY}, {0, INFINITY}}));
   // Strict bounds are the same numbers; a line is unbounded both ways; empty is (inf, -inf).
   const ConvexPolyhedron open = Plane({{{1, 0}, -1, Kind::kLess}, {{-1, 0}, 0, Kind::kLess}});
@@ -88,30 +74,30 @@ TEST(ConvexPolyhedron, BoundsPerDimension) {
 
 TEST(ConvexPolyhedron, SimultaneousResetsThatReadNoOtherWrittenDimension) {
   // x := x / 2 + 1, y := 7 on [0, 1] x [2, 3]: [1, 1.5] x {7}, each map reading the values before.
-  ConvexPolyhedron p = Box(0, 1, 2, 3);
+  ConvexPolyhedron p = Rectangle(0, 1, 2, 3);
   const std::vector<std::pair<int, AffineMap>> maps = {{0, AffineMap{{0.5, 0}, 1}},
                                                        {1, AffineMap{{0, 0}, 7}}};
   p.Assign(maps);
-  EXPECT_TRUE(SameSet(p, Box(1, 1.5, 7, 7)));
+  EXPECT_TRUE(SameSet(p, Rectangle(1, 1.5, 7, 7)));
   // y := x + y, x := 0 reads x, which the other writes: x + y of the values before.
-  ConvexPolyhedron q = Box(0, 1, 2, 3);
+  ConvexPolyhedron q = Rectangle(0, 1, 2, 3);
   const std::vector<std::pair<int, AffineMap>> reading = {{1, AffineMap{{1, 1}, 0}},
                                                           {0, AffineMap{{0, 0}, 0}}};
   q.Assign(reading);
-  EXPECT_TRUE(SameSet(q, Box(0, 0, 2, 4)));
+  EXPECT_TRUE(SameSet(q, Rectangle(0, 0, 2, 4)));
 }
 
 TEST(ConvexPolyhedron, SimultaneousResetsSwap) {
   // x := y, y := x on [0, 1] x [2, 3] gives [2, 3] x [0, 1] (one after the other would give a
   // part of the diagonal).
-  ConvexPolyhedron p = Box(0, 1, 2, 3);
+  ConvexPolyhedron p = Rectangle(0, 1, 2, 3);
   const std::vector<std::pair<int, AffineMap>> swap = {{0, AffineMap{{0, 1}, 0}},
                                                        {1, AffineMap{{1, 0}, 0}}};
   p.Assign(swap);
-  EXPECT_TRUE(SameSet(p, Box(2, 3, 0, 1)));
+  EXPECT_TRUE(SameSet(p, Rectangle(2, 3, 0, 1)));
   // Its pre-image is the box it came from.
   p.AssignPreimage(swap);
-  EXPECT_TRUE(SameSet(p, Box(0, 1, 2, 3)));
+  EXPECT_TRUE(SameSet(p, Rectangle(0, 1, 2, 3)));
 }
 
 TEST(ConvexPolyhedron, ResetPreimages) {
@@ -121,13 +107,13 @@ TEST(ConvexPolyhedron, ResetPreimages) {
   p.AssignPreimage(shift);
   EXPECT_TRUE(SameSet(p, Plane({{{-1, -1}, 5, Kind::kLessEqual}})));
   // x := 2, y := x + 1 into [0, 1] x [3, 4]: x + 1 in [3, 4] (2 is in [0, 1]? no): empty.
-  ConvexPolyhedron q = Box(0, 1, 3, 4);
+  ConvexPolyhedron q = Rectangle(0, 1, 3, 4);
   const std::vector<std::pair<int, AffineMap>> to_two = {{0, AffineMap{{0, 0}, 2}},
                                                          {1, AffineMap{{1, 0}, 1}}};
   q.AssignPreimage(to_two);
   EXPECT_TRUE(q.IsEmpty());
   // x := 0.5, y := x + 1 into the same box: x in [2, 3], y free.
-  ConvexPolyhedron r = Box(0, 1, 3, 4);
+  ConvexPolyhedron r = Rectangle(0, 1, 3, 4);
   const std::vector<std::pair<int, AffineMap>> to_half = {{0, AffineMap{{0, 0}, 0.5}},
                                                           {1, AffineMap{{1, 0}, 1}}};
   r.AssignPreimage(to_half);
@@ -212,7 +198,7 @@ TEST(MaximizeLinear, SmallProgramHasItsKnownOptimum) {
 
 // The size measure grows with the representation, and is the same for the same operations.
 TEST(ConvexPolyhedron, RepresentationBytesGrowWithTheRepresentation) {
-  const ConvexPolyhedron square = Box(0, 1, 0, 1);
+  const ConvexPolyhedron square = Rectangle(0, 1, 0, 1);
   // A polygon with more sides: the square with its four corners cut.
   const ConvexPolyhedron octagon = Plane({{{-1, 0}, 0, Kind::kLessEqual},
                                           {{1, 0}, -3, Kind::kLessEqual},
@@ -226,7 +212,7 @@ TEST(ConvexPolyhedron, RepresentationBytesGrowWithTheRepresentation) {
   EXPECT_GT(octagon.RepresentationBytes(), square.RepresentationBytes());
   // Longer coefficients take more bytes: the same square scaled by a large factor.
   const double big = 1e30;
-  EXPECT_GT(Box(0, big, 0, big).RepresentationBytes(), square.RepresentationBytes());
+  EXPECT_GT(Rectangle(0, big, 0, big).RepresentationBytes(), square.RepresentationBytes());
   // More dimensions take more bytes.
   ConvexPolyhedron wider = square;
   wider.AddDimensions(6);
@@ -235,8 +221,8 @@ TEST(ConvexPolyhedron, RepresentationBytesGrowWithTheRepresentation) {
   // copy (allocated to fit) may measure less than its original, never more.
   auto made = [] {
     ConvexPolyhedron p = ConvexPolyhedron::Point(std::vector<double>{0, 0});
-    p.TimeElapse(Box(1, 2, 1, 1));
-    p.Intersect(Box(0, 3, 0, 2));
+    p.TimeElapse(Rectangle(1, 2, 1, 1));
+    p.Intersect(Rectangle(0, 3, 0, 2));
     (void)p.Bounds();
     return p;
   };
@@ -277,7 +263,7 @@ TEST(ConvexPolyhedron, EmbeddedPlacesEachDimensionAndLeavesTheOthersFree) {
 
 TEST(ConvexPolyhedron, IntersectsAHalfSpaceExactlyAtTheBoundary) {
   // The box [0, 1]^2 against x + y REL 2, which touches it at its corner (1, 1) only.
-  const ConvexPolyhedron box = Box(0, 1, 0, 1);
+  const ConvexPolyhedron box = Rectangle(0, 1, 0, 1);
   const auto half = [](Kind kind, double b) { return Plane({{{-1, -1}, b, kind}}); };
   EXPECT_TRUE(box.Intersects(half(Kind::kLessEqual, 2)));               // x + y >= 2: the corner
   EXPECT_FALSE(box.Intersects(half(Kind::kLess, 2)));                   // x + y > 2
@@ -310,10 +296,11 @@ TEST(ConvexPolyhedron, IntersectsAgreesWithTheIntersectionAndWithPoints) {
   int met = 0, missed = 0;
   for (int round = 0; round < 300; ++round) {
     const double x0 = number(-8, 4), y0 = number(-8, 4);
-    ConvexPolyhedron state = Box(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
+    ConvexPolyhedron state = Rectangle(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
     state.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), Kind::kLessEqual});
     ConvexPolyhedron bad = ConvexPolyhedron::Universe(2);
-    if (rng() % 2 == 0) bad = Box(number(-12, 0), number(0, 12), number(-12, 0), number(0, 12));
+    if (rng() % 2 == 0)
+      bad = Rectangle(number(-12, 0), number(0, 12), number(-12, 0), number(0, 12));
     bad.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), kinds[rng() % 3]});
     ConvexPolyhedron meet = state;
     meet.Intersect(bad);
@@ -348,7 +335,7 @@ TEST(ConvexPolyhedron, BoundsAgreeWithTheSupremaPerDimension) {
     for (int k = 0; k < 3; ++k) {
       p.AddConstraint({{number(-6, 6), number(-6, 6)}, number(-12, 12), kinds[rng() % 2]});
     }
-    if (rng() % 2 == 0) p.Intersect(Box(-5, 5, -5, 5));
+    if (rng() % 2 == 0) p.Intersect(Rectangle(-5, 5, -5, 5));
     const auto bounds = p.Bounds();
     if (p.IsEmpty()) {
       EXPECT_EQ(bounds[0], std::make_pair(double{INFINITY}, double{-INFINITY})) << round;
@@ -369,9 +356,9 @@ TEST(ConvexPolyhedron, BoundsAgreeWithTheSupremaPerDimension) {
 
 TEST(ConvexPolyhedron, ConstraintHullKeepsTheConstraintsEachSetSatisfies) {
   // Two boxes side by side: every constraint that survives is a side of their hull.
-  ConvexPolyhedron boxes = Box(0, 1, 0, 1);
-  boxes.ConstraintHull(Box(2, 3, 0, 1));
-  EXPECT_TRUE(SameSet(boxes, Box(0, 3, 0, 1)));
+  ConvexPolyhedron boxes = Rectangle(0, 1, 0, 1);
+  boxes.ConstraintHull(Rectangle(2, 3, 0, 1));
+  EXPECT_TRUE(SameSet(boxes, Rectangle(0, 3, 0, 1)));
   // The triangle {x, y >= 0, x + y <= 1} and the segment y = 0, 2 <= x <= 3: x >= 0 and y >= 0
   // hold on both (y >= 0 also as half of the segment's equality), x <= 3 holds on the triangle;
   // x + y <= 1, x >= 2 and y <= 0 each fail on one. So {x >= 0, y >= 0, x <= 3}: it contains
@@ -391,12 +378,12 @@ TEST(ConvexPolyhedron, ConstraintHullKeepsTheConstraintsEachSetSatisfies) {
   EXPECT_TRUE(Holds(t, 0, 5));
   EXPECT_FALSE(Holds(convex, 0, 5));
   // The empty set changes nothing; from the empty set, the other set.
-  ConvexPolyhedron box = Box(0, 1, 0, 1);
+  ConvexPolyhedron box = Rectangle(0, 1, 0, 1);
   box.ConstraintHull(ConvexPolyhedron::Empty(2));
-  EXPECT_TRUE(SameSet(box, Box(0, 1, 0, 1)));
+  EXPECT_TRUE(SameSet(box, Rectangle(0, 1, 0, 1)));
   ConvexPolyhedron empty = ConvexPolyhedron::Empty(2);
-  empty.ConstraintHull(Box(0, 1, 0, 1));
-  EXPECT_TRUE(SameSet(empty, Box(0, 1, 0, 1)));
+  empty.ConstraintHull(Rectangle(0, 1, 0, 1));
+  EXPECT_TRUE(SameSet(empty, Rectangle(0, 1, 0, 1)));
 }
 
 TEST(ConvexPolyhedron, LargestCoefficientBitsMeasuresTheIntegerConstraints) {
@@ -424,7 +411,7 @@ TEST(ConvexPolyhedron, ClosedAndNotNecessarilyClosedGiveTheSameSets) {
   };
   const auto random_set = [&]() {
     const double x0 = number(-8, 4), y0 = number(-8, 4);
-    ConvexPolyhedron p = Box(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
+    ConvexPolyhedron p = Rectangle(x0, x0 + number(0, 8), y0, y0 + number(0, 8));
     p.AddConstraint({{number(-4, 4), number(-4, 4)}, number(-8, 8), Kind::kLessEqual});
     return p;
   };

@@ -126,14 +126,21 @@ struct EngineRun {
 
 using Engine = std::function<std::vector<CheckResult>(const System&, const std::vector<Property>&)>;
 
-/// `check --method reach` with a small deterministic budget (and a bound on symbolic states, as
-/// random clocks that are never reset have no fixpoint).
-std::vector<CheckResult> Reach(const System& system, const std::vector<Property>& properties) {
+/// The options of every reachability engine here: a small deterministic budget (and a bound on
+/// symbolic states, as random clocks that are never reset have no fixpoint), no hulls (each
+/// engine below says what it adds).
+PolyhedralReachability::Options SmallReach() {
   PolyhedralReachability::Options o;
-  o.budget = 0.02;  // 1.5 million reach units
+  o.budget = 0.02;  // 2 million reach units
   o.max_states = 400;
   o.cpu_seconds = 30;
-  o.hull_units = 0;  // the exact exploration alone (the hulls are "reach-hull")
+  o.hull_units = 0;
+  return o;
+}
+
+/// `check --method reach` with the exact exploration alone (the hulls are "reach-hull").
+std::vector<CheckResult> Reach(const System& system, const std::vector<Property>& properties) {
+  const PolyhedralReachability::Options o = SmallReach();
   return PolyhedralReachability(o).Check(system, properties);
 }
 
@@ -141,10 +148,8 @@ std::vector<CheckResult> Reach(const System& system, const std::vector<Property>
 /// budget), so that what the hulls prove (HullExploration) is attacked and compared like every
 /// other engine's verdicts.
 std::vector<CheckResult> ReachHull(const System& system, const std::vector<Property>& properties) {
-  PolyhedralReachability::Options o;
-  o.budget = 0.02;
-  o.max_states = 400;
-  o.cpu_seconds = 30;
+  PolyhedralReachability::Options o = SmallReach();
+  o.hull_units = PolyhedralReachability::Options().hull_units;
   return PolyhedralReachability(o).Check(system, properties);
 }
 
@@ -154,12 +159,8 @@ std::vector<CheckResult> ReachHull(const System& system, const std::vector<Prope
 /// turn).
 std::vector<CheckResult> ReachGroupsFirst(const System& system,
                                           const std::vector<Property>& properties) {
-  PolyhedralReachability::Options o;
-  o.budget = 0.02;
-  o.max_states = 400;
-  o.cpu_seconds = 30;
+  PolyhedralReachability::Options o = SmallReach();
   o.group_turn_units = 0;
-  o.hull_units = 0;
   return PolyhedralReachability(o).Check(system, properties);
 }
 
@@ -169,12 +170,8 @@ std::vector<CheckResult> ReachGroupsFirst(const System& system,
 /// compared like every other engine's.
 std::vector<CheckResult> ReachPaused(const System& system,
                                      const std::vector<Property>& properties) {
-  PolyhedralReachability::Options o;
-  o.budget = 0.02;
-  o.max_states = 400;
-  o.cpu_seconds = 30;
+  PolyhedralReachability::Options o = SmallReach();
   o.pause_units = 1;
-  o.hull_units = 0;
   o.pause = [](const System& s, const std::vector<Property>& open) {
     PropertyProver::Options quick;
     quick.max_depth = 1;
