@@ -9,11 +9,13 @@ namespace hybrid {
 
 HullExploration::HullExploration(const System& system, std::vector<const Property*> properties,
                                  const std::vector<int>& read, ReachMeter& meter,
-                                 std::function<void(int classes, int queued)> progress)
+                                 std::function<void(int classes, int queued)> progress,
+                                 int growths_before_widening)
     : lhs_(system, false, read),
       properties_(std::move(properties)),
       meter_(meter),
       progress_(std::move(progress)),
+      growths_before_widening_(std::max(growths_before_widening, 1)),
       met_(properties_.size(), false) {}
 
 HullExploration::Status HullExploration::Resume(const std::vector<bool>& settled) {
@@ -24,11 +26,16 @@ HullExploration::Status HullExploration::Resume(const std::vector<bool>& settled
   while (!abandoned_ && !NothingToProve(settled)) {
     if (queue_.empty()) return Status::kFixpoint;
     if (meter_.Exhausted() || meter_.OutOfTime()) return Status::kOpen;
-    const auto it = queue_.front();
-    queue_.pop_front();
-    it->second.queued = false;
+    const auto it = queue_.begin()->second;
+    queue_.erase(queue_.begin());
+    Class& c = it->second;
+    c.queued = false;
     const std::uint64_t before = meter_.used();
-    Expand(it->first, it->second);
+    // F is computed when the class is expanded, once for every growth of E since the last time.
+    const LinearLocation& loc = lhs_.At(it->first.first);
+    c.flowed = Flow(loc, c.entry, nullptr, meter_);
+    CheckProperties(loc, c.flowed);
+    if (!NothingToProve(settled)) Expand(it->first, c);
     meter_.Charge((kCostFactor - 1) * (meter_.used() - before));
     if (progress_ && ++expanded_ % 64 == 0) {
       progress_(static_cast<int>(classes_.size()), static_cast<int>(queue_.size()));
@@ -90,6 +97,7 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
   auto it = classes_.find(key);
   if (it == classes_.end()) {
     it = classes_.emplace(std::move(key), Class{std::move(set)}).first;
+    it->second.order = static_cast<long long>(classes_.size());
   } else {
     Class& c = it->second;
     meter_.Op(c.entry, set);
@@ -106,23 +114,23 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
       meter_.Op(c.entry, set);
       meter_.Op(c.entry);
     }
-    if (++c.growths > kGrowthsBeforeWidening) {  // each hull contains `previous`
+    if (++c.growths > growths_before_widening_) {  // each hull contains `previous`
       c.entry.Widen(previous);
+      widened_ = true;
       c.entry.Intersect(loc.invariant_set);
       meter_.Op(c.entry, 2);
     }
     meter_.Op(c.entry);
     if (c.entry.LargestCoefficientBits() > kMaxBits) {
       abandoned_ = true;
+      too_long_ = true;
       return;
     }
   }
   Class& c = it->second;
-  c.flowed = Flow(loc, c.entry, nullptr, meter_);
-  CheckProperties(loc, c.flowed);
   if (!c.queued) {
     c.queued = true;
-    queue_.push_back(it);
+    queue_.emplace(c.order, it);
   }
 }
 

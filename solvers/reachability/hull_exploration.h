@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <map>
 #include <utility>
@@ -26,9 +25,12 @@ namespace hybrid {
 /// merged. For each class, E is the convex hull of every set of entry states found for it (after
 /// the jump's reset, the dead variables forgotten, inside the invariant) and F = Flow(E) (time
 /// elapse within the invariant: every state a run reaches from E by letting time pass lies in F).
-/// A new entry set contained in E is dropped; else E grows to the hull of both, F is computed
-/// again and the class is expanded again (every edge from F). After the class has grown
-/// kGrowthsBeforeWidening times, E is widened (H79, a bigger set), so the exploration ends.
+/// A new entry set contained in E is dropped; else E grows to the hull of both and the class is
+/// queued to be expanded again: F is computed again and every edge taken from it. The queue
+/// takes the classes in the order they were found (the oldest first), so that a class upstream
+/// has grown before those downstream are expanded again from it. After the class has grown
+/// `growths_before_widening` times, E is widened (H79, a bigger set) at every growth, so the
+/// exploration ends.
 ///
 /// Soundness: every reachable state lies in some F. By induction on runs: an initial state lies
 /// in the E of its class, and its time successors in F; a state reached by a jump from a state of
@@ -56,7 +58,7 @@ class HullExploration {
   /// hull took 5 to 8 times the CPU time of one of the exact exploration (fiscs04, fiscs05,
   /// disc_2, nav4, tte_7 against fischer_5 and fiscs05 explored exactly).
   static constexpr std::uint64_t kCostFactor = 5;
-  /// Times a class's entry set grows by hull before it is widened.
+  /// Times a class's entry set grows by hull before it is widened, by default.
   static constexpr int kGrowthsBeforeWidening = 8;
   /// A convex hull with more than this many facets per dimension is replaced by the constraint
   /// hull of the same two sets (ConvexPolyhedron::ConstraintHull: bigger, but its facets are
@@ -71,9 +73,11 @@ class HullExploration {
   /// LinearHybridSystem::ReadSlots), charging `meter`. Throws std::invalid_argument where the
   /// system is outside the linear class (as the exact exploration does).
   /// `progress` (if set) is called every 64 expansions with the classes kept and those queued.
+  /// A class is widened from its `growths_before_widening` + 1st growth on (at least 1).
   HullExploration(const System& system, std::vector<const Property*> properties,
                   const std::vector<int>& read, ReachMeter& meter,
-                  std::function<void(int classes, int queued)> progress = nullptr);
+                  std::function<void(int classes, int queued)> progress = nullptr,
+                  int growths_before_widening = kGrowthsBeforeWidening);
 
   /// Explores until the meter's slice (or share) ends, the fixpoint, or nothing is left to prove:
   /// `settled[i]` says property i no longer needs the hull (decided by another exploration).
@@ -83,6 +87,11 @@ class HullExploration {
   /// After kFixpoint: whether property i's bad (target) states lie outside every class's
   /// states, so that it holds (`proved`; `unreachable` for `reach`).
   bool Misses(int i) const { return !met_[static_cast<std::size_t>(i)]; }
+  /// Whether the exploration stopped on a coefficient past kMaxBits (kAbandoned).
+  bool too_long() const { return too_long_; }
+  /// Whether some class has been widened. Until then the exploration is the same for every
+  /// `growths_before_widening` at least as large as this one's.
+  bool widened() const { return widened_; }
   /// The classes (polyhedra kept) and the locations they lie in.
   long long classes() const { return static_cast<long long>(classes_.size()); }
   int locations() const { return lhs_.num_locations(); }
@@ -93,6 +102,7 @@ class HullExploration {
     ConvexPolyhedron entry;
     ConvexPolyhedron flowed = ConvexPolyhedron::Universe(0);
     int growths = 0;
+    long long order = 0;
     bool queued = false;
   };
 
@@ -108,12 +118,15 @@ class HullExploration {
   std::vector<const Property*> properties_;
   ReachMeter& meter_;
   std::function<void(int, int)> progress_;
+  int growths_before_widening_;
   long long expanded_ = 0;
   bool started_ = false;
   bool abandoned_ = false;
+  bool too_long_ = false;
+  bool widened_ = false;
   std::vector<bool> met_;
   std::map<Key, Class> classes_;
-  std::deque<std::map<Key, Class>::iterator> queue_;
+  std::map<long long, std::map<Key, Class>::iterator> queue_;
   std::map<const LinearLocation*, std::vector<int>> constant_dims_;
   std::map<std::pair<std::size_t, const LinearLocation*>, std::vector<ConvexPolyhedron>> bad_;
 };

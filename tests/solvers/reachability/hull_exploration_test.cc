@@ -160,5 +160,34 @@ TEST(HullExploration, EndsThroughTheWideningWhereTheExactExplorationCannot) {
   EXPECT_EQ(violated.verdict, Verdict::kViolated) << violated.reason;
 }
 
+// n counts laps up to 10 (n := n + 1 while n <= 9, from [0, 1/2]), so n <= 10 always; y is
+// halved and raised by 1 at every lap, as in kHalving, so the exact exploration never ends. The
+// hulls' first widening (after 5 growths) drops n's upper bound with y's, and then meets n > 10;
+// the later one (after 32) comes when n's hull has reached [0, 10], which the widening keeps.
+constexpr std::string_view kCounting = R"(
+automaton counting {
+  var x, n, y;
+  mode lap { x' = 1; inv x <= 1; }
+  transition count: lap -> lap { guard x == 1 and n <= 9; reset x := 0, n := n + 1; }
+  transition halve: lap -> lap { guard x == 1; reset x := 0, y := y / 2 + 1; }
+  init lap { x = 0; n in [0, 0.5]; y in [0, 0.5]; }
+}
+system counting {
+  instance C = counting;
+  property at_most_ten: always C.n <= 10;
+  property at_most_9_5: always C.n <= 9.5;
+}
+)";
+
+TEST(HullExploration, WidensLaterWhereTheFirstWideningLosesTheProperty) {
+  const CheckResult r = CheckOne(kCounting, "at_most_ten");
+  EXPECT_EQ(r.verdict, Verdict::kProved) << r.reason;
+  EXPECT_TRUE(Says(r, kByHull)) << r.reason;
+  EXPECT_EQ(CheckOne(kCounting, "at_most_ten", 0, 0.5).verdict, Verdict::kUnknown);
+  // n = 10 after 10 counts from 0: violated, with the exact exploration's run.
+  const CheckResult violated = CheckOne(kCounting, "at_most_9_5");
+  EXPECT_EQ(violated.verdict, Verdict::kViolated) << violated.reason;
+}
+
 }  // namespace
 }  // namespace hybrid
