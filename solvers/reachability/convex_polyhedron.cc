@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <variant>
 
 namespace hybrid {
@@ -281,30 +282,187 @@ bool ConvexPolyhedron::Contains(const ConvexPolyhedron& other) const {
   return Impl::Both(self, *other.impl_, [](const auto& x, const auto& y) { return x.contains(y); });
 }
 
+namespace {
+
+// How closed polyhedron x lies with respect to one constraint: disjoint from its set, included
+// in it, or neither (PPL's Poly_Con_Relation, the two parts used here).
+enum class Relation { kDisjoint, kIncluded, kOther };
+
+Relation Relate(const ppl::C_Polyhedron& x, const ppl::Constraint& c) {
+  const ppl::Poly_Con_Relation r = x.relation_with(c);
+  if (r.implies(ppl::Poly_Con_Relation::is_disjoint())) return Relation::kDisjoint;
+  if (r.implies(ppl::Poly_Con_Relation::is_included())) return Relation::kIncluded;
+  return Relation::kOther;
+}
+
+// Whether closed, non-empty x meets the set of `constraints`, each related to x by `relate`:
+// one that x lies outside of settles it (disjoint); those that x lies inside of drop out; if at
+// most one is left, x meets the set (x meets that constraint's set, and lies in the others');
+// else nullopt (undecided).
+template <class Relate>
+std::optional<bool> MeetsByRelations(const ppl::Constraint_System& constraints, Relate&& relate) {
+  int left = 0;
+  for (const ppl::Constraint& c : constraints) {
+    const Relation r = relate(c);
+    if (r == Relation::kDisjoint) return false;
+    if (r != Relation::kIncluded) ++left;
+  }
+  if (left <= 1) return true;
+  return std::nullopt;
+}
+
+// Integers below 2^58 in magnitude: a scalar product of two rows of at most 1024 of them is
+// below 2^126, exact in 128 bits.
+constexpr int kSmallBits = 58;
+__extension__ typedef __int128 Int128;  // GCC's and Clang's, on the 64-bit targets built for
+constexpr std::size_t kMaxSmallRow = 1024;
+
+bool Small(const mpz_class& z, std::int64_t* out) {
+  if (mpz_sizeinbase(z.get_mpz_t(), 2) > static_cast<std::size_t>(kSmallBits)) return false;
+  *out = z.get_si();
+  return true;
+}
+
+// A closed polyhedron's generators as machine integers, every coefficient and divisor small
+// (Small): per generator its kind, its divisor (points) and its dims() coefficients.
+struct SmallGenerators {
+  enum class Kind { kPoint, kRay, kLine };
+  std::size_t dims = 0;
+  std::vector<Kind> kinds;
+  std::vector<std::int64_t> divisors;
+  std::vector<std::int64_t> coefficients;  // row-major, dims per generator
+};
+
+std::optional<SmallGenerators> SmallGeneratorsOf(const ppl::C_Polyhedron& x) {
+  SmallGenerators g;
+  g.dims = x.space_dimension();
+  if (g.dims + 1 > kMaxSmallRow) return std::nullopt;
+  for (const ppl::Generator& gen : x.generators()) {
+    std::int64_t divisor = 0;
+    if (gen.is_point()) {
+      if (!Small(gen.divisor(), &divisor)) return std::nullopt;
+      g.kinds.push_back(SmallGenerators::Kind::kPoint);
+    } else {
+      g.kinds.push_back(gen.is_ray() ? SmallGenerators::Kind::kRay : SmallGenerators::Kind::kLine);
+    }
+    g.divisors.push_back(divisor);
+    for (ppl::dimension_type i = 0; i < g.dims; ++i) {
+      std::int64_t v = 0;
+      if (!Small(gen.coefficient(ppl::Variable(i)), &v)) return std::nullopt;
+      g.coefficients.push_back(v);
+    }
+  }
+  return g;
+}
+
+// Relate(x, c) from x's small generators `g` (nullopt where c's coefficients are not small). For
+// c's form f (c is f >= 0, f > 0 or f = 0): f(p) at each point p has the sign of
+// f's integer form times p's divisor; along a line f is constant or takes every value (then
+// neither relation holds); its infimum over x is its least value at a point unless it decreases
+// along some ray (then minus infinity), its supremum likewise. x lies in c's set iff the
+// infimum satisfies c (attained at a point, so strictly for f > 0); x misses it iff the
+// supremum fails f >= 0 or f > 0 (for f = 0: the supremum is negative or the infimum positive).
+std::optional<Relation> RelateSmall(const SmallGenerators& g, const ppl::Constraint& c) {
+  std::int64_t b = 0;
+  if (!Small(c.inhomogeneous_term(), &b)) return std::nullopt;
+  std::vector<std::int64_t> a(g.dims, 0);
+  for (ppl::dimension_type i = 0; i < c.space_dimension(); ++i) {
+    if (!Small(c.coefficient(ppl::Variable(i)), &a[i])) return std::nullopt;
+  }
+  // Over the points: every f(p) >= 0, > 0, <= 0, < 0; over the rays: f never decreasing, never
+  // increasing.
+  bool p_ge = true, p_gt = true, p_le = true, p_lt = true, r_ge = true, r_le = true;
+  for (std::size_t k = 0; k < g.kinds.size(); ++k) {
+    Int128 s = 0;
+    const std::int64_t* row = &g.coefficients[k * g.dims];
+    for (std::size_t i = 0; i < g.dims; ++i) s += static_cast<Int128>(a[i]) * row[i];
+    const int sign = (s > 0) - (s < 0);
+    switch (g.kinds[k]) {
+      case SmallGenerators::Kind::kLine:
+        if (sign != 0) return Relation::kOther;
+        break;
+      case SmallGenerators::Kind::kRay:
+        r_ge = r_ge && sign >= 0;
+        r_le = r_le && sign <= 0;
+        break;
+      case SmallGenerators::Kind::kPoint: {
+        s += static_cast<Int128>(b) * g.divisors[k];
+        const int at = (s > 0) - (s < 0);
+        p_ge = p_ge && at >= 0;
+        p_gt = p_gt && at > 0;
+        p_le = p_le && at <= 0;
+        p_lt = p_lt && at < 0;
+        break;
+      }
+    }
+  }
+  bool included = false, disjoint = false;
+  switch (c.type()) {
+    case ppl::Constraint::NONSTRICT_INEQUALITY:
+      included = p_ge && r_ge;
+      disjoint = p_lt && r_le;
+      break;
+    case ppl::Constraint::STRICT_INEQUALITY:
+      included = p_gt && r_ge;
+      disjoint = p_le && r_le;
+      break;
+    case ppl::Constraint::EQUALITY:
+      included = p_ge && p_le && r_ge && r_le;
+      disjoint = (p_lt && r_le) || (p_gt && r_ge);
+      break;
+  }
+  if (disjoint) return Relation::kDisjoint;
+  if (included) return Relation::kIncluded;
+  return Relation::kOther;
+}
+
+}  // namespace
+
 bool ConvexPolyhedron::Intersects(const ConvexPolyhedron& other) const {
   if (other.dims() != dims()) throw std::invalid_argument("polyhedra of different dimensions");
   // With a closed one, x: each constraint of the other against the generators of x (PPL's
   // relation test, exact, with no intersection to convert and no not-necessarily-closed copy
-  // of x). One that x lies outside of settles it (disjoint); those that x lies inside of drop
-  // out; if at most one is left, x meets the other (x meets that constraint's set, and lies in
-  // the others'). A property's bad part is usually one half-space, its other bounds kept by the
-  // state, so the intersection is seldom built.
+  // of x; MeetsByRelations). A property's bad part is usually one half-space, its other bounds
+  // kept by the state, so the intersection is seldom built.
   const Impl* closed = impl_.get();
   const Impl* rest = other.impl_.get();
   if (!closed->closed()) std::swap(closed, rest);
   if (closed->closed()) {
     const ppl::C_Polyhedron& x = closed->c();
     if (x.is_empty()) return false;
-    int left = 0;
-    for (const ppl::Constraint& c : rest->Constraints()) {
-      const ppl::Poly_Con_Relation r = x.relation_with(c);
-      if (r.implies(ppl::Poly_Con_Relation::is_disjoint())) return false;
-      if (!r.implies(ppl::Poly_Con_Relation::is_included())) ++left;
-    }
-    if (left <= 1) return true;
+    const std::optional<bool> meets = MeetsByRelations(
+        rest->Constraints(), [&x](const ppl::Constraint& c) { return Relate(x, c); });
+    if (meets) return *meets;
   }
   return Impl::Both(*impl_, *other.impl_,
                     [](const auto& x, const auto& y) { return !x.is_disjoint_from(y); });
+}
+
+std::vector<bool> ConvexPolyhedron::IntersectsEach(
+    std::span<const ConvexPolyhedron* const> others) const {
+  std::vector<bool> meets;
+  meets.reserve(others.size());
+  std::optional<SmallGenerators> small;
+  if (impl_->closed() && !impl_->c().is_empty()) small = SmallGeneratorsOf(impl_->c());
+  for (const ConvexPolyhedron* other : others) {
+    if (other->dims() != dims()) throw std::invalid_argument("polyhedra of different dimensions");
+    if (!small) {
+      meets.push_back(Intersects(*other));
+      continue;
+    }
+    const ppl::C_Polyhedron& x = impl_->c();
+    const std::optional<bool> decided =
+        MeetsByRelations(other->impl_->Constraints(), [&](const ppl::Constraint& c) {
+          const std::optional<Relation> r = RelateSmall(*small, c);
+          return r ? *r : Relate(x, c);
+        });
+    // Undecided: the intersection, this set kept closed for the others (a copy made NNC).
+    meets.push_back(
+        decided ? *decided
+                : Impl::Both(std::as_const(*impl_), *other->impl_,
+                             [](const auto& p, const auto& q) { return !p.is_disjoint_from(q); }));
+  }
+  return meets;
 }
 
 void ConvexPolyhedron::TimeElapse(const ConvexPolyhedron& rates) {

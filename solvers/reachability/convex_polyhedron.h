@@ -59,6 +59,11 @@ class ConvexPolyhedron {
   bool Contains(const ConvexPolyhedron& other) const;
   /// Whether the two share a point.
   bool Intersects(const ConvexPolyhedron& other) const;
+  /// Intersects(*others[k]) for each k (each of this set's dimension), with the same answers:
+  /// where this set is closed, its generators are read once for all of them, and each relation
+  /// test of a constraint against them is made in 128-bit integers where every coefficient of
+  /// both is below 2^58 in magnitude (exact: each scalar product is below 2^126).
+  std::vector<bool> IntersectsEach(std::span<const ConvexPolyhedron* const> others) const;
   /// {x + t r : x in this, r in rates, t >= 0}: the states reached by letting time elapse at any
   /// constant rate of `rates` (a polyhedron of derivatives, same dims).
   void TimeElapse(const ConvexPolyhedron& rates);

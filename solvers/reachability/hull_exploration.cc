@@ -166,13 +166,12 @@ void HullExploration::CheckProperties(const LinearLocation& loc, const ConvexPol
         if (!set.IsEmpty()) it->second.push_back(std::move(set));
       }
     }
+    std::vector<const ConvexPolyhedron*> sets;
     for (const ConvexPolyhedron& bad : it->second) {
       meter_.Op(bad, states);
-      if (bad.Intersects(states)) {
-        met_[i] = true;
-        break;
-      }
+      sets.push_back(&bad);
     }
+    for (const bool meets : states.IntersectsEach(sets)) met_[i] = met_[i] || meets;
   }
 }
 

@@ -296,9 +296,16 @@ class Explorer {
   void CheckGoal(int index, int n) {
     Goal& g = goals_[index];
     const LinearLocation& loc = lhs_.At(nodes_[n].tuple);
-    for (const BadPart& bad : Bad(index, loc)) {
+    const std::vector<BadPart>& parts = Bad(index, loc);
+    std::vector<const ConvexPolyhedron*> sets;
+    for (const BadPart& bad : parts) {
       meter_.Op(bad.set, nodes_[n].set);
-      if (!bad.set.Intersects(nodes_[n].set)) continue;
+      sets.push_back(&bad.set);
+    }
+    const std::vector<bool> meets = nodes_[n].set.IntersectsEach(sets);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      if (!meets[k]) continue;
+      const BadPart& bad = parts[k];
       g.met = true;
       if (g.concretizations >= kMaxConcretizations) continue;
       if (Bound() != Stop::kNone) continue;  // no run is sought past a bound

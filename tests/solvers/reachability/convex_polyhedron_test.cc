@@ -320,6 +320,85 @@ TEST(ConvexPolyhedron, IntersectsAgreesWithTheIntersectionAndWithPoints) {
   EXPECT_GT(missed, 50);
 }
 
+// IntersectsEach by hand, where a relation test in integers could go wrong: a strict bad
+// constraint that the state only touches, and bounds that a ray of the state passes.
+TEST(ConvexPolyhedron, IntersectsEachAtTheBoundaryAndAlongRays) {
+  // The unit square and {x > 0, y - x >= 1}: x > 0 holds on part of the square only, and
+  // y - x >= 1 only at (0, 1), where x > 0 fails: disjoint.
+  const ConvexPolyhedron square = Rectangle(0, 1, 0, 1);
+  const ConvexPolyhedron corner =
+      Plane({{{-1, 0}, 0, Kind::kLess}, {{1, -1}, 1, Kind::kLessEqual}});
+  // {x > 1}: the square touches it only on its closure: disjoint. {x >= 1}: met.
+  const ConvexPolyhedron right = Plane({{{-1, 0}, 1, Kind::kLess}});
+  const ConvexPolyhedron right_closed = Plane({{{-1, 0}, 1, Kind::kLessEqual}});
+  const std::vector<const ConvexPolyhedron*> square_parts = {&corner, &right, &right_closed};
+  EXPECT_EQ(square.IntersectsEach(square_parts), (std::vector<bool>{false, false, true}));
+  // The half-line {x >= 1, y = 0}: a point and a ray. It meets x = 2 and x >= 2 further on,
+  // misses x = 0 and x <= 0, and lies in x >= 0 and y = 0.
+  const ConvexPolyhedron half_line =
+      Plane({{{-1, 0}, 1, Kind::kLessEqual}, {{0, 1}, 0, Kind::kEqual}});
+  const ConvexPolyhedron at_two = Plane({{{1, 0}, -2, Kind::kEqual}});
+  const ConvexPolyhedron past_two = Plane({{{-1, 0}, 2, Kind::kLessEqual}});
+  const ConvexPolyhedron at_zero = Plane({{{1, 0}, 0, Kind::kEqual}});
+  const ConvexPolyhedron below_zero = Plane({{{1, 0}, 0, Kind::kLessEqual}});
+  const ConvexPolyhedron on_axis =
+      Plane({{{-1, 0}, 0, Kind::kLessEqual}, {{0, 1}, 0, Kind::kEqual}});
+  const std::vector<const ConvexPolyhedron*> line_parts = {&at_two, &past_two, &at_zero,
+                                                           &below_zero, &on_axis};
+  EXPECT_EQ(half_line.IntersectsEach(line_parts),
+            (std::vector<bool>{true, true, false, false, true}));
+  // The line y = 1 (a line generator): it meets y = 1 and x >= 5 together, and misses y = 0.
+  const ConvexPolyhedron line = Plane({{{0, 1}, -1, Kind::kEqual}});
+  const ConvexPolyhedron far = Plane({{{-1, 0}, 5, Kind::kLessEqual}, {{0, 1}, -1, Kind::kEqual}});
+  const ConvexPolyhedron floor = Plane({{{0, 1}, 0, Kind::kEqual}});
+  const std::vector<const ConvexPolyhedron*> parts = {&far, &floor};
+  EXPECT_EQ(line.IntersectsEach(parts), (std::vector<bool>{true, false}));
+}
+
+// IntersectsEach (the relation tests in machine integers) against the intersection built and
+// tested for emptiness, on random sets in 3 dimensions: bounded or with rays and lines (fewer
+// constraints than dimensions), closed or with a strict constraint, with bad parts of 1 to 3
+// constraints of each kind, and some coefficients past 2^58 (the exact relation test instead).
+TEST(ConvexPolyhedron, IntersectsEachAgreesWithTheIntersection) {
+  std::mt19937_64 rng(20261201);
+  const auto number = [&rng](int lo, int hi) {  // an integer in [lo, hi], divided by 3
+    return static_cast<double>(lo + static_cast<int>(rng() % static_cast<unsigned>(hi - lo + 1))) /
+           3.0;
+  };
+  const auto constraint = [&](Kind kind) {
+    LinearConstraint c{{number(-6, 6), number(-6, 6), number(-6, 6)}, number(-12, 12), kind};
+    if (rng() % 8 == 0) c.a[rng() % 3] *= 1e19;  // past 2^58
+    return c;
+  };
+  const Kind kinds[] = {Kind::kLess, Kind::kLessEqual, Kind::kEqual};
+  int met = 0, missed = 0;
+  for (int round = 0; round < 300; ++round) {
+    ConvexPolyhedron state = ConvexPolyhedron::Universe(3);
+    const int n = 1 + static_cast<int>(rng() % 5);
+    for (int k = 0; k < n; ++k) {
+      state.AddConstraint(constraint(rng() % 6 == 0 ? Kind::kLess : Kind::kLessEqual));
+    }
+    std::vector<ConvexPolyhedron> bad;
+    for (int part = 0; part < 4; ++part) {
+      bad.push_back(ConvexPolyhedron::Universe(3));
+      const int m = 1 + static_cast<int>(rng() % 3);
+      for (int k = 0; k < m; ++k) bad.back().AddConstraint(constraint(kinds[rng() % 3]));
+    }
+    std::vector<const ConvexPolyhedron*> parts;
+    for (const ConvexPolyhedron& b : bad) parts.push_back(&b);
+    const std::vector<bool> meets = state.IntersectsEach(parts);
+    ASSERT_EQ(meets.size(), bad.size());
+    for (std::size_t k = 0; k < bad.size(); ++k) {
+      ConvexPolyhedron both = state;
+      both.Intersect(bad[k]);
+      EXPECT_EQ(meets[k], !both.IsEmpty()) << round << " part " << k;
+      (meets[k] ? met : missed) += 1;
+    }
+  }
+  EXPECT_GT(met, 200);
+  EXPECT_GT(missed, 200);
+}
+
 // Bounds (one pass over the generators) against the supremum of x and of -x and of y and -y
 // (PPL's optimisation), on random sets: bounded or not, closed or with a strict constraint.
 TEST(ConvexPolyhedron, BoundsAgreeWithTheSupremaPerDimension) {
