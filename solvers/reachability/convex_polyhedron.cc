@@ -323,6 +323,26 @@ bool Small(const mpz_class& z, std::int64_t* out) {
   return true;
 }
 
+// Whether generator g's n coefficients (and divisor, for a point) are all below 2^kSmallBits.
+bool SmallRow(const ppl::Generator& g, size_t n) {
+  std::int64_t v = 0;
+  if ((g.is_point() || g.is_closure_point()) && !Small(g.divisor(), &v)) return false;
+  for (size_t i = 0; i < n; ++i) {
+    if (!Small(g.coefficient(ppl::Variable(i)), &v)) return false;
+  }
+  return true;
+}
+
+int Compare(Int128 a, Int128 b) { return (a > b) - (a < b); }
+int Compare(const mpz_class& a, const mpz_class& b) {
+  const int c = cmp(a, b);
+  return (c > 0) - (c < 0);
+}
+mpz_class ToMpz(Int128 v) {  // |v| < 2^58 here
+  return mpz_class(static_cast<long>(v));
+}
+mpz_class ToMpz(const mpz_class& v) { return v; }
+
 // A closed polyhedron's generators as machine integers, every coefficient and divisor small
 // (Small): per generator its kind, its divisor (points) and its dims() coefficients.
 struct SmallGenerators {
@@ -718,35 +738,32 @@ ConvexPolyhedron ConvexPolyhedron::CentralPoint() const {
       std::make_unique<Impl>(Impl{ppl::C_Polyhedron(ppl::Generator_System(PointOf(centre)))}));
 }
 
-std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
-  const size_t n = static_cast<size_t>(dims());
-  std::vector<std::pair<double, double>> out(n, {INFINITY, -INFINITY});
-  if (IsEmpty()) return out;
-  // Each extreme as the coefficient and divisor of the point that has it (c / d, d > 0),
-  // compared by cross-multiplication: no rational made canonical (a gcd) per coordinate.
+namespace {
+
+// Each dimension's least and greatest value over generators `gens` (of a non-empty polyhedron in
+// n dimensions, points and closure points alike), each extreme as the coefficient and divisor of
+// the point that has it (c / d, d > 0), compared by cross-multiplication: no rational made
+// canonical (a gcd) per coordinate. In 128-bit integers where every coefficient is below 2^58
+// (exact: each product is below 2^116), else GMP's.
+template <class Int, class Read>
+std::vector<std::pair<double, double>> ExtremesOf(const ppl::Generator_System& gens, size_t n,
+                                                  Read&& read) {
   struct Extreme {
-    mpz_class c, d;
+    Int c{}, d{};
     bool set = false;
   };
   std::vector<Extreme> lo(n), hi(n);
   std::vector<bool> below(n, false), above(n, false);  // unbounded that way
-  mpz_class left, right;
-  // Whether c / d lies beyond `e` (below it for lo, above for hi), so replaces it.
-  const auto beyond = [&](const Extreme& e, mpz_srcptr c, mpz_srcptr d, int side) {
-    if (!e.set) return true;
-    mpz_mul(left.get_mpz_t(), c, e.d.get_mpz_t());
-    mpz_mul(right.get_mpz_t(), e.c.get_mpz_t(), d);
-    return side * mpz_cmp(left.get_mpz_t(), right.get_mpz_t()) > 0;
-  };
-  for (const ppl::Generator& g : impl_->Generators()) {
+  for (const ppl::Generator& g : gens) {
     if (g.is_point() || g.is_closure_point()) {
-      mpz_srcptr d = ppl::raw_value(g.divisor()).get_mpz_t();
+      const Int d = read(g.divisor());
       for (size_t i = 0; i < n; ++i) {
-        mpz_srcptr c = ppl::raw_value(g.coefficient(ppl::Variable(i))).get_mpz_t();
+        const Int c = read(g.coefficient(ppl::Variable(i)));
+        // c / d below lo (side -1) or above hi (side 1) replaces it.
         for (auto [e, side] : {std::pair{&lo[i], -1}, std::pair{&hi[i], 1}}) {
-          if (!beyond(*e, c, d, side)) continue;
-          mpz_set(e->c.get_mpz_t(), c);
-          mpz_set(e->d.get_mpz_t(), d);
+          if (e->set && !(side * Compare(Int(c * e->d), Int(e->c * d)) > 0)) continue;
+          e->c = c;
+          e->d = d;
           e->set = true;
         }
       }
@@ -759,15 +776,32 @@ std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
     }
   }
   const auto value = [](const Extreme& e) {
-    mpq_class q(e.c, e.d);
+    mpq_class q(ToMpz(e.c), ToMpz(e.d));
     q.canonicalize();
     return NearestDouble(q);
   };
+  std::vector<std::pair<double, double>> out(n);
   for (size_t i = 0; i < n; ++i) {
     out[i].first = below[i] ? -INFINITY : value(lo[i]);
     out[i].second = above[i] ? INFINITY : value(hi[i]);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<std::pair<double, double>> ConvexPolyhedron::Bounds() const {
+  const size_t n = static_cast<size_t>(dims());
+  if (IsEmpty()) return std::vector<std::pair<double, double>>(n, {INFINITY, -INFINITY});
+  const ppl::Generator_System& gens = impl_->Generators();
+  bool small = true;
+  for (auto g = gens.begin(); small && g != gens.end(); ++g) small = SmallRow(*g, n);
+  if (small) {
+    return ExtremesOf<Int128>(gens, n, [](const ppl::Coefficient& c) {
+      return static_cast<Int128>(ppl::raw_value(c).get_si());
+    });
+  }
+  return ExtremesOf<mpz_class>(gens, n, [](const ppl::Coefficient& c) { return ToInteger(c); });
 }
 
 bool ConvexPolyhedron::IsPoint() const {
