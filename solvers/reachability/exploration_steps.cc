@@ -94,6 +94,12 @@ std::optional<ConvexPolyhedron> Entering(const LinearLocation& target, ConvexPol
                                          ReachMeter& meter) {
   set = Forgetting(target, std::move(set), meter);
   if (!target.invariant.empty()) {  // else every state (and `set` is not empty)
+    meter.Op(target.invariant_set, set);
+    // Already inside it (a reset into it): no constraint to add, no conversion to make.
+    if (target.invariant_set.Contains(set)) {
+      if (set.IsEmpty()) return std::nullopt;
+      return set;
+    }
     set.Intersect(target.invariant_set);
     meter.Op(set, 2);
     if (set.IsEmpty()) return std::nullopt;

@@ -72,6 +72,13 @@ TEST(ExplorationSteps, AJumpKeepsItsGuardAndResetsAndEntersInsideTheInvariant) {
   const std::optional<ConvexPolyhedron> entered = Entering(target, *jumped, meter);
   ASSERT_TRUE(entered.has_value());
   EXPECT_TRUE(SameSet(*entered, Rectangle(2, 3, 1, 1.5)));
+  // An invariant that holds on all of it (y <= 2): the set as it is; none of an empty set.
+  target.invariant = {{{0, 1}, -2, Kind::kLessEqual}};
+  target.invariant_set = Plane(target.invariant);
+  const std::optional<ConvexPolyhedron> inside = Entering(target, *jumped, meter);
+  ASSERT_TRUE(inside.has_value());
+  EXPECT_TRUE(SameSet(*inside, Rectangle(2, 3, 1, 2)));
+  EXPECT_FALSE(Entering(target, ConvexPolyhedron::Empty(2), meter).has_value());
   // An invariant it misses, a guard it misses.
   target.invariant = {{{0, 1}, -0.5, Kind::kLessEqual}};
   target.invariant_set = Plane(target.invariant);
