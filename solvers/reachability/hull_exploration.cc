@@ -114,7 +114,8 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
       meter_.Op(c.entry, set);
       meter_.Op(c.entry);
     }
-    if (++c.growths > growths_before_widening_) {  // each hull contains `previous`
+    if (!c.queued) ++c.growths;
+    if (c.growths > growths_before_widening_) {  // each hull contains `previous`
       c.entry.Widen(previous);
       widened_ = true;
       c.entry.Intersect(loc.invariant_set);

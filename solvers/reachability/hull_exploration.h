@@ -28,8 +28,9 @@ namespace hybrid {
 /// A new entry set contained in E is dropped; else E grows to the hull of both and the class is
 /// queued to be expanded again: F is computed again and every edge taken from it. The queue
 /// takes the classes in the order they were found (the oldest first), so that a class upstream
-/// has grown before those downstream are expanded again from it. After the class has grown
-/// `growths_before_widening` times, E is widened (H79, a bigger set) at every growth, so the
+/// has grown before those downstream are expanded again from it. Once the class has been queued
+/// again for a growth `growths_before_widening` times (growths while it waits in the queue count
+/// once: they make one more expansion), E is widened (H79, a bigger set) at every growth, so the
 /// exploration ends.
 ///
 /// Soundness: every reachable state lies in some F. By induction on runs: an initial state lies
@@ -58,8 +59,6 @@ class HullExploration {
   /// hull took 5 to 8 times the CPU time of one of the exact exploration (fiscs04, fiscs05,
   /// disc_2, nav4, tte_7 against fischer_5 and fiscs05 explored exactly).
   static constexpr std::uint64_t kCostFactor = 5;
-  /// Times a class's entry set grows by hull before it is widened, by default.
-  static constexpr int kGrowthsBeforeWidening = 8;
   /// A convex hull with more than this many facets per dimension is replaced by the constraint
   /// hull of the same two sets (ConvexPolyhedron::ConstraintHull: bigger, but its facets are
   /// among theirs): the conversions between facets and vertices, which every operation on the
@@ -73,11 +72,12 @@ class HullExploration {
   /// LinearHybridSystem::ReadSlots), charging `meter`. Throws std::invalid_argument where the
   /// system is outside the linear class (as the exact exploration does).
   /// `progress` (if set) is called every 64 expansions with the classes kept and those queued.
-  /// A class is widened from its `growths_before_widening` + 1st growth on (at least 1).
+  /// A class is widened once it has been queued again for growths more than
+  /// `growths_before_widening` times (taken as at least 1).
   HullExploration(const System& system, std::vector<const Property*> properties,
                   const std::vector<int>& read, ReachMeter& meter,
-                  std::function<void(int classes, int queued)> progress = nullptr,
-                  int growths_before_widening = kGrowthsBeforeWidening);
+                  std::function<void(int classes, int queued)> progress,
+                  int growths_before_widening);
 
   /// Explores until the meter's slice (or share) ends, the fixpoint, or nothing is left to prove:
   /// `settled[i]` says property i no longer needs the hull (decided by another exploration).
@@ -101,7 +101,7 @@ class HullExploration {
   struct Class {
     ConvexPolyhedron entry;
     ConvexPolyhedron flowed = ConvexPolyhedron::Universe(0);
-    int growths = 0;
+    int growths = 0;  // the times E grew while the class was not queued
     long long order = 0;
     bool queued = false;
   };

@@ -555,7 +555,9 @@ TEST(ConvexPolyhedron, ClosedAndNotNecessarilyClosedGiveTheSameSets) {
     EXPECT_EQ(attained_a, attained_b) << round;
     const std::vector<int> to = {2, 0};
     EXPECT_TRUE(SameSet(p.Embedded(3, to), pn.Embedded(3, to))) << round;
-    if (!p.IsEmpty()) EXPECT_TRUE(p.Contains(pn.CentralPoint())) << round;
+    if (!p.IsEmpty()) {
+      EXPECT_TRUE(p.Contains(pn.CentralPoint())) << round;
+    }
   }
 }
 
