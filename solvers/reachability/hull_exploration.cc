@@ -129,6 +129,7 @@ void HullExploration::Add(const std::vector<int>& tuple, ConvexPolyhedron set) {
     }
   }
   Class& c = it->second;
+  CheckProperties(loc, c.entry);  // E lies in F: a bad state met here is met there
   if (!c.queued) {
     c.queued = true;
     queue_.emplace(c.order, it);
