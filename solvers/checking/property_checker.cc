@@ -56,12 +56,16 @@ std::vector<CheckResult> FallbackChecker::Check(const System& system,
     }
     std::vector<Property> left;
     std::vector<std::size_t> where;
+    bool open = false;
     for (std::size_t i = 0; i < results.size(); ++i) {
       if (!IsOpen(results[i])) continue;
+      open = true;
+      if (results[i].states_met && !checker->Falsifies()) continue;  // it could not decide it
       left.push_back(properties[i]);
       where.push_back(i);
     }
-    if (left.empty()) break;
+    if (!open) break;
+    if (left.empty()) continue;
     const std::vector<CheckResult> later = checker->Check(system, left);
     for (std::size_t k = 0; k < later.size() && k < where.size(); ++k) {
       CheckResult& r = results[where[k]];

@@ -44,7 +44,8 @@ struct Goal {
   bool decided = false;
   bool met = false;  // the reachable set met its bad (target) states without a replayed trace
   std::string why_no_trace;
-  int concretizations = 0;  // runs sought for it (at most kMaxConcretizations)
+  int concretizations = 0;   // runs sought for it (at most kMaxConcretizations)
+  bool met_exactly = false;  // met at a state whose path's rates are exact (not widened)
 };
 
 // Most runs sought per goal: each walks its path backwards with polyhedra, so a goal met by many
@@ -307,6 +308,7 @@ class Explorer {
       if (!meets[k]) continue;
       const BadPart& bad = parts[k];
       g.met = true;
+      g.met_exactly = g.met_exactly || ExactAlong(n);
       if (g.concretizations >= kMaxConcretizations) continue;
       if (Bound() != Stop::kNone) continue;  // no run is sought past a bound
       ++g.concretizations;
@@ -327,6 +329,15 @@ class Explorer {
       }
       g.why_no_trace = r.reason;
     }
+  }
+
+  // Whether the rates of every location on the path to node n are exact (no uncertain
+  // parameter's range in place of its value).
+  bool ExactAlong(int n) {
+    for (const int k : PathOf(n)) {
+      if (!LocationOf(k).exact_rates) return false;
+    }
+    return true;
   }
 
   std::vector<int> PathOf(int n) const {
@@ -595,6 +606,7 @@ void Explorer::Finish(Stop stop) {
     CheckResult& r = *g.result;
     r.verdict = Verdict::kUnknown;
     r.trace.reset();
+    r.states_met = g.met_exactly;
     if (g.met && g.concretizations == 0) {
       r.reason = "the reachable set meets the property's states, but " + stopped +
                  " before a run reaching them was sought (" + size.str() + ")" + caveat;

@@ -42,6 +42,11 @@ struct CheckResult {
   /// only the runs up to this model time (an engine that explored the reachable states that far
   /// and no farther: "proved within T"); absent for a verdict that holds for all time.
   std::optional<double> within;
+  /// For `unknown`: the engine computed the reachable states exactly (up to the closure of the
+  /// model's strict constraints) and they meet the property's bad (or target) states; only a run
+  /// that replays is missing. An engine that can only prove, by enclosing the reachable states
+  /// (PropertyChecker::Falsifies false), cannot decide it, so FallbackChecker does not ask one.
+  bool states_met = false;
 };
 
 /// The gate every verdict that rests on a trace passes before it is reported. For `violated`

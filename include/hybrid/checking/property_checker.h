@@ -35,12 +35,17 @@ class PropertyChecker {
   /// The verdicts of `properties` (System slots, as System::properties() has them).
   virtual std::vector<CheckResult> Check(const System& system,
                                          std::span<const Property> properties) = 0;
+  /// Whether the engine can find violations (and witnesses) at all; false for one that only
+  /// proves by enclosing the reachable states. Defaults to true.
+  virtual bool Falsifies() const { return true; }
 };
 
 /// Checkers in order: the first that handles the properties decides what it can, and each later
 /// one is asked what is still open: `unknown` (its reason appended to the earlier ones' as
 /// "; NAME: reason", its time added), or decided only up to a time (CheckResult::within, a
-/// bounded answer to an unbounded question). A later result replaces the earlier one where it
+/// bounded answer to an unbounded question), except that a checker that does not falsify is not
+/// asked about a property whose reachable states an earlier one found to meet its bad states
+/// (CheckResult::states_met). A later result replaces the earlier one where it
 /// decides and the earlier did not, or decides for all time (a violation found by simulation, a
 /// proof without a bound), or up to a later time.
 /// The method of `hybrid check --method auto` (reachability, then the prover).

@@ -30,6 +30,8 @@ class FlowpipeChecker : public PropertyChecker {
                                  std::span<const Property> properties) override {
     return FlowpipeReachability(options_).Check(system, properties, nullptr, reach_set_);
   }
+  /// A flowpipe encloses the reachable states: it proves, or says `unknown`.
+  bool Falsifies() const override { return false; }
 
  private:
   FlowpipeReachability::Options options_;

@@ -9,6 +9,7 @@
 
 #include <map>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@ class ScriptedChecker : public PropertyChecker {
     if (!handles_ && why) *why = "not my kind of model";
     return handles_;
   }
+  bool Falsifies() const override { return falsifies_; }
   std::vector<CheckResult> Check(const System&, std::span<const Property> properties) override {
     std::vector<CheckResult> out;
     for (const Property& p : properties) {
@@ -39,6 +41,7 @@ class ScriptedChecker : public PropertyChecker {
       const auto it = script_.find(p.name);
       r.verdict = it == script_.end() ? Verdict::kUnknown : it->second;
       if (const auto w = within_.find(p.name); w != within_.end()) r.within = w->second;
+      r.states_met = met_.count(p.name) > 0;
       r.reason = name_ + " says so";
       out.push_back(r);
     }
@@ -47,6 +50,9 @@ class ScriptedChecker : public PropertyChecker {
   std::shared_ptr<std::vector<std::string>> asked = std::make_shared<std::vector<std::string>>();
   /// Properties whose verdict covers the runs up to a time only (CheckResult::within).
   std::map<std::string, double> within_;
+  /// Properties whose reachable states it found to meet their bad states (states_met).
+  std::set<std::string> met_;
+  bool falsifies_ = true;
 
  private:
   std::string name_;
@@ -135,6 +141,48 @@ TEST(FallbackChecker, BoundedProofsAreAskedAgainAndImprovedOnly) {
   EXPECT_EQ(r[2].within, 9.0);  // proved for longer
   EXPECT_FALSE(r[3].within.has_value());
   EXPECT_EQ(r[3].method, "flowpipe");
+}
+
+// A checker that only proves (a flowpipe) is not asked about a property whose exact reachable
+// states met its bad states; one after it that can falsify is.
+TEST(FallbackChecker, AsksNoProofOnlyCheckerWhatTheStatesMet) {
+  auto reach = std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{});
+  reach->met_ = {"a"};
+  auto flowpipe = std::make_unique<ScriptedChecker>(
+      "flowpipe", std::map<std::string, Verdict>{{"b", Verdict::kProved}});
+  flowpipe->falsifies_ = false;
+  auto prove = std::make_unique<ScriptedChecker>(
+      "prove", std::map<std::string, Verdict>{{"a", Verdict::kReachable}});
+  const auto flowpipe_asked = flowpipe->asked, prove_asked = prove->asked;
+  std::vector<std::unique_ptr<PropertyChecker>> checkers;
+  checkers.push_back(std::move(reach));
+  checkers.push_back(std::move(flowpipe));
+  checkers.push_back(std::move(prove));
+  FallbackChecker fallback("auto", std::move(checkers));
+  const System system("s");
+  const std::vector<CheckResult> r = fallback.Check(system, Named({"a", "b", "c"}));
+  EXPECT_EQ(*flowpipe_asked, (std::vector<std::string>{"flowpipe:b", "flowpipe:c"}));
+  EXPECT_EQ(*prove_asked, (std::vector<std::string>{"prove:a", "prove:c"}));
+  EXPECT_EQ(r[0].verdict, Verdict::kReachable);
+  EXPECT_EQ(r[0].method, "prove");
+  EXPECT_EQ(r[1].verdict, Verdict::kProved);
+  EXPECT_EQ(r[2].reason, "reach says so; flowpipe: flowpipe says so; prove: prove says so");
+  // Only the met property left open: the proof-only checker is skipped, the next one asked.
+  auto reach2 = std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{});
+  reach2->met_ = {"a"};
+  auto flowpipe2 = std::make_unique<ScriptedChecker>("flowpipe", std::map<std::string, Verdict>{});
+  flowpipe2->falsifies_ = false;
+  auto sample = std::make_unique<ScriptedChecker>("sample", std::map<std::string, Verdict>{});
+  const auto flowpipe2_asked = flowpipe2->asked, sample_asked = sample->asked;
+  std::vector<std::unique_ptr<PropertyChecker>> more;
+  more.push_back(std::move(reach2));
+  more.push_back(std::move(flowpipe2));
+  more.push_back(std::move(sample));
+  FallbackChecker second("auto", std::move(more));
+  const std::vector<CheckResult> r2 = second.Check(system, Named({"a"}));
+  EXPECT_TRUE(flowpipe2_asked->empty());
+  EXPECT_EQ(*sample_asked, (std::vector<std::string>{"sample:a"}));
+  EXPECT_EQ(r2[0].reason, "reach says so; sample: sample says so");
 }
 
 TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {

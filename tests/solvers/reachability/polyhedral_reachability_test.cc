@@ -195,6 +195,33 @@ TEST(PolyhedralReachability, UncertainParameterIsCoveredAndChosen) {
   EXPECT_GT(AtTarget(system, replayed, "x"), 7.0);
 }
 
+// x rises to 1 and stays (its invariant): x >= 1 is reached exactly at the boundary, where no run
+// reaches it with margin. RATE is replaced below: 1, or an uncertain parameter's r, whose range
+// widens the rates (the states met are not exact any more).
+constexpr std::string_view kTouchModel = R"(
+automaton touch {
+  param r = 1 in [1, 2];
+  var x;
+  mode run { x' = RATE; inv x <= 1; }
+  init run { x = 0; }
+  property reaches_one: reach x >= 1;
+  property below_two: always x <= 2;
+}
+)";
+
+TEST(PolyhedralReachability, SaysWhenItsExactStatesMeetAPropertyWithoutARun) {
+  for (const std::string rate : {"1", "r"}) {
+    const std::string model(kTouchModel);
+    const std::size_t at = model.find("RATE");
+    const System system = Parse(model.substr(0, at) + rate + model.substr(at + 4));
+    const auto r = Check(system, {"reaches_one", "below_two"});
+    EXPECT_EQ(r[0].verdict, Verdict::kUnknown) << r[0].reason;
+    EXPECT_EQ(r[0].states_met, rate == "1") << rate << ": " << r[0].reason;
+    EXPECT_EQ(r[1].verdict, Verdict::kProved) << r[1].reason;
+    EXPECT_FALSE(r[1].states_met);
+  }
+}
+
 // x rises to 1 with y = 5, then x and y are swapped at once.
 constexpr std::string_view kSwapModel = R"(
 automaton swap {
