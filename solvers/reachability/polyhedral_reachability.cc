@@ -756,10 +756,14 @@ class GroupTurns {
 };
 
 // Reachability on convex hulls (HullExploration) beside the exact exploration: its first turn
-// before the exact exploration (Options::hull_units, at most 1/kHullTurnDivisor of the share),
-// then 1/kHullTurnDivisor of each of the exact exploration's turns, until its fixpoint proves
-// what its hulls miss or it is abandoned.
-constexpr std::uint64_t kHullTurnDivisor = 4;
+// before the exact exploration (Options::hull_units, at most 1/kHullFirstTurnDivisor of the
+// share, so that a small budget leaves the exact exploration most of it), then as many units as
+// each of the exact exploration's turns (1/kHullTurnDivisor of them), until its fixpoint proves
+// what its hulls miss or it is abandoned: hulls that have not met every property are the likelier
+// proof (fischer_6's need 2.6 billion units, which a quarter of the turns did not give them
+// within the default budget).
+constexpr std::uint64_t kHullFirstTurnDivisor = 4;
+constexpr std::uint64_t kHullTurnDivisor = 1;
 // The hulls' widening, the coarsest first: the growths of a class before its hull is widened
 // (HullExploration's growths_before_widening). Where widened hulls meet the bad states of a
 // property still open (at their fixpoint or before), the exploration starts again, from the
@@ -928,7 +932,7 @@ void FirstTurns(const System& system, const std::vector<Property>& properties,
   if (options.hull_units > 0 && !exact.AllDecided()) {
     try {
       side.hull.emplace(system, observed, read, options, meter);
-      side.hull->Turn(exact, std::min(options.hull_units, meter.share() / kHullTurnDivisor));
+      side.hull->Turn(exact, std::min(options.hull_units, meter.share() / kHullFirstTurnDivisor));
     } catch (const std::invalid_argument&) {
       side.hull.reset();
     }

@@ -93,11 +93,11 @@ class PolyhedralReachability {
     /// convex hulls (HullExploration: one polyhedron per location and per value of the
     /// variables constant there, an over-approximation: solvers/reachability/hull_exploration.h),
     /// taken before the exact exploration (at most a quarter of the exploration's share of the
-    /// budget); later turns get 1/4 of each of the exact exploration's turns. At its fixpoint a
-    /// property whose bad states the hulls miss holds; the hull proves nothing else (a bad state
-    /// met is left to the exact exploration), and it is abandoned once every property left is met
-    /// or its coefficients grow too long. 0: no hull. The default, 2 budget seconds, lets the hull
-    /// of FISCS05 (163 million units) end in its first turn.
+    /// budget); later turns get as many units as each of the exact exploration's turns. At its
+    /// fixpoint a property whose bad states the hulls miss holds; the hull proves nothing else (a
+    /// bad state met is left to the exact exploration), and it is abandoned once every property
+    /// left is met or its coefficients grow too long. 0: no hull. The default, 2 budget seconds,
+    /// lets the hulls of FISCS05 (143 million units) end in their first turn.
     std::uint64_t hull_units = 200'000'000;
     /// Another engine's turn (say, a cheap proof by induction), taken once the exploration of
     /// the properties without a horizon has used `pause_units` reach units without deciding all
