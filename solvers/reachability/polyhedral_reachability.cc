@@ -760,8 +760,8 @@ class GroupTurns {
 // share, so that a small budget leaves the exact exploration most of it), then as many units as
 // each of the exact exploration's turns (1/kHullTurnDivisor of them), until its fixpoint proves
 // what its hulls miss or it is abandoned: hulls that have not met every property are the likelier
-// proof (fischer_6's need 2.6 billion units, which a quarter of the turns did not give them
-// within the default budget).
+// proof (fischer_6's mutual exclusion is proved on them at 5.2 billion units in all, about half
+// of them the hulls', which a quarter of the turns did not give within the default budget).
 constexpr std::uint64_t kHullFirstTurnDivisor = 4;
 constexpr std::uint64_t kHullTurnDivisor = 1;
 // The hulls' widening, the coarsest first: the growths of a class before its hull is widened
