@@ -770,8 +770,8 @@ constexpr std::uint64_t kHullTurnDivisor = 1;
 // next turn on, with the next, later widening: finer hulls, which cost more (the proof of
 // DISC03's all_sending took 61, 69 and 75 million reach units at 3, 4 and 5), and may prove what
 // the first lost. Hulls that met them before any widening would meet them again at any later
-// one. At 2, FISCS05's first hulls meet the bad states of its mutual exclusion: the later ones
-// prove it, after 2.5 billion units in all.
+// one. At 2, FISCS05's first hulls meet the bad states of its mutual exclusion, which they prove
+// at 3.
 constexpr std::array<int, 2> kWideningLadder = {3, 32};
 // The later widenings' turns: 1/kLaterLevelDivisor of the first's (they seldom prove what the
 // first did not, and where the hulls meet the bad states at every widening, as TTEthernet's do,
