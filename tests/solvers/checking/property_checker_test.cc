@@ -60,6 +60,14 @@ class ScriptedChecker : public PropertyChecker {
   bool handles_;
 };
 
+// The fallback "auto" over `checkers`, in order.
+template <class... Checkers>
+FallbackChecker Auto(std::unique_ptr<Checkers>... checkers) {
+  std::vector<std::unique_ptr<PropertyChecker>> all;
+  (all.push_back(std::move(checkers)), ...);
+  return FallbackChecker("auto", std::move(all));
+}
+
 std::vector<Property> Named(const std::vector<std::string>& names) {
   std::vector<Property> out;
   for (const std::string& n : names) out.push_back({n, Property::Kind::kAlways, Predicate::True()});
@@ -95,10 +103,7 @@ TEST(FallbackChecker, AsksLaterCheckersOnlyWhatIsUnknown) {
   auto prove = std::make_unique<ScriptedChecker>(
       "prove", std::map<std::string, Verdict>{{"b", Verdict::kViolated}});
   const auto reach_asked = reach->asked, prove_asked = prove->asked;
-  std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(std::move(reach));
-  checkers.push_back(std::move(prove));
-  FallbackChecker fallback("auto", std::move(checkers));
+  FallbackChecker fallback = Auto(std::move(reach), std::move(prove));
   const System system("s");
   const std::vector<CheckResult> results = fallback.Check(system, Named({"a", "b", "c"}));
   ASSERT_EQ(results.size(), 3u);
@@ -126,10 +131,7 @@ TEST(FallbackChecker, BoundedProofsAreAskedAgainAndImprovedOnly) {
       "sample", std::map<std::string, Verdict>{{"a", Verdict::kViolated}, {"c", Verdict::kProved}});
   sample->within_ = {{"c", 9.0}};
   const auto sample_asked = sample->asked;
-  std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(std::move(flowpipe));
-  checkers.push_back(std::move(sample));
-  FallbackChecker fallback("auto", std::move(checkers));
+  FallbackChecker fallback = Auto(std::move(flowpipe), std::move(sample));
   const System system("s");
   const std::vector<CheckResult> r = fallback.Check(system, Named({"a", "b", "c", "d"}));
   EXPECT_EQ(*sample_asked, (std::vector<std::string>{"sample:a", "sample:b", "sample:c"}));
@@ -154,11 +156,7 @@ TEST(FallbackChecker, AsksNoProofOnlyCheckerWhatTheStatesMet) {
   auto prove = std::make_unique<ScriptedChecker>(
       "prove", std::map<std::string, Verdict>{{"a", Verdict::kReachable}});
   const auto flowpipe_asked = flowpipe->asked, prove_asked = prove->asked;
-  std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(std::move(reach));
-  checkers.push_back(std::move(flowpipe));
-  checkers.push_back(std::move(prove));
-  FallbackChecker fallback("auto", std::move(checkers));
+  FallbackChecker fallback = Auto(std::move(reach), std::move(flowpipe), std::move(prove));
   const System system("s");
   const std::vector<CheckResult> r = fallback.Check(system, Named({"a", "b", "c"}));
   EXPECT_EQ(*flowpipe_asked, (std::vector<std::string>{"flowpipe:b", "flowpipe:c"}));
@@ -167,22 +165,22 @@ TEST(FallbackChecker, AsksNoProofOnlyCheckerWhatTheStatesMet) {
   EXPECT_EQ(r[0].method, "prove");
   EXPECT_EQ(r[1].verdict, Verdict::kProved);
   EXPECT_EQ(r[2].reason, "reach says so; flowpipe: flowpipe says so; prove: prove says so");
-  // Only the met property left open: the proof-only checker is skipped, the next one asked.
-  auto reach2 = std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{});
-  reach2->met_ = {"a"};
-  auto flowpipe2 = std::make_unique<ScriptedChecker>("flowpipe", std::map<std::string, Verdict>{});
-  flowpipe2->falsifies_ = false;
+}
+
+// With only a met property left open, the proof-only checker is skipped and the next one asked.
+TEST(FallbackChecker, GoesPastAProofOnlyCheckerWhenOnlyMetPropertiesAreOpen) {
+  auto reach = std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{});
+  reach->met_ = {"a"};
+  auto flowpipe = std::make_unique<ScriptedChecker>("flowpipe", std::map<std::string, Verdict>{});
+  flowpipe->falsifies_ = false;
   auto sample = std::make_unique<ScriptedChecker>("sample", std::map<std::string, Verdict>{});
-  const auto flowpipe2_asked = flowpipe2->asked, sample_asked = sample->asked;
-  std::vector<std::unique_ptr<PropertyChecker>> more;
-  more.push_back(std::move(reach2));
-  more.push_back(std::move(flowpipe2));
-  more.push_back(std::move(sample));
-  FallbackChecker second("auto", std::move(more));
-  const std::vector<CheckResult> r2 = second.Check(system, Named({"a"}));
-  EXPECT_TRUE(flowpipe2_asked->empty());
+  const auto flowpipe_asked = flowpipe->asked, sample_asked = sample->asked;
+  FallbackChecker fallback = Auto(std::move(reach), std::move(flowpipe), std::move(sample));
+  const System system("s");
+  const std::vector<CheckResult> r = fallback.Check(system, Named({"a"}));
+  EXPECT_TRUE(flowpipe_asked->empty());
   EXPECT_EQ(*sample_asked, (std::vector<std::string>{"sample:a"}));
-  EXPECT_EQ(r2[0].reason, "reach says so; sample: sample says so");
+  EXPECT_EQ(r[0].reason, "reach says so; sample: sample says so");
 }
 
 TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {
@@ -190,10 +188,7 @@ TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {
       "reach", std::map<std::string, Verdict>{{"a", Verdict::kProved}}, false);
   auto prove = std::make_unique<ScriptedChecker>("prove", std::map<std::string, Verdict>{});
   const auto reach_asked = reach->asked;
-  std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(std::move(reach));
-  checkers.push_back(std::move(prove));
-  FallbackChecker fallback("auto", std::move(checkers));
+  FallbackChecker fallback = Auto(std::move(reach), std::move(prove));
   const System system("s");
   const std::vector<CheckResult> results = fallback.Check(system, Named({"a"}));
   EXPECT_TRUE(reach_asked->empty());
@@ -203,10 +198,8 @@ TEST(FallbackChecker, SkipsCheckersThatDoNotApply) {
 }
 
 TEST(FallbackChecker, NoCheckerThatAppliesLeavesEveryPropertyUnknownSayingWhy) {
-  std::vector<std::unique_ptr<PropertyChecker>> checkers;
-  checkers.push_back(
-      std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{}, false));
-  FallbackChecker fallback("auto", std::move(checkers));
+  FallbackChecker fallback =
+      Auto(std::make_unique<ScriptedChecker>("reach", std::map<std::string, Verdict>{}, false));
   const System system("s");
   const std::vector<CheckResult> results = fallback.Check(system, Named({"a"}));
   ASSERT_EQ(results.size(), 1u);
